@@ -1,0 +1,207 @@
+//! Linear constraints of the smoothing QP (paper eq. 13–14, SPEC.md "Constraint sets").
+//!
+//! Every constrained edge is oriented by the representative u (i → j when (u_i, i) < (u_j, j))
+//! and asks `f_j − f_i ≥ ε`. Sorting the vertices by (u, index) is therefore a topological
+//! order of the constraint graph, which gives the largest feasible margin in linear time per
+//! trial (NOTES.md 2): with fixed values, `f_j − f_i ≥ ε` on a DAG is feasible iff every
+//! directed path of `L` edges from a fixed a to a fixed b has `f_b − f_a ≥ L·ε`.
+//!
+//! ```
+//! use toposmooth::{constraints::{constraint_edges, max_margin, EdgeSet}, domain::Series};
+//! let u = [0.0, 1.0, 2.0, 3.0];
+//! let fixed = [Some(0.0), None, None, Some(3.0)];
+//! let edges = constraint_edges(&Series::uniform(4), &u, &fixed, EdgeSet::Minimal);
+//! assert_eq!(edges, vec![(0, 1), (1, 2), (2, 3)]);
+//! let eps = max_margin(&u, &edges, &fixed).unwrap();
+//! assert!((eps - 1.0).abs() < 1e-9); // 3 edges across a rise of 3
+//! ```
+
+use crate::domain::{sos_less, sos_sort, Domain};
+use crate::error::{Error, Result};
+
+/// Which edges carry an ordering constraint.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum EdgeSet {
+    /// Per free vertex its lowest and highest neighbour in u, plus every edge between a fixed
+    /// and a free vertex.
+    Minimal,
+    /// Every edge with at least one free end.
+    All,
+}
+
+/// Constrained edges `(i, j)` meaning `f_j − f_i ≥ ε`, sorted and without duplicates.
+pub fn constraint_edges<D: Domain>(domain: &D, u: &[f64], fixed: &[Option<f64>], set: EdgeSet) -> Vec<(usize, usize)> {
+    let n = domain.n_vertices();
+    let orient = |a: usize, b: usize| if sos_less(u, a, b) { (a, b) } else { (b, a) };
+    let mut edges = Vec::new();
+    for v in 0..n {
+        match set {
+            EdgeSet::All => {
+                for w in domain.neighbors(v) {
+                    if v < w && (fixed[v].is_none() || fixed[w].is_none()) {
+                        edges.push(orient(v, w));
+                    }
+                }
+            }
+            EdgeSet::Minimal => {
+                if fixed[v].is_some() {
+                    for w in domain.neighbors(v) {
+                        if fixed[w].is_none() {
+                            edges.push(orient(v, w));
+                        }
+                    }
+                    continue;
+                }
+                let mut low: Option<usize> = None;
+                let mut high: Option<usize> = None;
+                for w in domain.neighbors(v) {
+                    if low.is_none_or(|l| sos_less(u, w, l)) {
+                        low = Some(w);
+                    }
+                    if high.is_none_or(|h| sos_less(u, h, w)) {
+                        high = Some(w);
+                    }
+                }
+                for w in low.into_iter().chain(high) {
+                    edges.push(orient(v, w));
+                }
+            }
+        }
+    }
+    edges.sort_unstable();
+    edges.dedup();
+    edges
+}
+
+/// Largest ε for which `f_j − f_i ≥ ε` on every edge is feasible with the fixed values
+/// (`+inf` when no path joins two fixed vertices), to a relative precision of 1e-12.
+///
+/// # Errors
+/// Infeasible if even ε = 0 is infeasible: an edge path runs from a fixed value down to a
+/// smaller one (u disagrees with the fixed values).
+pub fn max_margin(u: &[f64], edges: &[(usize, usize)], fixed: &[Option<f64>]) -> Result<f64> {
+    let n = u.len();
+    let order = sos_sort(u);
+    // out-edges in compressed form
+    let mut start = vec![0usize; n + 1];
+    for &(a, _) in edges {
+        start[a + 1] += 1;
+    }
+    for i in 0..n {
+        start[i + 1] += start[i];
+    }
+    let mut fill = start.clone();
+    let mut succ = vec![0usize; edges.len()];
+    for &(a, b) in edges {
+        succ[fill[a]] = b;
+        fill[a] += 1;
+    }
+    let mut lo = vec![f64::NEG_INFINITY; n];
+    // Some(v) = the first fixed vertex whose bound fails at this ε
+    let mut violated = |eps: f64| -> Option<usize> {
+        for (v, l) in lo.iter_mut().enumerate() {
+            *l = fixed[v].unwrap_or(f64::NEG_INFINITY);
+        }
+        for &v in &order {
+            let base = lo[v];
+            if base == f64::NEG_INFINITY {
+                continue;
+            }
+            for &w in &succ[start[v]..start[v + 1]] {
+                let cand = base + eps;
+                match fixed[w] {
+                    Some(fw) if cand > fw => return Some(w),
+                    Some(_) => {}
+                    None => lo[w] = lo[w].max(cand),
+                }
+            }
+        }
+        None
+    };
+    if let Some(w) = violated(0.0) {
+        return Err(Error::infeasible(format!(
+            "the constraint graph runs from a fixed value down to the smaller fixed value at vertex {w}"
+        )));
+    }
+    let (fmin, fmax) = fixed.iter().flatten().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| (a.min(v), b.max(v)));
+    let span = if fmax > fmin { fmax - fmin } else { 1.0 };
+    if violated(span).is_none() {
+        // a path of one edge between fixed values already allows the whole span: no bound
+        // short of it matters; report +inf when no fixed pair is linked at all
+        return Ok(if violated(2.0 * span + 1.0).is_none() { f64::INFINITY } else { span });
+    }
+    let (mut ok, mut bad) = (0.0, span);
+    while bad - ok > 1e-12 * span {
+        let mid = 0.5 * (ok + bad);
+        if violated(mid).is_none() {
+            ok = mid;
+        } else {
+            bad = mid;
+        }
+    }
+    Ok(ok)
+}
+
+/// The margin used: half the largest feasible one, and at most `1e-6` of the value range.
+///
+/// Half keeps u's constraint set strictly feasible with slack on every path (so an
+/// interior-point solver starts and ends inside); 1e-6 of the range is 100× the solver's
+/// feasibility tolerance (1e-8 after the values are scaled to unit range), so the tolerance
+/// cannot turn a constrained edge into a tie, while a slope of 1e-6·range per edge is far
+/// below anything visible.
+///
+/// `resolution` is the spacing of doubles at the field's largest magnitude, in the same
+/// units as the margin.
+///
+/// # Errors
+/// Infeasible (exit 3) when the margin is not above 4 × `resolution`: floating point cannot
+/// represent a strict function with the kept values along the longest constrained path.
+pub fn choose_margin(max_margin: f64, range: f64, resolution: f64) -> Result<f64> {
+    let eps = (0.5 * max_margin).min(1e-6 * range);
+    if !(eps > 4.0 * resolution) {
+        return Err(Error::infeasible(format!(
+            "the kept values leave a margin of {eps:e} per edge, not above 4 × the spacing of doubles ({resolution:e}): no strict function in double precision"
+        )));
+    }
+    Ok(eps)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::domain::Series;
+
+    #[test]
+    fn minimal_set_adds_all_edges_at_fixed_vertices() {
+        let u = [3.0, 0.0, 1.0, 2.0, 5.0, 4.0];
+        let fixed = [None, Some(0.0), None, None, Some(5.0), None];
+        let e = constraint_edges(&Series::uniform(6), &u, &fixed, EdgeSet::Minimal);
+        assert_eq!(e, vec![(1, 0), (1, 2), (2, 3), (3, 4), (5, 4)]);
+        let all = constraint_edges(&Series::uniform(6), &u, &fixed, EdgeSet::All);
+        assert_eq!(all, e);
+    }
+
+    #[test]
+    fn margin_is_the_tightest_path() {
+        // fixed 0 at vertex 0 and 1 at vertex 4: 4 edges ⇒ ε_max = 0.25
+        let u = [0.0, 0.1, 0.2, 0.3, 1.0];
+        let fixed = [Some(0.0), None, None, None, Some(1.0)];
+        let e = constraint_edges(&Series::uniform(5), &u, &fixed, EdgeSet::Minimal);
+        let m = max_margin(&u, &e, &fixed).unwrap();
+        assert!((m - 0.25).abs() < 1e-9, "{m}");
+        assert_eq!(choose_margin(m, 1.0, f64::EPSILON).unwrap(), 1e-6);
+        assert!(choose_margin(1e-20, 1.0, f64::EPSILON).is_err());
+        // u disagreeing with the fixed values
+        let bad = [Some(1.0), None, None, None, Some(0.0)];
+        assert!(max_margin(&u, &e, &bad).is_err());
+    }
+
+    #[test]
+    fn unlinked_fixed_values_give_an_unbounded_margin() {
+        let u = [0.0, 1.0, 2.0];
+        let fixed = [Some(0.0), None, None];
+        let e = constraint_edges(&Series::uniform(3), &u, &fixed, EdgeSet::Minimal);
+        assert_eq!(max_margin(&u, &e, &fixed).unwrap(), f64::INFINITY);
+    }
+}

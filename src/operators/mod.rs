@@ -1,0 +1,25 @@
+//! Discrete operators: stiffness (minus the Laplacian), lumped mass, polyharmonic energies.
+//!
+//! Conventions (libigl's, with the sign flipped once): `K = −L` is the symmetric positive
+//! semi-definite stiffness matrix with `K·1 = 0`, `M` the diagonal lumped mass. The
+//! polyharmonic energy of order `k` is `E_k(f) = fᵀ Q_k f` with `Q_1 = K`, `Q_2 = K M⁻¹ K`,
+//! `Q_3 = K M⁻¹ K M⁻¹ K`, `Q_4 = K M⁻¹ K M⁻¹ K M⁻¹ K` (paper eq. 18; `∫ |∇^k f|²`).
+//!
+//! ```
+//! use toposmooth::{domain::Series, operators::{series_stiffness, series_mass, polyharmonic, Energy}};
+//! let s = Series::uniform(5);
+//! let (k, m) = (series_stiffness(&s), series_mass(&s));
+//! let q = polyharmonic(&k, &m, &Energy::order(2), &[1.0]);
+//! // a linear function has zero Laplacian inside; only the ends (natural boundary) see it
+//! let f: Vec<f64> = (0..5).map(|i| i as f64).collect();
+//! assert!(toposmooth::operators::quadratic_form(&q, &f) > 0.0);
+//! assert!(toposmooth::operators::quadratic_form(&q, &[1.0; 5]).abs() < 1e-12);
+//! ```
+
+mod polyharmonic;
+mod series;
+mod sparse;
+
+pub use polyharmonic::{polyharmonic, Energy};
+pub use series::{series_mass, series_stiffness};
+pub use sparse::{quadratic_form, Sparse};

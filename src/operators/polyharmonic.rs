@@ -1,0 +1,188 @@
+//! Polyharmonic energies of order 1..4, their blends, and sharp vertices.
+
+use super::sparse::{from_triplets, matmul, scale_cols, scale_rows, triplets, Sparse};
+use crate::error::{Error, Result};
+use faer::sparse::Triplet;
+
+/// A smoothness energy: a weighted sum of polyharmonic orders (Botsch & Kobbelt 2004) and
+/// the vertices where orders ≥ 2 are not penalised.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct Energy {
+    /// `(order k, weight)` pairs, k in 1..=4, weight ≥ 0.
+    pub terms: Vec<(u8, f64)>,
+    /// Sharp vertices: the Laplacian there is not penalised, so a kink can stay C0.
+    pub sharp: Vec<usize>,
+}
+
+impl Energy {
+    /// A single order with weight 1.
+    pub fn order(k: u8) -> Self {
+        Energy { terms: vec![(k, 1.0)], sharp: Vec::new() }
+    }
+
+    /// Parses `2` or a blend `1:0.2,2:1`.
+    ///
+    /// # Errors
+    /// Usage error for an order outside 1..=4, a negative or non-finite weight, or all
+    /// weights zero.
+    pub fn parse(spec: &str) -> Result<Self> {
+        let mut terms = Vec::new();
+        for part in spec.split(',') {
+            let (k, w) = match part.split_once(':') {
+                Some((k, w)) => (k.trim(), w.trim()),
+                None => (part.trim(), "1"),
+            };
+            let k: u8 = k.parse().map_err(|_| Error::Usage(format!("order `{k}` in `{spec}` is not an integer 1..4")))?;
+            let w: f64 = w.parse().map_err(|_| Error::Usage(format!("weight `{w}` in `{spec}` is not a number")))?;
+            terms.push((k, w));
+        }
+        let e = Energy { terms, sharp: Vec::new() };
+        e.validate()?;
+        Ok(e)
+    }
+
+    /// Checks orders and weights.
+    pub fn validate(&self) -> Result<()> {
+        for &(k, w) in &self.terms {
+            if !(1..=4).contains(&k) {
+                return Err(Error::Usage(format!("energy order {k} is outside 1..4")));
+            }
+            if !(w.is_finite() && w >= 0.0) {
+                return Err(Error::Usage(format!("weight {w} of order {k} must be finite and ≥ 0")));
+            }
+        }
+        if self.terms.iter().all(|&(_, w)| w == 0.0) {
+            return Err(Error::Usage("the smoothness energy needs a positive weight".into()));
+        }
+        Ok(())
+    }
+
+    /// Highest order with a positive weight.
+    pub fn max_order(&self) -> u8 {
+        self.terms.iter().filter(|t| t.1 > 0.0).map(|t| t.0).max().unwrap_or(1)
+    }
+}
+
+/// Assembles `Q = Σ_t w_t · scale_t · Q_{k_t}` (`#V × #V`, symmetric PSD) from the stiffness
+/// `K = −L` and the lumped mass `M`; `scale[t]` multiplies term `t` (e.g. `ℓ^{2k}`).
+///
+/// `Q_1 = K`; for `k ≥ 2`, with `G = S M⁻¹ K` the Laplacian at non-sharp vertices (`S` zeroes
+/// the rows of sharp vertices), `Q_k = Gᵀ Q′_{k−2} G`, where `Q′_0 = M`, `Q′_1 = K′`,
+/// `Q′_2 = K′ M⁻¹ K′` and `K′` is `K` with every edge at a sharp vertex removed. Without
+/// sharp vertices this is `K (M⁻¹ K)^{k−1}` (paper eq. 18).
+///
+/// # Panics
+/// If `scale.len() != energy.terms.len()`, `m.len() != K.nrows()`, or a sharp index is out of
+/// range (callers validate first).
+pub fn polyharmonic(k: &Sparse, m: &[f64], energy: &Energy, scale: &[f64]) -> Sparse {
+    assert_eq!(scale.len(), energy.terms.len());
+    let n = k.nrows();
+    assert_eq!(m.len(), n);
+    let mut sharp = vec![false; n];
+    for &v in &energy.sharp {
+        sharp[v] = true;
+    }
+    let d: Vec<f64> = (0..n).map(|i| if sharp[i] { 0.0 } else { 1.0 / m[i] }).collect();
+    let k_cut = if energy.sharp.is_empty() { k.clone() } else { cut_edges(k, &sharp) };
+    let minv: Vec<f64> = m.iter().map(|x| 1.0 / x).collect();
+    let mut all = Vec::new();
+    for (&(order, w), &s) in energy.terms.iter().zip(scale) {
+        let c = w * s;
+        if c == 0.0 {
+            continue;
+        }
+        let q = match order {
+            1 => k.clone(),
+            _ => {
+                let g = scale_rows(k, &d); // D K
+                let gt = scale_cols(k, &d); // K D = Gᵀ (K symmetric)
+                let inner = match order {
+                    2 => scale_rows(&g, m),                                 // M G
+                    3 => matmul(&k_cut, &g),                                 // K′ G
+                    _ => matmul(&k_cut, &scale_rows(&matmul(&k_cut, &g), &minv)), // K′ M⁻¹ K′ G
+                };
+                matmul(&gt, &inner)
+            }
+        };
+        all.extend(triplets(&q).into_iter().map(|t| Triplet::new(t.row, t.col, c * t.val)));
+    }
+    from_triplets(n, n, &all)
+}
+
+/// `K` without the edges at sharp vertices, diagonal recomputed so that rows sum to zero.
+fn cut_edges(k: &Sparse, sharp: &[bool]) -> Sparse {
+    let n = k.nrows();
+    let mut diag = vec![0.0; n];
+    let mut t = Vec::new();
+    for e in triplets(k) {
+        if e.row != e.col && !sharp[e.row] && !sharp[e.col] {
+            t.push(e);
+            diag[e.row] -= e.val;
+        }
+    }
+    t.extend((0..n).map(|i| Triplet::new(i, i, diag[i])));
+    from_triplets(n, n, &t)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::domain::Series;
+    use crate::operators::{quadratic_form, series_mass, series_stiffness};
+
+    fn setup(x: Vec<f64>) -> (Sparse, Vec<f64>) {
+        let s = Series::with_coordinates(x).unwrap();
+        (series_stiffness(&s), series_mass(&s))
+    }
+
+    #[test]
+    fn orders_annihilate_constants_and_are_symmetric() {
+        let (k, m) = setup(vec![0.0, 0.3, 1.0, 1.2, 2.0, 3.5, 4.0]);
+        for order in 1..=4 {
+            let q = polyharmonic(&k, &m, &Energy::order(order), &[1.0]);
+            assert!(quadratic_form(&q, &[2.0; 7]).abs() < 1e-10, "order {order}");
+            let dense = q.to_dense();
+            for i in 0..7 {
+                for j in 0..7 {
+                    assert!((dense[(i, j)] - dense[(j, i)]).abs() < 1e-9 * (1.0 + dense[(i, j)].abs()));
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn biharmonic_measures_the_laplacian() {
+        // uniform unit spacing: (M⁻¹K f)_i = −(f_{i−1} − 2 f_i + f_{i+1}) inside
+        let (k, m) = setup((0..6).map(|i| i as f64).collect());
+        let f: Vec<f64> = (0..6).map(|i| ((i * i) as f64) / 2.0).collect(); // f'' = 1
+        let q = polyharmonic(&k, &m, &Energy::order(2), &[1.0]);
+        // interior: 4 vertices with Laplacian 1 and mass 1; ends: (f0 − f1)/0.5 = 1, (f5−f4)/0.5 = 9
+        let ends = 0.5 * 1.0f64.powi(2) + 0.5 * 9.0f64.powi(2);
+        assert!((quadratic_form(&q, &f) - (4.0 + ends)).abs() < 1e-9);
+    }
+
+    #[test]
+    fn sharp_vertices_allow_a_kink() {
+        let (k, m) = setup((0..9).map(|i| i as f64).collect());
+        // a tent: linear up to vertex 4, linear down after it
+        let f: Vec<f64> = (0..9).map(|i| 4.0 - (i as f64 - 4.0).abs()).collect();
+        for order in 2..=4u8 {
+            let plain = polyharmonic(&k, &m, &Energy::order(order), &[1.0]);
+            let mut e = Energy::order(order);
+            e.sharp = vec![0, 4, 8];
+            let sharp = polyharmonic(&k, &m, &e, &[1.0]);
+            assert!(quadratic_form(&plain, &f) > 1.0, "order {order}");
+            assert!(quadratic_form(&sharp, &f).abs() < 1e-10, "order {order}: {}", quadratic_form(&sharp, &f));
+        }
+    }
+
+    #[test]
+    fn blends_parse_and_validate() {
+        let e = Energy::parse("1:0.2,2:1").unwrap();
+        assert_eq!(e.terms, vec![(1, 0.2), (2, 1.0)]);
+        assert_eq!(e.max_order(), 2);
+        assert!(Energy::parse("5").is_err());
+        assert!(Energy::parse("2:-1").is_err());
+        assert!(Energy::parse("x").is_err());
+    }
+}

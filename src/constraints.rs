@@ -31,7 +31,12 @@ pub enum EdgeSet {
 }
 
 /// Constrained edges `(i, j)` meaning `f_j − f_i ≥ ε`, sorted and without duplicates.
-pub fn constraint_edges<D: Domain>(domain: &D, u: &[f64], fixed: &[Option<f64>], set: EdgeSet) -> Vec<(usize, usize)> {
+pub fn constraint_edges<D: Domain>(
+    domain: &D,
+    u: &[f64],
+    fixed: &[Option<f64>],
+    set: EdgeSet,
+) -> Vec<(usize, usize)> {
     let n = domain.n_vertices();
     let orient = |a: usize, b: usize| if sos_less(u, a, b) { (a, b) } else { (b, a) };
     let mut edges = Vec::new();
@@ -124,12 +129,21 @@ pub fn max_margin(u: &[f64], edges: &[(usize, usize)], fixed: &[Option<f64>]) ->
             "the constraint graph runs from a fixed value down to the smaller fixed value at vertex {w}"
         )));
     }
-    let (fmin, fmax) = fixed.iter().flatten().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| (a.min(v), b.max(v)));
+    let (fmin, fmax) = fixed
+        .iter()
+        .flatten()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
+            (a.min(v), b.max(v))
+        });
     let span = if fmax > fmin { fmax - fmin } else { 1.0 };
     if violated(span).is_none() {
         // a path of one edge between fixed values already allows the whole span: no bound
         // short of it matters; report +inf when no fixed pair is linked at all
-        return Ok(if violated(2.0 * span + 1.0).is_none() { f64::INFINITY } else { span });
+        return Ok(if violated(2.0 * span + 1.0).is_none() {
+            f64::INFINITY
+        } else {
+            span
+        });
     }
     let (mut ok, mut bad) = (0.0, span);
     while bad - ok > 1e-12 * span {

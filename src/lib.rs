@@ -15,8 +15,11 @@ pub mod operators;
 pub mod topology;
 
 pub use error::{Error, Result};
+pub mod commands;
 pub mod constraints;
+pub mod io;
 pub mod pipeline;
+pub mod plot;
 pub mod representative;
 pub mod solve;
 pub mod verify;

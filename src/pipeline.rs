@@ -14,10 +14,14 @@
 use crate::constraints::{choose_margin, constraint_edges, max_margin, EdgeSet};
 use crate::domain::{sos_sort, Domain, Series};
 use crate::error::{Error, Result};
-use crate::operators::{polyharmonic, quadratic_form, series_mass, series_stiffness, Energy, Sparse};
+use crate::operators::{
+    polyharmonic, quadratic_form, series_mass, series_stiffness, Energy, Sparse,
+};
 use crate::representative::series_representative;
 use crate::solve::{repair, solve_monotone_qp, MonotoneQp, QpSettings, RepairSummary, SolveStatus};
-use crate::topology::{extrema_table, select, ExtremumKind, KeptExtremum, KeptSet, Role, Selection};
+use crate::topology::{
+    extrema_table, select, ExtremumKind, KeptExtremum, KeptSet, Role, Selection,
+};
 use crate::verify::{certify, Certificate};
 use faer::sparse::Triplet;
 use std::time::Instant;
@@ -82,15 +86,23 @@ impl SmoothSettings {
     pub fn validate(&self) -> Result<()> {
         self.energy.validate()?;
         if !(self.data_weight.is_finite() && self.data_weight >= 0.0) {
-            return Err(Error::Usage(format!("--data-weight must be finite and ≥ 0, got {}", self.data_weight)));
+            return Err(Error::Usage(format!(
+                "--data-weight must be finite and ≥ 0, got {}",
+                self.data_weight
+            )));
         }
         if let Some(w) = self.smooth_weight {
             if !(w.is_finite() && w > 0.0) {
-                return Err(Error::Usage(format!("--smooth-weight must be finite and > 0, got {w}")));
+                return Err(Error::Usage(format!(
+                    "--smooth-weight must be finite and > 0, got {w}"
+                )));
             }
         }
         if !(self.smooth_length.is_finite() && self.smooth_length > 0.0) {
-            return Err(Error::Usage(format!("--smooth-length must be finite and > 0, got {}", self.smooth_length)));
+            return Err(Error::Usage(format!(
+                "--smooth-length must be finite and > 0, got {}",
+                self.smooth_length
+            )));
         }
         Ok(())
     }
@@ -200,10 +212,15 @@ pub fn smooth<D: Smoothable>(domain: &D, h: &[f64], settings: &SmoothSettings) -
     settings.validate()?;
     let n = domain.n_vertices();
     if h.len() != n {
-        return Err(Error::input(format!("the field has {} values, the domain {n} vertices", h.len())));
+        return Err(Error::input(format!(
+            "the field has {} values, the domain {n} vertices",
+            h.len()
+        )));
     }
     if let Some(&v) = settings.energy.sharp.iter().find(|&&v| v >= n) {
-        return Err(Error::Usage(format!("sharp vertex {v} is out of range (the input has {n} vertices)")));
+        return Err(Error::Usage(format!(
+            "sharp vertex {v} is out of range (the input has {n} vertices)"
+        )));
     }
     let mut seconds = StageSeconds::default();
 
@@ -218,25 +235,40 @@ pub fn smooth<D: Smoothable>(domain: &D, h: &[f64], settings: &SmoothSettings) -
     let u = domain.representative(h, &kept)?;
     let representative_certificate = certify(domain, &u, &kept.roles, None);
     if !representative_certificate.passed {
-        return Err(Error::Representative { path: None, message: representative_certificate.summary() });
+        return Err(Error::Representative {
+            path: None,
+            message: representative_certificate.summary(),
+        });
     }
     seconds.representative = t.elapsed().as_secs_f64();
 
     // work in units where the field spans [0, 1]
     let t = Instant::now();
-    let (lo, hi) = h.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| (a.min(v), b.max(v)));
+    let (lo, hi) = h
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
+            (a.min(v), b.max(v))
+        });
     let range = hi - lo;
     let z: Vec<f64> = h.iter().map(|v| (v - lo) / range).collect();
     let k = domain.stiffness();
     let m = domain.mass();
     let ell = settings.smooth_length * domain.diameter();
-    let weights: Vec<f64> =
-        settings.energy.terms.iter().map(|&(order, _)| settings.smooth_weight.unwrap_or(ell.powi(2 * order as i32))).collect();
+    let weights: Vec<f64> = settings
+        .energy
+        .terms
+        .iter()
+        .map(|&(order, _)| settings.smooth_weight.unwrap_or(ell.powi(2 * order as i32)))
+        .collect();
     let q_energy = polyharmonic(&k, &m, &settings.energy, &weights);
     let gd = settings.data_weight;
     let mut trip: Vec<Triplet<usize, usize, f64>> = Vec::new();
     {
-        let (cp, ri, val) = (q_energy.symbolic().col_ptr(), q_energy.symbolic().row_idx(), q_energy.val());
+        let (cp, ri, val) = (
+            q_energy.symbolic().col_ptr(),
+            q_energy.symbolic().row_idx(),
+            q_energy.val(),
+        );
         for j in 0..n {
             for p in cp[j]..cp[j + 1] {
                 trip.push(Triplet::new(ri[p], j, val[p]));
@@ -249,7 +281,9 @@ pub fn smooth<D: Smoothable>(domain: &D, h: &[f64], settings: &SmoothSettings) -
     seconds.operators = t.elapsed().as_secs_f64();
 
     let t = Instant::now();
-    let fixed: Vec<Option<f64>> = (0..n).map(|i| kept.roles[i].is_fixed().then_some(z[i])).collect();
+    let fixed: Vec<Option<f64>> = (0..n)
+        .map(|i| kept.roles[i].is_fixed().then_some(z[i]))
+        .collect();
     let edges = constraint_edges(domain, &u, &fixed, settings.edges);
     check_fixed_neighbours(domain, h, &kept.roles)?;
     let eps_max = max_margin(&u, &edges, &fixed)?;
@@ -259,7 +293,16 @@ pub fn smooth<D: Smoothable>(domain: &D, h: &[f64], settings: &SmoothSettings) -
     seconds.constraints = t.elapsed().as_secs_f64();
 
     let t = Instant::now();
-    let sol = solve_monotone_qp(&MonotoneQp { p: &p, q: &q, fixed: &fixed, edges: &edges, margin: eps }, &settings.qp)?;
+    let sol = solve_monotone_qp(
+        &MonotoneQp {
+            p: &p,
+            q: &q,
+            fixed: &fixed,
+            edges: &edges,
+            margin: eps,
+        },
+        &settings.qp,
+    )?;
     seconds.solve = t.elapsed().as_secs_f64();
 
     let t = Instant::now();
@@ -310,7 +353,11 @@ pub fn smooth<D: Smoothable>(domain: &D, h: &[f64], settings: &SmoothSettings) -
         kept: kept.kept.clone(),
         warnings: kept.warnings.clone(),
         seconds,
-        energy: EnergyReport { smoothness, data, total: smoothness + data },
+        energy: EnergyReport {
+            smoothness,
+            data,
+            total: smoothness + data,
+        },
         rms_deviation: (sq / n as f64).sqrt(),
         max_deviation,
         solver_status: sol.status,
@@ -319,7 +366,12 @@ pub fn smooth<D: Smoothable>(domain: &D, h: &[f64], settings: &SmoothSettings) -
         representative_certificate,
         certificate,
     };
-    Ok(Smoothed { output: f, u, roles: kept.roles, report })
+    Ok(Smoothed {
+        output: f,
+        u,
+        roles: kept.roles,
+        report,
+    })
 }
 
 /// Two adjacent fixed vertices of different roles must differ in value (SPEC.md).

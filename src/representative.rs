@@ -36,14 +36,26 @@ pub fn series_representative(series: &Series, h: &[f64], kept: &KeptSet) -> Resu
     let anchors: Vec<(usize, Role)> = kept.kept.iter().map(|k| (k.index, k.role)).collect();
     let mut u = h.to_vec();
     if anchors.is_empty() {
-        return Err(Error::Representative { path: None, message: "no kept extremum".into() });
+        return Err(Error::Representative {
+            path: None,
+            message: "no kept extremum".into(),
+        });
     }
-    let (lo, hi) = h.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| (a.min(v), b.max(v)));
+    let (lo, hi) = h
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
+            (a.min(v), b.max(v))
+        });
     let slope = (hi - lo) / series.diameter();
     // free ends: the end opposite in type to the nearest kept extremum
     let (first, first_role) = anchors[0];
     if first > 0 {
-        let end = end_value(&h[..=first], h[first], first_role, slope * (x[first] - x[0]));
+        let end = end_value(
+            &h[..=first],
+            h[first],
+            first_role,
+            slope * (x[first] - x[0]),
+        );
         linear(&mut u, x, 0, first, end, h[first]);
     }
     let (last, last_role) = anchors[anchors.len() - 1];
@@ -70,10 +82,18 @@ fn end_value(stretch: &[f64], anchor: f64, role: Role, fallback: f64) -> f64 {
     let fallback = if fallback > 0.0 { fallback } else { 1.0 };
     if role == Role::Min {
         let m = stretch.iter().cloned().fold(f64::NEG_INFINITY, f64::max);
-        if m > anchor { m } else { anchor + fallback }
+        if m > anchor {
+            m
+        } else {
+            anchor + fallback
+        }
     } else {
         let m = stretch.iter().cloned().fold(f64::INFINITY, f64::min);
-        if m < anchor { m } else { anchor - fallback }
+        if m < anchor {
+            m
+        } else {
+            anchor - fallback
+        }
     }
 }
 
@@ -93,7 +113,11 @@ fn floats_between(a: f64, b: f64) -> u64 {
     // monotone map of doubles to integers; −0 and +0 share one key
     let key = |x: f64| {
         let bits = (if x == 0.0 { 0.0 } else { x }).to_bits();
-        if bits >> 63 == 1 { (!bits) + 1 } else { bits | (1 << 63) }
+        if bits >> 63 == 1 {
+            (!bits) + 1
+        } else {
+            bits | (1 << 63)
+        }
     };
     let (ka, kb) = (key(a), key(b));
     ka.abs_diff(kb).saturating_sub(1)
@@ -112,7 +136,13 @@ fn strictify(u: &mut [f64], anchors: &[(usize, Role)]) {
     }
     for (a, b) in stretches {
         let up = u[b] > u[a];
-        let step = |v: f64, toward_up: bool| if toward_up { v.next_up() } else { v.next_down() };
+        let step = |v: f64, toward_up: bool| {
+            if toward_up {
+                v.next_up()
+            } else {
+                v.next_down()
+            }
+        };
         for i in a + 1..b {
             let bound = step(u[i - 1], up);
             if (up && u[i] < bound) || (!up && u[i] > bound) {
@@ -146,7 +176,14 @@ mod tests {
         let b = a + 2.0 * f64::EPSILON; // one double strictly between
         let h = [a, 0.5 * (a + b), a, a, b];
         let s = Series::uniform(5);
-        let kept = select(&s, &h, &Selection::Explicit { minima: vec![0], maxima: vec![4] });
+        let kept = select(
+            &s,
+            &h,
+            &Selection::Explicit {
+                minima: vec![0],
+                maxima: vec![4],
+            },
+        );
         // vertex 0 must be a minimum of the input: it is (SoS), vertex 4 the global maximum
         let kept = kept.unwrap();
         let e = series_representative(&s, &h, &kept).unwrap_err();
@@ -159,7 +196,15 @@ mod tests {
         let b = a + 4.0 * f64::EPSILON; // three doubles between: exactly enough for 3 samples
         let h = [a, a, a, a, b];
         let s = Series::uniform(5);
-        let kept = select(&s, &h, &Selection::Explicit { minima: vec![0], maxima: vec![4] }).unwrap();
+        let kept = select(
+            &s,
+            &h,
+            &Selection::Explicit {
+                minima: vec![0],
+                maxima: vec![4],
+            },
+        )
+        .unwrap();
         let u = series_representative(&s, &h, &kept).unwrap();
         assert!(u.windows(2).all(|w| w[0] < w[1]), "{u:?}");
     }

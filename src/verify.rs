@@ -47,10 +47,22 @@ impl Certificate {
     /// One line naming the failed items and the first offending vertices.
     pub fn summary(&self) -> String {
         if self.passed {
-            return format!("certified: {} minima, {} maxima, no other extremum", self.strict_minima, self.strict_maxima);
+            return format!(
+                "certified: {} minima, {} maxima, no other extremum",
+                self.strict_minima, self.strict_maxima
+            );
         }
-        let list: Vec<String> = self.failures.iter().take(5).map(|f| format!("item {}: vertex {} {}", f.item, f.vertex, f.reason)).collect();
-        format!("{} failure(s); first: {}", self.failure_count, list.join("; "))
+        let list: Vec<String> = self
+            .failures
+            .iter()
+            .take(5)
+            .map(|f| format!("item {}: vertex {} {}", f.item, f.vertex, f.reason))
+            .collect();
+        format!(
+            "{} failure(s); first: {}",
+            self.failure_count,
+            list.join("; ")
+        )
     }
 }
 
@@ -63,13 +75,24 @@ impl Certificate {
 /// * `Fixed`: exempt.
 ///
 /// Item 5 (the values as written and read back) is this function applied to the file's values.
-pub fn certify<D: Domain>(domain: &D, f: &[f64], roles: &[Role], input: Option<&[f64]>) -> Certificate {
+pub fn certify<D: Domain>(
+    domain: &D,
+    f: &[f64],
+    roles: &[Role],
+    input: Option<&[f64]>,
+) -> Certificate {
     let n = domain.n_vertices();
     assert_eq!(f.len(), n);
     assert_eq!(roles.len(), n);
     let mut failures = Vec::new();
     let (mut strict_minima, mut strict_maxima, mut flat) = (0, 0, 0);
-    let mut fail = |item: u8, vertex: usize, reason: String| failures.push(Failure { item, vertex, reason });
+    let mut fail = |item: u8, vertex: usize, reason: String| {
+        failures.push(Failure {
+            item,
+            vertex,
+            reason,
+        })
+    };
     for v in 0..n {
         if !f[v].is_finite() {
             fail(4, v, format!("is not finite ({})", f[v]));
@@ -92,8 +115,16 @@ pub fn certify<D: Domain>(domain: &D, f: &[f64], roles: &[Role], input: Option<&
         strict_maxima += is_max as usize;
         flat += (!is_min && !is_max && !regular) as usize;
         match roles[v] {
-            Role::Min if !is_min => fail(1, v, format!("should be a strict minimum ({lower} lower, {equal} equal neighbours)")),
-            Role::Max if !is_max => fail(1, v, format!("should be a strict maximum ({higher} higher, {equal} equal neighbours)")),
+            Role::Min if !is_min => fail(
+                1,
+                v,
+                format!("should be a strict minimum ({lower} lower, {equal} equal neighbours)"),
+            ),
+            Role::Max if !is_max => fail(
+                1,
+                v,
+                format!("should be a strict maximum ({higher} higher, {equal} equal neighbours)"),
+            ),
             Role::Other if !regular => fail(
                 2,
                 v,
@@ -105,12 +136,20 @@ pub fn certify<D: Domain>(domain: &D, f: &[f64], roles: &[Role], input: Option<&
                     format!("is a flat spot ({equal} equal neighbours)")
                 },
             ),
-            Role::End if !(is_min || is_max) => fail(2, v, "free end is not a strict extremum".into()),
+            Role::End if !(is_min || is_max) => {
+                fail(2, v, "free end is not a strict extremum".into())
+            }
             _ => {}
         }
         if let Some(h) = input {
-            if matches!(roles[v], Role::Min | Role::Max | Role::Fixed) && f[v].to_bits() != h[v].to_bits() {
-                fail(3, v, format!("kept value {} differs from the input {}", f[v], h[v]));
+            if matches!(roles[v], Role::Min | Role::Max | Role::Fixed)
+                && f[v].to_bits() != h[v].to_bits()
+            {
+                fail(
+                    3,
+                    v,
+                    format!("kept value {} differs from the input {}", f[v], h[v]),
+                );
             }
         }
     }
@@ -135,7 +174,14 @@ mod tests {
     #[test]
     fn finds_each_kind_of_defect() {
         let s = Series::uniform(6);
-        let roles = [Role::End, Role::Other, Role::Min, Role::Other, Role::Max, Role::End];
+        let roles = [
+            Role::End,
+            Role::Other,
+            Role::Min,
+            Role::Other,
+            Role::Max,
+            Role::End,
+        ];
         let good = [1.0, 0.5, 0.0, 1.0, 2.0, 1.5];
         let c = certify(&s, &good, &roles, Some(&good));
         assert!(c.passed, "{}", c.summary());
@@ -153,6 +199,9 @@ mod tests {
         assert!(c.failures.iter().any(|f| f.item == 3 && f.vertex == 2));
         let mut nan = good;
         nan[1] = f64::NAN;
-        assert!(certify(&s, &nan, &roles, None).failures.iter().any(|f| f.item == 4));
+        assert!(certify(&s, &nan, &roles, None)
+            .failures
+            .iter()
+            .any(|f| f.item == 4));
     }
 }

@@ -16,7 +16,9 @@ impl Series {
     /// If `n < 2` (a contract violation; readers reject such input first).
     pub fn uniform(n: usize) -> Self {
         assert!(n >= 2, "a series needs at least 2 samples");
-        Series { x: (0..n).map(|i| i as f64).collect() }
+        Series {
+            x: (0..n).map(|i| i as f64).collect(),
+        }
     }
 
     /// Series with the given coordinates.
@@ -32,7 +34,9 @@ impl Series {
             )));
         }
         if let Some(i) = x.iter().position(|v| !v.is_finite()) {
-            return Err(Error::input(format!("x coordinate of sample {i} is not finite")));
+            return Err(Error::input(format!(
+                "x coordinate of sample {i} is not finite"
+            )));
         }
         if let Some(i) = (1..x.len()).find(|&i| x[i] <= x[i - 1]) {
             return Err(Error::input(format!(

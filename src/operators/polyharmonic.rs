@@ -17,7 +17,10 @@ pub struct Energy {
 impl Energy {
     /// A single order with weight 1.
     pub fn order(k: u8) -> Self {
-        Energy { terms: vec![(k, 1.0)], sharp: Vec::new() }
+        Energy {
+            terms: vec![(k, 1.0)],
+            sharp: Vec::new(),
+        }
     }
 
     /// Parses `2` or a blend `1:0.2,2:1`.
@@ -32,11 +35,18 @@ impl Energy {
                 Some((k, w)) => (k.trim(), w.trim()),
                 None => (part.trim(), "1"),
             };
-            let k: u8 = k.parse().map_err(|_| Error::Usage(format!("order `{k}` in `{spec}` is not an integer 1..4")))?;
-            let w: f64 = w.parse().map_err(|_| Error::Usage(format!("weight `{w}` in `{spec}` is not a number")))?;
+            let k: u8 = k.parse().map_err(|_| {
+                Error::Usage(format!("order `{k}` in `{spec}` is not an integer 1..4"))
+            })?;
+            let w: f64 = w
+                .parse()
+                .map_err(|_| Error::Usage(format!("weight `{w}` in `{spec}` is not a number")))?;
             terms.push((k, w));
         }
-        let e = Energy { terms, sharp: Vec::new() };
+        let e = Energy {
+            terms,
+            sharp: Vec::new(),
+        };
         e.validate()?;
         Ok(e)
     }
@@ -48,18 +58,27 @@ impl Energy {
                 return Err(Error::Usage(format!("energy order {k} is outside 1..4")));
             }
             if !(w.is_finite() && w >= 0.0) {
-                return Err(Error::Usage(format!("weight {w} of order {k} must be finite and ≥ 0")));
+                return Err(Error::Usage(format!(
+                    "weight {w} of order {k} must be finite and ≥ 0"
+                )));
             }
         }
         if self.terms.iter().all(|&(_, w)| w == 0.0) {
-            return Err(Error::Usage("the smoothness energy needs a positive weight".into()));
+            return Err(Error::Usage(
+                "the smoothness energy needs a positive weight".into(),
+            ));
         }
         Ok(())
     }
 
     /// Highest order with a positive weight.
     pub fn max_order(&self) -> u8 {
-        self.terms.iter().filter(|t| t.1 > 0.0).map(|t| t.0).max().unwrap_or(1)
+        self.terms
+            .iter()
+            .filter(|t| t.1 > 0.0)
+            .map(|t| t.0)
+            .max()
+            .unwrap_or(1)
     }
 }
 
@@ -82,8 +101,14 @@ pub fn polyharmonic(k: &Sparse, m: &[f64], energy: &Energy, scale: &[f64]) -> Sp
     for &v in &energy.sharp {
         sharp[v] = true;
     }
-    let d: Vec<f64> = (0..n).map(|i| if sharp[i] { 0.0 } else { 1.0 / m[i] }).collect();
-    let k_cut = if energy.sharp.is_empty() { k.clone() } else { cut_edges(k, &sharp) };
+    let d: Vec<f64> = (0..n)
+        .map(|i| if sharp[i] { 0.0 } else { 1.0 / m[i] })
+        .collect();
+    let k_cut = if energy.sharp.is_empty() {
+        k.clone()
+    } else {
+        cut_edges(k, &sharp)
+    };
     let minv: Vec<f64> = m.iter().map(|x| 1.0 / x).collect();
     let mut all = Vec::new();
     for (&(order, w), &s) in energy.terms.iter().zip(scale) {
@@ -97,14 +122,18 @@ pub fn polyharmonic(k: &Sparse, m: &[f64], energy: &Energy, scale: &[f64]) -> Sp
                 let g = scale_rows(k, &d); // D K
                 let gt = scale_cols(k, &d); // K D = Gᵀ (K symmetric)
                 let inner = match order {
-                    2 => scale_rows(&g, m),                                 // M G
-                    3 => matmul(&k_cut, &g),                                 // K′ G
+                    2 => scale_rows(&g, m),                                       // M G
+                    3 => matmul(&k_cut, &g),                                      // K′ G
                     _ => matmul(&k_cut, &scale_rows(&matmul(&k_cut, &g), &minv)), // K′ M⁻¹ K′ G
                 };
                 matmul(&gt, &inner)
             }
         };
-        all.extend(triplets(&q).into_iter().map(|t| Triplet::new(t.row, t.col, c * t.val)));
+        all.extend(
+            triplets(&q)
+                .into_iter()
+                .map(|t| Triplet::new(t.row, t.col, c * t.val)),
+        );
     }
     from_triplets(n, n, &all)
 }
@@ -144,7 +173,9 @@ mod tests {
             let dense = q.to_dense();
             for i in 0..7 {
                 for j in 0..7 {
-                    assert!((dense[(i, j)] - dense[(j, i)]).abs() < 1e-9 * (1.0 + dense[(i, j)].abs()));
+                    assert!(
+                        (dense[(i, j)] - dense[(j, i)]).abs() < 1e-9 * (1.0 + dense[(i, j)].abs())
+                    );
                 }
             }
         }
@@ -172,7 +203,11 @@ mod tests {
             e.sharp = vec![0, 4, 8];
             let sharp = polyharmonic(&k, &m, &e, &[1.0]);
             assert!(quadratic_form(&plain, &f) > 1.0, "order {order}");
-            assert!(quadratic_form(&sharp, &f).abs() < 1e-10, "order {order}: {}", quadratic_form(&sharp, &f));
+            assert!(
+                quadratic_form(&sharp, &f).abs() < 1e-10,
+                "order {order}: {}",
+                quadratic_form(&sharp, &f)
+            );
         }
     }
 

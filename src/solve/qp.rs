@@ -3,7 +3,9 @@
 use crate::error::{Error, Result};
 use crate::operators::Sparse;
 use clarabel::algebra::CscMatrix;
-use clarabel::solver::{DefaultSettingsBuilder, DefaultSolver, IPSolver, NonnegativeConeT, SolverStatus};
+use clarabel::solver::{
+    DefaultSettingsBuilder, DefaultSolver, IPSolver, NonnegativeConeT, SolverStatus,
+};
 
 /// The problem: `min ½ fᵀ P f + qᵀ f` s.t. `f_i = fixed_i` where given and
 /// `f_j − f_i ≥ margin` for every `(i, j)` in `edges`.
@@ -31,7 +33,10 @@ pub struct QpSettings {
 
 impl Default for QpSettings {
     fn default() -> Self {
-        QpSettings { max_iter: 200, tolerance: 1e-8 }
+        QpSettings {
+            max_iter: 200,
+            tolerance: 1e-8,
+        }
     }
 }
 
@@ -80,12 +85,20 @@ pub fn solve_monotone_qp(qp: &MonotoneQp<'_>, settings: &QpSettings) -> Result<Q
     }
     let mut x: Vec<f64> = qp.fixed.iter().map(|f| f.unwrap_or(0.0)).collect();
     if free.is_empty() {
-        return Ok(QpSolution { x, status: SolveStatus::Trivial, iterations: 0 });
+        return Ok(QpSolution {
+            x,
+            status: SolveStatus::Trivial,
+            iterations: 0,
+        });
     }
     let nf = free.len();
     // P_FF (upper triangle) and q_F + P_FX x_X
     let mut qf: Vec<f64> = free.iter().map(|&i| qp.q[i]).collect();
-    let (cp, ri, val) = (qp.p.symbolic().col_ptr(), qp.p.symbolic().row_idx(), qp.p.val());
+    let (cp, ri, val) = (
+        qp.p.symbolic().col_ptr(),
+        qp.p.symbolic().row_idx(),
+        qp.p.val(),
+    );
     let mut pi = Vec::new();
     let mut pj = Vec::new();
     let mut pv = Vec::new();
@@ -156,9 +169,16 @@ pub fn solve_monotone_qp(qp: &MonotoneQp<'_>, settings: &QpSettings) -> Result<Q
         .tol_gap_rel(settings.tolerance)
         .direct_solve_method("faer".to_string())
         .build()
-        .map_err(|e| Error::NoSolution { path: None, status: format!("bad solver settings: {e:?}") })?;
-    let mut solver = DefaultSolver::new(&p, &qf, &a, &b, &cones, solver_settings)
-        .map_err(|e| Error::NoSolution { path: None, status: format!("solver setup failed: {e}") })?;
+        .map_err(|e| Error::NoSolution {
+            path: None,
+            status: format!("bad solver settings: {e:?}"),
+        })?;
+    let mut solver = DefaultSolver::new(&p, &qf, &a, &b, &cones, solver_settings).map_err(|e| {
+        Error::NoSolution {
+            path: None,
+            status: format!("solver setup failed: {e}"),
+        }
+    })?;
     solver.solve();
     let sol = &solver.solution;
     let status = match sol.status {
@@ -167,16 +187,26 @@ pub fn solve_monotone_qp(qp: &MonotoneQp<'_>, settings: &QpSettings) -> Result<Q
         SolverStatus::MaxIterations | SolverStatus::MaxTime => SolveStatus::MaxIterations,
         SolverStatus::NumericalError | SolverStatus::InsufficientProgress => SolveStatus::Stalled,
         other => {
-            return Err(Error::NoSolution { path: None, status: format!("{other:?} after {} iterations", sol.iterations) })
+            return Err(Error::NoSolution {
+                path: None,
+                status: format!("{other:?} after {} iterations", sol.iterations),
+            })
         }
     };
     if sol.x.iter().any(|v| !v.is_finite()) {
-        return Err(Error::NoSolution { path: None, status: format!("{:?} with non-finite values", sol.status) });
+        return Err(Error::NoSolution {
+            path: None,
+            status: format!("{:?} with non-finite values", sol.status),
+        });
     }
     for (k, &i) in free.iter().enumerate() {
         x[i] = sol.x[k];
     }
-    Ok(QpSolution { x, status, iterations: sol.iterations })
+    Ok(QpSolution {
+        x,
+        status,
+        iterations: sol.iterations,
+    })
 }
 
 #[cfg(test)]
@@ -188,14 +218,36 @@ mod tests {
     #[test]
     fn projects_onto_a_monotone_chain() {
         // min Σ (f_i − h_i)² with f_0 = 0, f_3 = 3 fixed and f increasing: h = [0, 2, 1, 3]
-        let p = Sparse::try_new_from_triplets(4, 4, &(0..4).map(|i| Triplet::new(i, i, 1.0)).collect::<Vec<_>>()).unwrap();
+        let p = Sparse::try_new_from_triplets(
+            4,
+            4,
+            &(0..4).map(|i| Triplet::new(i, i, 1.0)).collect::<Vec<_>>(),
+        )
+        .unwrap();
         let q = [0.0, -2.0, -1.0, -3.0];
         let fixed = [Some(0.0), None, None, Some(3.0)];
         let edges = [(0, 1), (1, 2), (2, 3)];
-        let sol = solve_monotone_qp(&MonotoneQp { p: &p, q: &q, fixed: &fixed, edges: &edges, margin: 1e-6 }, &QpSettings::default()).unwrap();
-        assert!(matches!(sol.status, SolveStatus::Solved | SolveStatus::AlmostSolved));
+        let sol = solve_monotone_qp(
+            &MonotoneQp {
+                p: &p,
+                q: &q,
+                fixed: &fixed,
+                edges: &edges,
+                margin: 1e-6,
+            },
+            &QpSettings::default(),
+        )
+        .unwrap();
+        assert!(matches!(
+            sol.status,
+            SolveStatus::Solved | SolveStatus::AlmostSolved
+        ));
         // isotonic regression pools 2 and 1 at 1.5 (then the margin splits them)
-        assert!((sol.x[1] - 1.5).abs() < 1e-4 && (sol.x[2] - 1.5).abs() < 1e-4, "{:?}", sol.x);
+        assert!(
+            (sol.x[1] - 1.5).abs() < 1e-4 && (sol.x[2] - 1.5).abs() < 1e-4,
+            "{:?}",
+            sol.x
+        );
         assert!(sol.x[2] - sol.x[1] > 0.5e-6);
         assert_eq!((sol.x[0], sol.x[3]), (0.0, 3.0));
     }

@@ -21,10 +21,19 @@ pub struct RepairSummary {
 /// given step, or one ulp where that is smaller than the spacing of doubles). Fixed values
 /// never change, so kept values stay bit for bit; the passes repeat (at most 4 sweeps) until
 /// no edge is violated. Whether that succeeded is for the certificate to decide.
-pub fn repair(f: &mut [f64], fixed: &[bool], edges: &[(usize, usize)], order: &[usize], delta: f64) -> RepairSummary {
+pub fn repair(
+    f: &mut [f64],
+    fixed: &[bool],
+    edges: &[(usize, usize)],
+    order: &[usize],
+    delta: f64,
+) -> RepairSummary {
     let n = f.len();
     let violated = |f: &[f64]| edges.iter().filter(|&&(i, j)| !(f[j] > f[i])).count();
-    let mut summary = RepairSummary { violated_edges: violated(f), ..Default::default() };
+    let mut summary = RepairSummary {
+        violated_edges: violated(f),
+        ..Default::default()
+    };
     if summary.violated_edges == 0 {
         return summary;
     }

@@ -1,0 +1,147 @@
+//! `toposmooth extrema`: list the extrema with persistence and strictness; draw the diagram.
+
+use super::plot_atomic;
+use crate::domain::Series;
+use crate::error::{Error, Result};
+use crate::io::series_csv::{read_series, SeriesCsvOptions};
+use crate::plot::{plot_persistence_diagram, DiagramPoint};
+use crate::topology::{extrema_table, select, ExtremumKind, Role, Selection};
+use std::path::PathBuf;
+
+/// Options of `extrema`.
+#[derive(Clone, Debug)]
+pub struct ExtremaArgs {
+    /// Input file.
+    pub input: PathBuf,
+    /// Column choice.
+    pub csv: SeriesCsvOptions,
+    /// Print JSON instead of a table.
+    pub json: bool,
+    /// Persistence diagram PNG.
+    pub plot: Option<PathBuf>,
+    /// Selection whose kept extrema are marked (default: SPEC's 5 %).
+    pub selection: Selection,
+}
+
+#[derive(serde::Serialize)]
+struct Listing<'a> {
+    file: String,
+    column: &'a str,
+    samples: usize,
+    sos_minima: usize,
+    sos_maxima: usize,
+    ends: usize,
+    strict_minima: usize,
+    strict_maxima: usize,
+    threshold: Option<f64>,
+    extrema: Vec<Row<'a>>,
+}
+
+#[derive(serde::Serialize)]
+struct Row<'a> {
+    #[serde(flatten)]
+    info: &'a crate::topology::ExtremumInfo,
+    x: &'a str,
+    kept: bool,
+}
+
+/// Runs `extrema`; returns the text printed on standard output.
+pub fn extrema(args: &ExtremaArgs) -> Result<String> {
+    let data = read_series(&args.input, &args.csv)?;
+    let series = Series::with_coordinates(data.x.clone()).map_err(|e| e.in_file(&args.input))?;
+    let h = &data.values;
+    let table = extrema_table(&series, h);
+    let kept = select(&series, h, &args.selection).map_err(|e| e.in_file(&args.input))?;
+    let count = |k: ExtremumKind, strict: bool| {
+        table
+            .iter()
+            .filter(|r| r.kind == k && (!strict || r.strict))
+            .count()
+    };
+    let listing = Listing {
+        file: args.input.display().to_string(),
+        column: &data.column,
+        samples: h.len(),
+        sos_minima: count(ExtremumKind::Min, false),
+        sos_maxima: count(ExtremumKind::Max, false) + count(ExtremumKind::End, false),
+        ends: count(ExtremumKind::End, false),
+        strict_minima: count(ExtremumKind::Min, true),
+        strict_maxima: count(ExtremumKind::Max, true) + count(ExtremumKind::End, true),
+        threshold: kept.threshold,
+        extrema: table
+            .iter()
+            .map(|r| Row {
+                info: r,
+                x: &data.x_text[r.index],
+                kept: matches!(kept.roles[r.index], Role::Min | Role::Max),
+            })
+            .collect(),
+    };
+    if let Some(path) = &args.plot {
+        let mut points = Vec::new();
+        for r in &table {
+            if r.kind != ExtremumKind::Min {
+                continue;
+            }
+            let death = r.partner.map(|p| h[p]).unwrap_or(f64::INFINITY);
+            points.push(DiagramPoint {
+                birth: r.value,
+                death,
+                is_max: false,
+                kept: kept.roles[r.index] == Role::Min,
+            });
+        }
+        let title = format!(
+            "{} — {} ({} pairs)",
+            args.input.file_name().unwrap_or_default().to_string_lossy(),
+            data.column,
+            points.len()
+        );
+        plot_atomic(path, |p| {
+            plot_persistence_diagram(p, &points, kept.threshold, &title, (900, 800))
+        })?;
+    }
+    if args.json {
+        return serde_json::to_string_pretty(&listing).map_err(|e| Error::input(e.to_string()));
+    }
+    let mut out = String::new();
+    out += &format!(
+        "{:>8} {:>12} {:>4} {:>14} {:>14} {:>6} {:>4}\n",
+        "index", "x", "type", "value", "persistence", "strict", "kept"
+    );
+    for row in &listing.extrema {
+        let r = row.info;
+        let kind = match r.kind {
+            ExtremumKind::Min => "min",
+            ExtremumKind::Max => "max",
+            ExtremumKind::End => "end",
+        };
+        let pers = match r.persistence {
+            None => "-".to_string(),
+            Some(p) if p.is_infinite() => "inf".to_string(),
+            Some(p) => format!("{p:.6e}"),
+        };
+        out += &format!(
+            "{:>8} {:>12} {:>4} {:>14.6e} {:>14} {:>6} {:>4}\n",
+            r.index,
+            row.x,
+            kind,
+            r.value,
+            pers,
+            if r.strict { "yes" } else { "no" },
+            if row.kept { "yes" } else { "" }
+        );
+    }
+    out += &format!(
+        "{}: {} samples of `{}`; SoS extrema: {} minima, {} maxima (incl. {} ends); strict in the raw values: {} minima, {} maxima\n",
+        listing.file, listing.samples, listing.column, listing.sos_minima, listing.sos_maxima, listing.ends, listing.strict_minima, listing.strict_maxima
+    );
+    if let Some(t) = kept.threshold {
+        out += &format!(
+            "kept at persistence ≥ {t:e}: {} minima, {} maxima\n",
+            kept.minima().len(),
+            kept.maxima().len()
+        );
+    }
+    Ok(out)
+}

@@ -1,0 +1,115 @@
+//! The command-line tool's commands: reading files, running the pipeline, printing, writing.
+//! `main.rs` only parses arguments into these option structs and maps errors to exit codes.
+
+mod bench;
+mod extrema;
+mod smooth;
+mod verify;
+
+pub use bench::{bench, BenchArgs};
+pub use extrema::{extrema, ExtremaArgs};
+pub use smooth::{smooth, SmoothArgs};
+pub use verify::{verify, VerifyArgs};
+
+use crate::error::{Error, Result};
+use crate::io::series_csv::XSource;
+use crate::plot::XAxis;
+use crate::topology::Selection;
+use std::path::Path;
+
+/// Parses `--persistence`: `5%` (relative to the value range) or `0.3` (absolute).
+pub fn parse_persistence(s: &str) -> Result<Selection> {
+    let t = s.trim();
+    let (num, relative) = match t.strip_suffix('%') {
+        Some(p) => (p.trim(), true),
+        None => (t, false),
+    };
+    let v: f64 = num.parse().map_err(|_| {
+        Error::Usage(format!(
+            "--persistence `{s}` is not a number or a percentage"
+        ))
+    })?;
+    if !(v.is_finite() && v > 0.0) {
+        return Err(Error::Usage(format!(
+            "--persistence must be > 0, got `{s}`"
+        )));
+    }
+    Ok(if relative {
+        Selection::Relative(v / 100.0)
+    } else {
+        Selection::Absolute(v)
+    })
+}
+
+/// Parses a comma-separated list of vertex indices.
+pub fn parse_indices(s: &str) -> Result<Vec<usize>> {
+    s.split(',')
+        .filter(|p| !p.trim().is_empty())
+        .map(|p| {
+            p.trim()
+                .parse::<usize>()
+                .map_err(|_| Error::Usage(format!("`{p}` in `{s}` is not a vertex index")))
+        })
+        .collect()
+}
+
+/// The plot's x axis for a series read from CSV, and x shifted to start at 0 for dates.
+fn x_axis(source: &XSource, x: &[f64]) -> (XAxis, Vec<f64>) {
+    match source {
+        XSource::Index => (XAxis::Numeric("sample".into()), x.to_vec()),
+        XSource::Numeric(name) => (XAxis::Numeric(name.clone()), x.to_vec()),
+        XSource::Dates(_, first) => {
+            let x0 = x[0].floor();
+            (XAxis::DaysSince(*first), x.iter().map(|v| v - x0).collect())
+        }
+    }
+}
+
+/// Runs `draw` on a temporary sibling of `path` and renames it into place.
+fn plot_atomic(
+    path: &Path,
+    draw: impl FnOnce(&Path) -> std::result::Result<(), crate::plot::PlotError>,
+) -> Result<()> {
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .unwrap_or("")
+        .to_ascii_lowercase();
+    if ext != "png" {
+        return Err(Error::Usage(format!(
+            "{}: plots are written as PNG; use a .png name",
+            path.display()
+        )));
+    }
+    let tmp = crate::io::temp_sibling(path).with_extension("png");
+    draw(&tmp).map_err(|e| {
+        let _ = std::fs::remove_file(&tmp);
+        Error::Io {
+            path: path.to_path_buf(),
+            source: std::io::Error::other(e.to_string()),
+        }
+    })?;
+    std::fs::rename(&tmp, path).map_err(|source| Error::Io {
+        path: path.to_path_buf(),
+        source,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn persistence_and_indices() {
+        assert_eq!(parse_persistence("5%").unwrap(), Selection::Relative(0.05));
+        assert_eq!(
+            parse_persistence("0.25").unwrap(),
+            Selection::Absolute(0.25)
+        );
+        assert!(parse_persistence("-1").is_err());
+        assert!(parse_persistence("abc").is_err());
+        assert!(parse_persistence("0%").is_err());
+        assert_eq!(parse_indices("1, 5,9").unwrap(), vec![1, 5, 9]);
+        assert!(parse_indices("1,x").is_err());
+    }
+}

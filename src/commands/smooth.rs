@@ -1,0 +1,161 @@
+//! `toposmooth smooth`: the whole pipeline on a file, with output, plot and report.
+
+use super::{plot_atomic, x_axis};
+use crate::domain::Series;
+use crate::error::Result;
+use crate::io::series_csv::{read_series, write_series_output, SeriesCsvOptions, SeriesOutput};
+use crate::io::write_json;
+use crate::pipeline::{smooth as run_pipeline, Report, SmoothSettings};
+use crate::plot::{plot_series, Marker};
+use crate::topology::Role;
+use std::path::PathBuf;
+use std::time::Instant;
+
+/// Options of `smooth`.
+#[derive(Clone, Debug)]
+pub struct SmoothArgs {
+    /// Input file.
+    pub input: PathBuf,
+    /// Column choice.
+    pub csv: SeriesCsvOptions,
+    /// Output CSV.
+    pub output: PathBuf,
+    /// Pipeline settings.
+    pub settings: SmoothSettings,
+    /// Figure.
+    pub plot: Option<PathBuf>,
+    /// JSON report.
+    pub report: Option<PathBuf>,
+}
+
+#[derive(serde::Serialize)]
+struct RunReport<'a> {
+    input_file: String,
+    column: &'a str,
+    output_file: String,
+    read_seconds: f64,
+    write_seconds: f64,
+    total_seconds: f64,
+    #[serde(flatten)]
+    report: &'a Report,
+}
+
+/// Runs `smooth`; returns the summary printed on standard output.
+pub fn smooth(args: &SmoothArgs) -> Result<String> {
+    let start = Instant::now();
+    let data = read_series(&args.input, &args.csv)?;
+    let series = Series::with_coordinates(data.x.clone()).map_err(|e| e.in_file(&args.input))?;
+    let read_seconds = start.elapsed().as_secs_f64();
+    let result =
+        run_pipeline(&series, &data.values, &args.settings).map_err(|e| e.in_file(&args.input))?;
+    let t = Instant::now();
+    let out = SeriesOutput {
+        x_text: data.x_text.clone(),
+        input: data.values.clone(),
+        output: result.output.clone(),
+        u: result.u.clone(),
+        roles: result.roles.clone(),
+    };
+    write_series_output(&args.output, &out)?;
+    if let Some(path) = &args.plot {
+        let (axis, x) = x_axis(&data.x_source, &data.x);
+        let markers: Vec<Marker> = result
+            .roles
+            .iter()
+            .enumerate()
+            .filter_map(|(i, r)| match r {
+                Role::Min => Some(Marker {
+                    index: i,
+                    is_max: false,
+                }),
+                Role::Max => Some(Marker {
+                    index: i,
+                    is_max: true,
+                }),
+                _ => None,
+            })
+            .collect();
+        let r = &result.report;
+        let title = format!(
+            "{} — {}: {} of {} extrema kept, certified (RMS change {:.3e})",
+            args.input.file_name().unwrap_or_default().to_string_lossy(),
+            data.column,
+            r.kept.len(),
+            r.input_minima + r.input_maxima,
+            r.rms_deviation
+        );
+        plot_atomic(path, |p| {
+            plot_series(
+                p,
+                &x,
+                &axis,
+                &data.column,
+                &data.values,
+                &result.output,
+                &markers,
+                &title,
+                (1400, 700),
+            )
+        })?;
+    }
+    let write_seconds = t.elapsed().as_secs_f64();
+    let r = &result.report;
+    if let Some(path) = &args.report {
+        let run = RunReport {
+            input_file: args.input.display().to_string(),
+            column: &data.column,
+            output_file: args.output.display().to_string(),
+            read_seconds,
+            write_seconds,
+            total_seconds: start.elapsed().as_secs_f64(),
+            report: r,
+        };
+        write_json(path, &run)?;
+    }
+    let s = &r.seconds;
+    let mut text = String::new();
+    for w in &r.warnings {
+        text += &format!("warning: {w}\n");
+    }
+    let kmin = r.kept.iter().filter(|k| k.role == Role::Min).count();
+    text += &format!(
+        "{}: {} samples of `{}`, {} minima and {} maxima in the input (SoS, ends included)\n",
+        args.input.display(),
+        r.vertices,
+        data.column,
+        r.input_minima,
+        r.input_maxima
+    );
+    text += &format!(
+        "kept {} minima and {} maxima{}\n",
+        kmin,
+        r.kept.len() - kmin,
+        r.threshold
+            .map(|t| format!(" (persistence ≥ {t:.6e})"))
+            .unwrap_or_default()
+    );
+    text += &format!(
+        "{}; RMS deviation {:.6e}, max deviation {:.6e}\n",
+        r.certificate.summary(),
+        r.rms_deviation,
+        r.max_deviation
+    );
+    text += &format!(
+        "solver {:?} in {} iterations, {} constraints, margin {:.3e}; repair changed {} vertices\n",
+        r.solver_status, r.solver_iterations, r.constraints, r.margin[0], r.repair.changed_vertices
+    );
+    text += &format!(
+        "seconds: read {:.3}, persistence {:.3}, representative {:.3}, operators {:.3}, constraints {:.3}, solve {:.3}, repair {:.3}, verify {:.3}, write {:.3}, total {:.3}\n",
+        read_seconds, s.persistence, s.representative, s.operators, s.constraints, s.solve, s.repair, s.verify, write_seconds,
+        start.elapsed().as_secs_f64()
+    );
+    text += &format!("wrote {}", args.output.display());
+    if let Some(p) = &args.plot {
+        text += &format!(", {}", p.display());
+    }
+    if let Some(p) = &args.report {
+        text += &format!(", {}", p.display());
+    }
+    text.push('\n');
+    Ok(text)
+}

@@ -12,7 +12,7 @@
 //! let fixed = [Some(0.0), None, None, Some(3.0)];
 //! let edges = constraint_edges(&Series::uniform(4), &u, &fixed, EdgeSet::Minimal);
 //! assert_eq!(edges, vec![(0, 1), (1, 2), (2, 3)]);
-//! let eps = max_margin(&u, &edges, &fixed).unwrap();
+//! let eps = max_margin(&u, &edges, &fixed, None).unwrap();
 //! assert!((eps - 1.0).abs() < 1e-9); // 3 edges across a rise of 3
 //! ```
 
@@ -80,12 +80,14 @@ pub fn constraint_edges<D: Domain>(
 }
 
 /// Largest ε for which `f_j − f_i ≥ ε` on every edge is feasible with the fixed values
-/// (`+inf` when no path joins two fixed vertices), to a relative precision of 1e-12.
+/// (`+inf` when no path joins two fixed vertices), to a relative precision of 1e-12. With
+/// `cap = Some(c)`, the search stops at `2c` when that is feasible (all that
+/// [`choose_margin`] needs to know).
 ///
 /// # Errors
 /// Infeasible if even ε = 0 is infeasible: an edge path runs from a fixed value down to a
 /// smaller one (u disagrees with the fixed values).
-pub fn max_margin(u: &[f64], edges: &[(usize, usize)], fixed: &[Option<f64>]) -> Result<f64> {
+pub fn max_margin(u: &[f64], edges: &[(usize, usize)], fixed: &[Option<f64>], cap: Option<f64>) -> Result<f64> {
     let n = u.len();
     let order = sos_sort(u);
     // out-edges in compressed form
@@ -136,6 +138,12 @@ pub fn max_margin(u: &[f64], edges: &[(usize, usize)], fixed: &[Option<f64>]) ->
             (a.min(v), b.max(v))
         });
     let span = if fmax > fmin { fmax - fmin } else { 1.0 };
+    // the usual case: the cap of `choose_margin` is feasible twice over; one pass decides
+    if let Some(cap) = cap.filter(|&c| c < span) {
+        if violated(2.0 * cap).is_none() {
+            return Ok(2.0 * cap);
+        }
+    }
     if violated(span).is_none() {
         // a path of one edge between fixed values already allows the whole span: no bound
         // short of it matters; report +inf when no fixed pair is linked at all
@@ -157,6 +165,9 @@ pub fn max_margin(u: &[f64], edges: &[(usize, usize)], fixed: &[Option<f64>]) ->
     Ok(ok)
 }
 
+/// Relative cap of the margin: `1e-6` of the value range.
+pub const MARGIN_CAP: f64 = 1e-6;
+
 /// The margin used: half the largest feasible one, and at most `1e-6` of the value range.
 ///
 /// Half keeps u's constraint set strictly feasible with slack on every path (so an
@@ -172,7 +183,7 @@ pub fn max_margin(u: &[f64], edges: &[(usize, usize)], fixed: &[Option<f64>]) ->
 /// Infeasible (exit 3) when the margin is not above 4 × `resolution`: floating point cannot
 /// represent a strict function with the kept values along the longest constrained path.
 pub fn choose_margin(max_margin: f64, range: f64, resolution: f64) -> Result<f64> {
-    let eps = (0.5 * max_margin).min(1e-6 * range);
+    let eps = (0.5 * max_margin).min(MARGIN_CAP * range);
     if !(eps > 4.0 * resolution) {
         return Err(Error::infeasible(format!(
             "the kept values leave a margin of {eps:e} per edge, not above 4 × the spacing of doubles ({resolution:e}): no strict function in double precision"
@@ -202,13 +213,14 @@ mod tests {
         let u = [0.0, 0.1, 0.2, 0.3, 1.0];
         let fixed = [Some(0.0), None, None, None, Some(1.0)];
         let e = constraint_edges(&Series::uniform(5), &u, &fixed, EdgeSet::Minimal);
-        let m = max_margin(&u, &e, &fixed).unwrap();
+        let m = max_margin(&u, &e, &fixed, None).unwrap();
+        assert_eq!(max_margin(&u, &e, &fixed, Some(0.01)).unwrap(), 0.02);
         assert!((m - 0.25).abs() < 1e-9, "{m}");
         assert_eq!(choose_margin(m, 1.0, f64::EPSILON).unwrap(), 1e-6);
         assert!(choose_margin(1e-20, 1.0, f64::EPSILON).is_err());
         // u disagreeing with the fixed values
         let bad = [Some(1.0), None, None, None, Some(0.0)];
-        assert!(max_margin(&u, &e, &bad).is_err());
+        assert!(max_margin(&u, &e, &bad, None).is_err());
     }
 
     #[test]
@@ -216,6 +228,6 @@ mod tests {
         let u = [0.0, 1.0, 2.0];
         let fixed = [Some(0.0), None, None];
         let e = constraint_edges(&Series::uniform(3), &u, &fixed, EdgeSet::Minimal);
-        assert_eq!(max_margin(&u, &e, &fixed).unwrap(), f64::INFINITY);
+        assert_eq!(max_margin(&u, &e, &fixed, None).unwrap(), f64::INFINITY);
     }
 }

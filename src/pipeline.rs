@@ -11,19 +11,18 @@
 //! # Ok::<(), toposmooth::Error>(())
 //! ```
 
-use crate::constraints::{choose_margin, constraint_edges, max_margin, EdgeSet};
+use crate::constraints::{choose_margin, constraint_edges, max_margin, EdgeSet, MARGIN_CAP};
 use crate::domain::{sos_sort, Domain, Series};
 use crate::error::{Error, Result};
 use crate::operators::{
-    polyharmonic, quadratic_form, series_mass, series_stiffness, Energy, Sparse,
+    polyharmonic, quadratic_form, scaled_plus_diagonal, series_mass, series_stiffness, Energy, Sparse,
 };
 use crate::representative::series_representative;
 use crate::solve::{repair, solve_monotone_qp, MonotoneQp, QpSettings, RepairSummary, SolveStatus};
 use crate::topology::{
-    extrema_table, select, ExtremumKind, KeptExtremum, KeptSet, Role, Selection,
+    count_sos_extrema, select, KeptExtremum, KeptSet, Role, Selection,
 };
 use crate::verify::{certify, Certificate};
-use faer::sparse::Triplet;
 use std::time::Instant;
 
 /// A domain the pipeline can smooth on: it supplies its operators and its representative.
@@ -226,9 +225,7 @@ pub fn smooth<D: Smoothable>(domain: &D, h: &[f64], settings: &SmoothSettings) -
 
     let t = Instant::now();
     let kept = select(domain, h, &settings.selection)?;
-    let table = extrema_table(domain, h);
-    let input_minima = table.iter().filter(|r| r.kind == ExtremumKind::Min).count();
-    let input_maxima = table.len() - input_minima;
+    let (input_minima, input_maxima) = count_sos_extrema(domain, h);
     seconds.persistence = t.elapsed().as_secs_f64();
 
     let t = Instant::now();
@@ -262,21 +259,8 @@ pub fn smooth<D: Smoothable>(domain: &D, h: &[f64], settings: &SmoothSettings) -
         .collect();
     let q_energy = polyharmonic(&k, &m, &settings.energy, &weights);
     let gd = settings.data_weight;
-    let mut trip: Vec<Triplet<usize, usize, f64>> = Vec::new();
-    {
-        let (cp, ri, val) = (
-            q_energy.symbolic().col_ptr(),
-            q_energy.symbolic().row_idx(),
-            q_energy.val(),
-        );
-        for j in 0..n {
-            for p in cp[j]..cp[j + 1] {
-                trip.push(Triplet::new(ri[p], j, val[p]));
-            }
-        }
-    }
-    trip.extend((0..n).map(|i| Triplet::new(i, i, gd * m[i])));
-    let p = Sparse::try_new_from_triplets(n, n, &trip).expect("indices in range");
+    let data_diag: Vec<f64> = m.iter().map(|mi| gd * mi).collect();
+    let p = scaled_plus_diagonal(&q_energy, 1.0, &data_diag);
     let q: Vec<f64> = (0..n).map(|i| -gd * m[i] * z[i]).collect();
     seconds.operators = t.elapsed().as_secs_f64();
 
@@ -286,7 +270,7 @@ pub fn smooth<D: Smoothable>(domain: &D, h: &[f64], settings: &SmoothSettings) -
         .collect();
     let edges = constraint_edges(domain, &u, &fixed, settings.edges);
     check_fixed_neighbours(domain, h, &kept.roles)?;
-    let eps_max = max_margin(&u, &edges, &fixed)?;
+    let eps_max = max_margin(&u, &edges, &fixed, Some(MARGIN_CAP))?;
     let magnitude = h.iter().fold(0.0f64, |a, v| a.max(v.abs()));
     let resolution = (magnitude.next_up() - magnitude) / range;
     let eps = choose_margin(eps_max, 1.0, resolution)?;

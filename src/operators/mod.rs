@@ -22,4 +22,4 @@ mod sparse;
 
 pub use polyharmonic::{polyharmonic, Energy};
 pub use series::{series_mass, series_stiffness};
-pub use sparse::{quadratic_form, Sparse};
+pub use sparse::{quadratic_form, scaled_plus_diagonal, Sparse};

@@ -111,6 +111,8 @@ pub fn polyharmonic(k: &Sparse, m: &[f64], energy: &Energy, scale: &[f64]) -> Sp
     };
     let minv: Vec<f64> = m.iter().map(|x| 1.0 / x).collect();
     let mut all = Vec::new();
+    let mut single: Option<Sparse> = None;
+    let active = energy.terms.iter().zip(scale).filter(|(t, s)| t.1 * **s != 0.0).count();
     for (&(order, w), &s) in energy.terms.iter().zip(scale) {
         let c = w * s;
         if c == 0.0 {
@@ -129,13 +131,13 @@ pub fn polyharmonic(k: &Sparse, m: &[f64], energy: &Energy, scale: &[f64]) -> Sp
                 matmul(&gt, &inner)
             }
         };
-        all.extend(
-            triplets(&q)
-                .into_iter()
-                .map(|t| Triplet::new(t.row, t.col, c * t.val)),
-        );
+        if active == 1 {
+            single = Some(super::sparse::scaled_plus_diagonal(&q, c, &vec![0.0; n]));
+        } else {
+            all.extend(triplets(&q).into_iter().map(|t| Triplet::new(t.row, t.col, c * t.val)));
+        }
     }
-    from_triplets(n, n, &all)
+    single.unwrap_or_else(|| from_triplets(n, n, &all))
 }
 
 /// `K` without the edges at sharp vertices, diagonal recomputed so that rows sum to zero.

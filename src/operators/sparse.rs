@@ -28,22 +28,47 @@ pub(crate) fn triplets(a: &Sparse) -> Vec<Triplet<usize, usize, f64>> {
     out
 }
 
-/// `diag(d) · A`.
+/// `diag(d) · A` (same pattern, values scaled in place).
 pub(crate) fn scale_rows(a: &Sparse, d: &[f64]) -> Sparse {
-    let t: Vec<_> = triplets(a)
-        .into_iter()
-        .map(|t| Triplet::new(t.row, t.col, t.val * d[t.row]))
-        .collect();
-    from_triplets(a.nrows(), a.ncols(), &t)
+    let mut out = a.clone();
+    let rows: Vec<usize> = out.symbolic().row_idx().to_vec();
+    for (v, &r) in out.val_mut().iter_mut().zip(&rows) {
+        *v *= d[r];
+    }
+    out
 }
 
-/// `A · diag(d)`.
+/// `A · diag(d)` (same pattern, values scaled in place).
 pub(crate) fn scale_cols(a: &Sparse, d: &[f64]) -> Sparse {
-    let t: Vec<_> = triplets(a)
-        .into_iter()
-        .map(|t| Triplet::new(t.row, t.col, t.val * d[t.col]))
-        .collect();
-    from_triplets(a.nrows(), a.ncols(), &t)
+    let mut out = a.clone();
+    let cp: Vec<usize> = out.symbolic().col_ptr().to_vec();
+    let val = out.val_mut();
+    for j in 0..d.len() {
+        for v in &mut val[cp[j]..cp[j + 1]] {
+            *v *= d[j];
+        }
+    }
+    out
+}
+
+/// `c · A + diag(d)`; the diagonal is added to the pattern where missing.
+pub fn scaled_plus_diagonal(a: &Sparse, c: f64, d: &[f64]) -> Sparse {
+    let n = a.nrows();
+    let (cp, ri) = (a.symbolic().col_ptr(), a.symbolic().row_idx());
+    if (0..n).all(|j| ri[cp[j]..cp[j + 1]].contains(&j)) {
+        let mut out = a.clone();
+        let (cp, ri) = (cp.to_vec(), ri.to_vec());
+        let val = out.val_mut();
+        for j in 0..n {
+            for p in cp[j]..cp[j + 1] {
+                val[p] = c * val[p] + if ri[p] == j { d[j] } else { 0.0 };
+            }
+        }
+        return out;
+    }
+    let mut t: Vec<_> = triplets(a).into_iter().map(|t| Triplet::new(t.row, t.col, c * t.val)).collect();
+    t.extend((0..n).map(|i| Triplet::new(i, i, d[i])));
+    from_triplets(n, n, &t)
 }
 
 /// `A · B`.
@@ -54,12 +79,17 @@ pub(crate) fn matmul(a: &Sparse, b: &Sparse) -> Sparse {
 
 /// `fᵀ A f`.
 pub fn quadratic_form(a: &Sparse, f: &[f64]) -> f64 {
-    triplets(a)
-        .iter()
-        .map(|t| f[t.row] * t.val * f[t.col])
-        .sum()
+    let (cp, ri, v) = (a.symbolic().col_ptr(), a.symbolic().row_idx(), a.val());
+    let mut s = 0.0;
+    for j in 0..a.ncols() {
+        for p in cp[j]..cp[j + 1] {
+            s += f[ri[p]] * v[p] * f[j];
+        }
+    }
+    s
 }
 
+#[cfg(test)]
 /// `A · x` for a dense vector.
 #[cfg(test)]
 pub(crate) fn mul_vec(a: &Sparse, x: &[f64]) -> Vec<f64> {

@@ -96,6 +96,19 @@ fn union_find_pairs<D: Domain>(domain: &D, values: &[f64], order: &[usize]) -> V
     pairs
 }
 
+/// Numbers of SoS minima and SoS maxima (series ends included): a local test per vertex.
+pub fn count_sos_extrema<D: Domain>(domain: &D, values: &[f64]) -> (usize, usize) {
+    let (mut minima, mut maxima) = (0, 0);
+    for v in 0..domain.n_vertices() {
+        if domain.neighbors(v).all(|w| crate::domain::sos_greater(values, w, v)) {
+            minima += 1;
+        } else if domain.neighbors(v).all(|w| crate::domain::sos_less(values, w, v)) {
+            maxima += 1;
+        }
+    }
+    (minima, maxima)
+}
+
 /// Kind of an extremum in an [`extrema_table`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
 #[serde(rename_all = "lowercase")]
@@ -258,6 +271,7 @@ mod tests {
             ]
         );
         assert!(!t[1].strict, "vertex 1 ties with vertex 2");
+        assert_eq!(count_sos_extrema(&Series::uniform(6), &h), (2, 3));
         assert!(t[2].strict);
         assert_eq!(t[2].persistence, Some(2.0));
     }

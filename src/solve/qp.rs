@@ -162,12 +162,12 @@ pub fn solve_monotone_qp(qp: &MonotoneQp<'_>, settings: &QpSettings) -> Result<Q
     let a = CscMatrix::new_from_triplets(m, nf, ai, aj, av);
     let cones = [NonnegativeConeT(m)];
     let solver_settings = DefaultSettingsBuilder::default()
-        .verbose(std::env::var_os("TOPOSMOOTH_SOLVER_VERBOSE").is_some())
+        .verbose(false)
         .max_iter(settings.max_iter)
         .tol_feas(settings.tolerance)
         .tol_gap_abs(settings.tolerance)
         .tol_gap_rel(settings.tolerance)
-        .direct_solve_method(std::env::var("TOPOSMOOTH_KKT").unwrap_or_else(|_| "faer".to_string()))
+        .direct_solve_method("faer".to_string())
         .build()
         .map_err(|e| Error::NoSolution {
             path: None,

@@ -1,0 +1,127 @@
+//! Property tests over random series, thresholds and orders: every run with a kept set chosen
+//! by persistence certifies; explicit lists certify or exit 3; nothing panics; every
+//! certificate is re-checked by the independent extremum counter in `common`.
+
+mod common;
+
+use common::count_series_extrema;
+use proptest::prelude::*;
+use toposmooth::constraints::EdgeSet;
+use toposmooth::domain::{Domain, Series};
+use toposmooth::operators::Energy;
+use toposmooth::pipeline::{smooth, SmoothSettings, Smoothed};
+use toposmooth::topology::{Role, Selection};
+
+fn values() -> impl Strategy<Value = Vec<f64>> {
+    prop_oneof![
+        // few distinct values: ties and plateaus everywhere
+        prop::collection::vec((0i32..5).prop_map(f64::from), 2..60),
+        prop::collection::vec(-10.0f64..10.0, 2..80),
+        // random walks with tiny steps
+        prop::collection::vec(-1.0f64..1.0, 2..120).prop_map(|s| s
+            .iter()
+            .scan(0.0, |a, v| {
+                *a += v * 1e-3;
+                Some(*a)
+            })
+            .collect()),
+    ]
+}
+
+fn coordinates(n: usize, seed: u64) -> Series {
+    if seed % 2 == 0 {
+        return Series::uniform(n);
+    }
+    let r = common::uniform(seed, n);
+    Series::with_coordinates(r.iter().scan(0.0, |a, v| {
+        *a += 0.05 + v;
+        Some(*a)
+    }).collect())
+    .unwrap()
+}
+
+fn energy() -> impl Strategy<Value = Energy> {
+    prop_oneof![
+        Just(Energy::order(1)),
+        Just(Energy::order(2)),
+        Just(Energy::order(3)),
+        Just(Energy::order(4)),
+        Just(Energy::parse("1:0.2,2:1").unwrap()),
+    ]
+}
+
+fn check_certified(h: &[f64], out: &Smoothed) -> Result<(), TestCaseError> {
+    let n = h.len();
+    let c = count_series_extrema(&out.output);
+    prop_assert!(c.flat.is_empty(), "flat spots {:?}", c.flat);
+    let kept_min: Vec<usize> = (0..n).filter(|&i| out.roles[i] == Role::Min).collect();
+    let kept_max: Vec<usize> = (0..n).filter(|&i| out.roles[i] == Role::Max).collect();
+    let not_end = |v: Vec<usize>| v.into_iter().filter(|&i| out.roles[i] != Role::End).collect::<Vec<_>>();
+    prop_assert_eq!(not_end(c.minima), kept_min.clone());
+    prop_assert_eq!(not_end(c.maxima), kept_max.clone());
+    for &i in kept_min.iter().chain(&kept_max) {
+        prop_assert_eq!(out.output[i].to_bits(), h[i].to_bits());
+    }
+    prop_assert!(out.output.iter().all(|v| v.is_finite()));
+    prop_assert!(!kept_min.is_empty() && !kept_max.is_empty());
+    Ok(())
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 1500, .. ProptestConfig::default() })]
+
+    #[test]
+    fn persistence_selections_always_certify(
+        h in values(),
+        frac in 0.0005f64..0.9,
+        pairs in 0usize..12,
+        use_pairs in any::<bool>(),
+        energy in energy(),
+        all_edges in any::<bool>(),
+        seed in 0u64..1000,
+    ) {
+        let series = coordinates(h.len(), seed);
+        let constant = h.iter().all(|&v| v == h[0]);
+        let selection = if use_pairs { Selection::Pairs(pairs) } else { Selection::Relative(frac) };
+        let settings = SmoothSettings {
+            selection,
+            energy,
+            edges: if all_edges { EdgeSet::All } else { EdgeSet::Minimal },
+            ..Default::default()
+        };
+        match smooth(&series, &h, &settings) {
+            Ok(out) => {
+                prop_assert!(!constant);
+                prop_assert!(out.report.certificate.passed);
+                check_certified(&h, &out)?;
+            }
+            Err(e) => {
+                prop_assert!(constant, "persistence selection failed: {} (exit {})", e, e.exit_code());
+                prop_assert_eq!(e.exit_code(), 3);
+            }
+        }
+    }
+
+    #[test]
+    fn explicit_lists_certify_or_exit_3(
+        h in values(),
+        picks in prop::collection::vec(any::<bool>(), 120),
+        energy in energy(),
+    ) {
+        let series = Series::uniform(h.len());
+        // candidate extrema of the input in SoS order, a random subset of them
+        let sos_less = |a: usize, b: usize| (h[a], a) < (h[b], b);
+        let mut minima = vec![];
+        let mut maxima = vec![];
+        for v in 0..h.len() {
+            if !picks[v] { continue; }
+            if series.neighbors(v).all(|w| sos_less(v, w)) { minima.push(v); }
+            else if series.neighbors(v).all(|w| sos_less(w, v)) { maxima.push(v); }
+        }
+        let settings = SmoothSettings { selection: Selection::Explicit { minima, maxima }, energy, ..Default::default() };
+        match smooth(&series, &h, &settings) {
+            Ok(out) => check_certified(&h, &out)?,
+            Err(e) => prop_assert_eq!(e.exit_code(), 3, "{}", e),
+        }
+    }
+}

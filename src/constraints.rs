@@ -87,7 +87,12 @@ pub fn constraint_edges<D: Domain>(
 /// # Errors
 /// Infeasible if even ε = 0 is infeasible: an edge path runs from a fixed value down to a
 /// smaller one (u disagrees with the fixed values).
-pub fn max_margin(u: &[f64], edges: &[(usize, usize)], fixed: &[Option<f64>], cap: Option<f64>) -> Result<f64> {
+pub fn max_margin(
+    u: &[f64],
+    edges: &[(usize, usize)],
+    fixed: &[Option<f64>],
+    cap: Option<f64>,
+) -> Result<f64> {
     let n = u.len();
     let order = sos_sort(u);
     // out-edges in compressed form

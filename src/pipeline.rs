@@ -15,13 +15,14 @@ use crate::constraints::{choose_margin, constraint_edges, max_margin, EdgeSet, M
 use crate::domain::{sos_sort, Domain, Series};
 use crate::error::{Error, Result};
 use crate::operators::{
-    polyharmonic, quadratic_form, scaled_plus_diagonal, series_mass, series_stiffness, Energy, Sparse,
+    polyharmonic, quadratic_form, scaled_plus_diagonal, series_mass, series_stiffness, Energy,
+    Sparse,
 };
 use crate::representative::series_representative;
-use crate::solve::{repair, solve_monotone_qp, MonotoneQp, QpSettings, RepairSummary, SolveStatus};
-use crate::topology::{
-    count_sos_extrema, select, KeptExtremum, KeptSet, Role, Selection,
+use crate::solve::{
+    repair, solve_monotone_qp, Method, MonotoneQp, QpSettings, RepairSummary, SolveStatus,
 };
+use crate::topology::{count_sos_extrema, select, KeptExtremum, KeptSet, Role, Selection};
 use crate::verify::{certify, Certificate};
 use std::time::Instant;
 
@@ -180,6 +181,10 @@ pub struct Report {
     pub solver_status: SolveStatus,
     /// Interior-point iterations.
     pub solver_iterations: u32,
+    /// The solver that produced the point.
+    pub solver: Method,
+    /// Why the structured solver handed over to Clarabel, if it did.
+    pub solver_fallback: Option<String>,
     /// What the repair changed.
     pub repair: RepairSummary,
     /// Certificate of u (items 1, 2, 4).
@@ -277,16 +282,16 @@ pub fn smooth<D: Smoothable>(domain: &D, h: &[f64], settings: &SmoothSettings) -
     seconds.constraints = t.elapsed().as_secs_f64();
 
     let t = Instant::now();
-    let sol = solve_monotone_qp(
-        &MonotoneQp {
-            p: &p,
-            q: &q,
-            fixed: &fixed,
-            edges: &edges,
-            margin: eps,
-        },
-        &settings.qp,
-    )?;
+    let hint: Vec<f64> = u.iter().map(|v| (v - lo) / range).collect();
+    let qp = MonotoneQp {
+        p: &p,
+        q: &q,
+        fixed: &fixed,
+        edges: &edges,
+        margin: eps,
+        hint: Some(&hint),
+    };
+    let sol = solve_monotone_qp(&qp, &settings.qp)?;
     seconds.solve = t.elapsed().as_secs_f64();
 
     let t = Instant::now();
@@ -346,6 +351,8 @@ pub fn smooth<D: Smoothable>(domain: &D, h: &[f64], settings: &SmoothSettings) -
         max_deviation,
         solver_status: sol.status,
         solver_iterations: sol.iterations,
+        solver: sol.method,
+        solver_fallback: sol.fallback.clone(),
         repair: repair_summary,
         representative_certificate,
         certificate,

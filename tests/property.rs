@@ -33,10 +33,14 @@ fn coordinates(n: usize, seed: u64) -> Series {
         return Series::uniform(n);
     }
     let r = common::uniform(seed, n);
-    Series::with_coordinates(r.iter().scan(0.0, |a, v| {
-        *a += 0.05 + v;
-        Some(*a)
-    }).collect())
+    Series::with_coordinates(
+        r.iter()
+            .scan(0.0, |a, v| {
+                *a += 0.05 + v;
+                Some(*a)
+            })
+            .collect(),
+    )
     .unwrap()
 }
 
@@ -56,7 +60,11 @@ fn check_certified(h: &[f64], out: &Smoothed) -> Result<(), TestCaseError> {
     prop_assert!(c.flat.is_empty(), "flat spots {:?}", c.flat);
     let kept_min: Vec<usize> = (0..n).filter(|&i| out.roles[i] == Role::Min).collect();
     let kept_max: Vec<usize> = (0..n).filter(|&i| out.roles[i] == Role::Max).collect();
-    let not_end = |v: Vec<usize>| v.into_iter().filter(|&i| out.roles[i] != Role::End).collect::<Vec<_>>();
+    let not_end = |v: Vec<usize>| {
+        v.into_iter()
+            .filter(|&i| out.roles[i] != Role::End)
+            .collect::<Vec<_>>()
+    };
     prop_assert_eq!(not_end(c.minima), kept_min.clone());
     prop_assert_eq!(not_end(c.maxima), kept_max.clone());
     for &i in kept_min.iter().chain(&kept_max) {
@@ -93,6 +101,7 @@ proptest! {
             Ok(out) => {
                 prop_assert!(!constant);
                 prop_assert!(out.report.certificate.passed);
+                prop_assert!(out.report.solver_fallback.is_none(), "fallback: {:?}", out.report.solver_fallback);
                 check_certified(&h, &out)?;
             }
             Err(e) => {

@@ -80,6 +80,8 @@ pub fn bench(args: &BenchArgs) -> Result<String> {
             "kept": rep.kept.len(),
             "constraints": rep.constraints,
             "iterations": rep.solver_iterations,
+            "solver": rep.solver,
+            "fallback": rep.solver_fallback,
             "status": format!("{:?}", rep.solver_status),
             "certified": rep.certificate.passed,
             "seconds": rep.seconds,

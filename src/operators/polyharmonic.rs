@@ -112,7 +112,12 @@ pub fn polyharmonic(k: &Sparse, m: &[f64], energy: &Energy, scale: &[f64]) -> Sp
     let minv: Vec<f64> = m.iter().map(|x| 1.0 / x).collect();
     let mut all = Vec::new();
     let mut single: Option<Sparse> = None;
-    let active = energy.terms.iter().zip(scale).filter(|(t, s)| t.1 * **s != 0.0).count();
+    let active = energy
+        .terms
+        .iter()
+        .zip(scale)
+        .filter(|(t, s)| t.1 * **s != 0.0)
+        .count();
     for (&(order, w), &s) in energy.terms.iter().zip(scale) {
         let c = w * s;
         if c == 0.0 {
@@ -134,7 +139,11 @@ pub fn polyharmonic(k: &Sparse, m: &[f64], energy: &Energy, scale: &[f64]) -> Sp
         if active == 1 {
             single = Some(super::sparse::scaled_plus_diagonal(&q, c, &vec![0.0; n]));
         } else {
-            all.extend(triplets(&q).into_iter().map(|t| Triplet::new(t.row, t.col, c * t.val)));
+            all.extend(
+                triplets(&q)
+                    .into_iter()
+                    .map(|t| Triplet::new(t.row, t.col, c * t.val)),
+            );
         }
     }
     single.unwrap_or_else(|| from_triplets(n, n, &all))

@@ -66,7 +66,10 @@ pub fn scaled_plus_diagonal(a: &Sparse, c: f64, d: &[f64]) -> Sparse {
         }
         return out;
     }
-    let mut t: Vec<_> = triplets(a).into_iter().map(|t| Triplet::new(t.row, t.col, c * t.val)).collect();
+    let mut t: Vec<_> = triplets(a)
+        .into_iter()
+        .map(|t| Triplet::new(t.row, t.col, c * t.val))
+        .collect();
     t.extend((0..n).map(|i| Triplet::new(i, i, d[i])));
     from_triplets(n, n, &t)
 }

@@ -1,10 +1,15 @@
 //! The monotone QP: `min ½ fᵀ P f + qᵀ f` with some entries of f fixed and `f_j − f_i ≥ ε`
-//! on given pairs, solved by Clarabel; and the repair of a returned point (NOTES.md 3).
+//! on given pairs; a structured interior-point solver, Clarabel, and the repair of a returned
+//! point (NOTES.md 3).
 //!
 //! This layer knows matrices, vectors and index pairs only: no domain, no mesh.
 
+mod clarabel;
+mod ipm;
 mod qp;
 mod repair;
 
-pub use qp::{solve_monotone_qp, MonotoneQp, QpSettings, QpSolution, SolveStatus};
+pub use qp::{
+    solve_monotone_qp, Method, MonotoneQp, QpSettings, QpSolution, ReducedQp, SolveStatus,
+};
 pub use repair::{repair, RepairSummary};

@@ -1,11 +1,7 @@
-//! Clarabel on the monotone QP, with the fixed entries eliminated.
+//! The monotone QP, its reduction to the free variables, and the choice of solver.
 
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::operators::Sparse;
-use clarabel::algebra::CscMatrix;
-use clarabel::solver::{
-    DefaultSettingsBuilder, DefaultSolver, IPSolver, NonnegativeConeT, SolverStatus,
-};
 
 /// The problem: `min ½ fᵀ P f + qᵀ f` s.t. `f_i = fixed_i` where given and
 /// `f_j − f_i ≥ margin` for every `(i, j)` in `edges`.
@@ -20,6 +16,20 @@ pub struct MonotoneQp<'a> {
     pub edges: &'a [(usize, usize)],
     /// ε > 0.
     pub margin: f64,
+    /// A point that satisfies every constraint (the representative u), `#V`, if known: the
+    /// structured solver starts there.
+    pub hint: Option<&'a [f64]>,
+}
+
+/// Which interior-point solver runs.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Method {
+    /// The structured solver of [`super::ipm`] (normal equations, faer Cholesky with the
+    /// symbolic analysis done once); Clarabel takes over if it does not converge.
+    Structured,
+    /// Clarabel on the full KKT system.
+    Clarabel,
 }
 
 /// Solver settings.
@@ -27,15 +37,18 @@ pub struct MonotoneQp<'a> {
 pub struct QpSettings {
     /// Largest number of interior-point iterations. {200}
     pub max_iter: u32,
-    /// Feasibility and gap tolerance (Clarabel's tol_feas, tol_gap_abs/rel). {1e-8}
+    /// Feasibility and gap tolerance on the scaled problem. {1e-9}
     pub tolerance: f64,
+    /// Solver. {structured}
+    pub method: Method,
 }
 
 impl Default for QpSettings {
     fn default() -> Self {
         QpSettings {
             max_iter: 200,
-            tolerance: 1e-8,
+            tolerance: 1e-9,
+            method: Method::Structured,
         }
     }
 }
@@ -64,159 +77,161 @@ pub struct QpSolution {
     pub status: SolveStatus,
     /// Interior-point iterations.
     pub iterations: u32,
+    /// The solver that produced the point.
+    pub method: Method,
+    /// Why the structured solver handed over to Clarabel, if it did.
+    pub fallback: Option<String>,
 }
 
-/// Solves the monotone QP with Clarabel (faer's sparse LDLᵀ inside).
+/// The QP on the free variables: `min ½ xᵀ P x + qᵀ x` s.t. `A x ≤ b`, objective scaled so
+/// that the mean diagonal of P is 1. Rows have one or two entries and are stored in order.
+pub struct ReducedQp {
+    /// Number of free variables.
+    pub n: usize,
+    /// Upper triangle of P as triplets (row ≤ col).
+    pub p: Vec<(usize, usize, f64)>,
+    /// Linear term.
+    pub q: Vec<f64>,
+    /// Row index of each entry of A (non-decreasing).
+    pub a_row: Vec<usize>,
+    /// Column of each entry of A.
+    pub a_col: Vec<usize>,
+    /// Value of each entry of A.
+    pub a_val: Vec<f64>,
+    /// Right-hand side, one per row.
+    pub b: Vec<f64>,
+}
+
+impl ReducedQp {
+    /// Number of rows.
+    pub fn m(&self) -> usize {
+        self.b.len()
+    }
+}
+
+/// Solves the monotone QP.
 ///
 /// # Errors
-/// [`Error::NoSolution`] when the solver returns no usable point (infeasibility
-/// certificates, non-finite output).
+/// [`crate::Error::NoSolution`] when no solver returns a usable point.
 pub fn solve_monotone_qp(qp: &MonotoneQp<'_>, settings: &QpSettings) -> Result<QpSolution> {
     let n = qp.q.len();
     assert_eq!(qp.fixed.len(), n);
     assert_eq!(qp.p.nrows(), n);
-    let mut slot = vec![usize::MAX; n];
-    let mut free = Vec::new();
-    for (i, f) in qp.fixed.iter().enumerate() {
-        if f.is_none() {
-            slot[i] = free.len();
-            free.push(i);
-        }
-    }
+    let free: Vec<usize> = (0..n).filter(|&i| qp.fixed[i].is_none()).collect();
     let mut x: Vec<f64> = qp.fixed.iter().map(|f| f.unwrap_or(0.0)).collect();
     if free.is_empty() {
         return Ok(QpSolution {
             x,
             status: SolveStatus::Trivial,
             iterations: 0,
+            method: settings.method,
+            fallback: None,
         });
     }
-    let nf = free.len();
-    // P_FF (upper triangle) and q_F + P_FX x_X
-    let mut qf: Vec<f64> = free.iter().map(|&i| qp.q[i]).collect();
+    let reduced = reduce(qp, &free);
+    let hint: Option<Vec<f64>> = qp.hint.map(|h| free.iter().map(|&i| h[i]).collect());
+    let mut fallback = None;
+    let (xf, status, iterations, method) = match settings.method {
+        Method::Structured => match super::ipm::solve(&reduced, hint.as_deref(), settings) {
+            Ok((xf, status, it)) => (xf, status, it, Method::Structured),
+            Err(why) => {
+                fallback = Some(why);
+                let (xf, status, it) = super::clarabel::solve(&reduced, settings)?;
+                (xf, status, it, Method::Clarabel)
+            }
+        },
+        Method::Clarabel => {
+            let (xf, status, it) = super::clarabel::solve(&reduced, settings)?;
+            (xf, status, it, Method::Clarabel)
+        }
+    };
+    for (k, &i) in free.iter().enumerate() {
+        x[i] = xf[k];
+    }
+    Ok(QpSolution {
+        x,
+        status,
+        iterations,
+        method,
+        fallback,
+    })
+}
+
+/// Eliminates the fixed variables: `P_FF`, `q_F + P_FX x_X`, and one row per constrained edge.
+fn reduce(qp: &MonotoneQp<'_>, free: &[usize]) -> ReducedQp {
+    let n = qp.q.len();
+    let mut slot = vec![usize::MAX; n];
+    for (k, &i) in free.iter().enumerate() {
+        slot[i] = k;
+    }
+    let xfix = |i: usize| qp.fixed[i].unwrap_or(0.0);
+    let mut q: Vec<f64> = free.iter().map(|&i| qp.q[i]).collect();
     let (cp, ri, val) = (
         qp.p.symbolic().col_ptr(),
         qp.p.symbolic().row_idx(),
         qp.p.val(),
     );
-    let mut pi = Vec::new();
-    let mut pj = Vec::new();
-    let mut pv = Vec::new();
+    let mut p = Vec::new();
     for j in 0..n {
         for k in cp[j]..cp[j + 1] {
             let i = ri[k];
-            let v = val[k];
             match (slot[i], slot[j]) {
                 (usize::MAX, _) => {}
-                (si, usize::MAX) => qf[si] += v * x[j],
-                (si, sj) => {
-                    if si <= sj {
-                        pi.push(si);
-                        pj.push(sj);
-                        pv.push(v);
-                    }
-                }
+                (si, usize::MAX) => q[si] += val[k] * xfix(j),
+                (si, sj) if si <= sj => p.push((si, sj, val[k])),
+                _ => {}
             }
         }
     }
-    // scale the objective so that its diagonal is of order one
-    let diag_mean = {
-        let mut s = 0.0;
-        for k in 0..pi.len() {
-            if pi[k] == pj[k] {
-                s += pv[k];
-            }
-        }
-        (s / nf as f64).max(f64::MIN_POSITIVE)
+    let nf = free.len();
+    let diag: f64 = p.iter().filter(|t| t.0 == t.1).map(|t| t.2).sum();
+    let scale = (diag / nf as f64).max(f64::MIN_POSITIVE);
+    p.iter_mut().for_each(|t| t.2 /= scale);
+    q.iter_mut().for_each(|v| *v /= scale);
+    // f_j − f_i ≥ ε  ⇔  f_i − f_j ≤ −ε
+    let mut r = ReducedQp {
+        n: nf,
+        p,
+        q,
+        a_row: vec![],
+        a_col: vec![],
+        a_val: vec![],
+        b: vec![],
     };
-    pv.iter_mut().for_each(|v| *v /= diag_mean);
-    qf.iter_mut().for_each(|v| *v /= diag_mean);
-    let p = CscMatrix::new_from_triplets(nf, nf, pi, pj, pv);
-    // rows: f_i − f_j + s = −ε, s ≥ 0  ⇔  f_j − f_i ≥ ε
-    let (mut ai, mut aj, mut av, mut b) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     for &(i, j) in qp.edges {
-        let row = b.len();
+        let row = r.b.len();
+        let mut push = |col: usize, v: f64| {
+            r.a_row.push(row);
+            r.a_col.push(col);
+            r.a_val.push(v);
+        };
         match (qp.fixed[i], qp.fixed[j]) {
             (Some(_), Some(_)) => continue,
             (None, None) => {
-                ai.extend([row, row]);
-                aj.extend([slot[i], slot[j]]);
-                av.extend([1.0, -1.0]);
-                b.push(-qp.margin);
+                push(slot[i], 1.0);
+                push(slot[j], -1.0);
+                r.b.push(-qp.margin);
             }
             (Some(fi), None) => {
-                ai.push(row);
-                aj.push(slot[j]);
-                av.push(-1.0);
-                b.push(-qp.margin - fi);
+                push(slot[j], -1.0);
+                r.b.push(-qp.margin - fi);
             }
             (None, Some(fj)) => {
-                ai.push(row);
-                aj.push(slot[i]);
-                av.push(1.0);
-                b.push(fj - qp.margin);
+                push(slot[i], 1.0);
+                r.b.push(fj - qp.margin);
             }
         }
     }
-    let m = b.len();
-    let a = CscMatrix::new_from_triplets(m, nf, ai, aj, av);
-    let cones = [NonnegativeConeT(m)];
-    let solver_settings = DefaultSettingsBuilder::default()
-        .verbose(false)
-        .max_iter(settings.max_iter)
-        .tol_feas(settings.tolerance)
-        .tol_gap_abs(settings.tolerance)
-        .tol_gap_rel(settings.tolerance)
-        .direct_solve_method("faer".to_string())
-        .build()
-        .map_err(|e| Error::NoSolution {
-            path: None,
-            status: format!("bad solver settings: {e:?}"),
-        })?;
-    let mut solver = DefaultSolver::new(&p, &qf, &a, &b, &cones, solver_settings).map_err(|e| {
-        Error::NoSolution {
-            path: None,
-            status: format!("solver setup failed: {e}"),
-        }
-    })?;
-    solver.solve();
-    let sol = &solver.solution;
-    let status = match sol.status {
-        SolverStatus::Solved => SolveStatus::Solved,
-        SolverStatus::AlmostSolved => SolveStatus::AlmostSolved,
-        SolverStatus::MaxIterations | SolverStatus::MaxTime => SolveStatus::MaxIterations,
-        SolverStatus::NumericalError | SolverStatus::InsufficientProgress => SolveStatus::Stalled,
-        other => {
-            return Err(Error::NoSolution {
-                path: None,
-                status: format!("{other:?} after {} iterations", sol.iterations),
-            })
-        }
-    };
-    if sol.x.iter().any(|v| !v.is_finite()) {
-        return Err(Error::NoSolution {
-            path: None,
-            status: format!("{:?} with non-finite values", sol.status),
-        });
-    }
-    for (k, &i) in free.iter().enumerate() {
-        x[i] = sol.x[k];
-    }
-    Ok(QpSolution {
-        x,
-        status,
-        iterations: sol.iterations,
-    })
+    r
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::operators::Sparse;
     use faer::sparse::Triplet;
 
     #[test]
-    fn projects_onto_a_monotone_chain() {
+    fn both_solvers_project_onto_a_monotone_chain() {
         // min Σ (f_i − h_i)² with f_0 = 0, f_3 = 3 fixed and f increasing: h = [0, 2, 1, 3]
         let p = Sparse::try_new_from_triplets(
             4,
@@ -227,28 +242,38 @@ mod tests {
         let q = [0.0, -2.0, -1.0, -3.0];
         let fixed = [Some(0.0), None, None, Some(3.0)];
         let edges = [(0, 1), (1, 2), (2, 3)];
-        let sol = solve_monotone_qp(
-            &MonotoneQp {
-                p: &p,
-                q: &q,
-                fixed: &fixed,
-                edges: &edges,
-                margin: 1e-6,
-            },
-            &QpSettings::default(),
-        )
-        .unwrap();
-        assert!(matches!(
-            sol.status,
-            SolveStatus::Solved | SolveStatus::AlmostSolved
-        ));
-        // isotonic regression pools 2 and 1 at 1.5 (then the margin splits them)
-        assert!(
-            (sol.x[1] - 1.5).abs() < 1e-4 && (sol.x[2] - 1.5).abs() < 1e-4,
-            "{:?}",
-            sol.x
-        );
-        assert!(sol.x[2] - sol.x[1] > 0.5e-6);
-        assert_eq!((sol.x[0], sol.x[3]), (0.0, 3.0));
+        for method in [Method::Structured, Method::Clarabel] {
+            for hint in [None, Some(&[0.0, 1.0, 2.0, 3.0][..])] {
+                let qp = MonotoneQp {
+                    p: &p,
+                    q: &q,
+                    fixed: &fixed,
+                    edges: &edges,
+                    margin: 1e-6,
+                    hint,
+                };
+                let sol = solve_monotone_qp(
+                    &qp,
+                    &QpSettings {
+                        method,
+                        ..Default::default()
+                    },
+                )
+                .unwrap();
+                assert_eq!(sol.method, method, "{:?}", sol.fallback);
+                assert!(matches!(
+                    sol.status,
+                    SolveStatus::Solved | SolveStatus::AlmostSolved
+                ));
+                // isotonic regression pools 2 and 1 at 1.5 (then the margin splits them)
+                assert!(
+                    (sol.x[1] - 1.5).abs() < 1e-5 && (sol.x[2] - 1.5).abs() < 1e-5,
+                    "{method:?}: {:?}",
+                    sol.x
+                );
+                assert!(sol.x[2] - sol.x[1] > 0.5e-6);
+                assert_eq!((sol.x[0], sol.x[3]), (0.0, 3.0));
+            }
+        }
     }
 }

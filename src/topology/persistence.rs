@@ -100,9 +100,15 @@ fn union_find_pairs<D: Domain>(domain: &D, values: &[f64], order: &[usize]) -> V
 pub fn count_sos_extrema<D: Domain>(domain: &D, values: &[f64]) -> (usize, usize) {
     let (mut minima, mut maxima) = (0, 0);
     for v in 0..domain.n_vertices() {
-        if domain.neighbors(v).all(|w| crate::domain::sos_greater(values, w, v)) {
+        if domain
+            .neighbors(v)
+            .all(|w| crate::domain::sos_greater(values, w, v))
+        {
             minima += 1;
-        } else if domain.neighbors(v).all(|w| crate::domain::sos_less(values, w, v)) {
+        } else if domain
+            .neighbors(v)
+            .all(|w| crate::domain::sos_less(values, w, v))
+        {
             maxima += 1;
         }
     }

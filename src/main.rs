@@ -7,7 +7,7 @@ use toposmooth::constraints::EdgeSet;
 use toposmooth::io::series_csv::SeriesCsvOptions;
 use toposmooth::operators::Energy;
 use toposmooth::pipeline::SmoothSettings;
-use toposmooth::solve::QpSettings;
+use toposmooth::solve::{Method, QpSettings};
 use toposmooth::topology::Selection;
 use toposmooth::{Error, Result};
 
@@ -66,6 +66,9 @@ enum Command {
         /// RNG seed.
         #[arg(long, default_value_t = 1)]
         seed: u64,
+        /// QP solver.
+        #[arg(long, value_enum, default_value_t = Solver::Structured)]
+        solver: Solver,
         /// Run one size in this process and print one JSON line.
         #[arg(long, hide = true)]
         single: Option<usize>,
@@ -90,6 +93,12 @@ impl CsvArgs {
             x_column: self.x_column.clone(),
         }
     }
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum Solver {
+    Structured,
+    Clarabel,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -140,6 +149,10 @@ struct SmoothCli {
     /// Largest number of solver iterations.
     #[arg(long, default_value_t = 200)]
     max_iter: u32,
+    /// QP solver: the structured interior-point method (Clarabel takes over if it fails), or
+    /// Clarabel alone.
+    #[arg(long, value_enum, default_value_t = Solver::Structured)]
+    solver: Solver,
     /// Figure: input (grey), output, kept extrema.
     #[arg(long, value_name = "PNG")]
     plot: Option<PathBuf>,
@@ -152,6 +165,13 @@ fn edge_set(e: Edges) -> EdgeSet {
     match e {
         Edges::Minimal => EdgeSet::Minimal,
         Edges::All => EdgeSet::All,
+    }
+}
+
+fn method(s: Solver) -> Method {
+    match s {
+        Solver::Structured => Method::Structured,
+        Solver::Clarabel => Method::Clarabel,
     }
 }
 
@@ -178,6 +198,7 @@ fn smooth_args(c: SmoothCli) -> Result<SmoothArgs> {
         edges: edge_set(c.edges),
         qp: QpSettings {
             max_iter: c.max_iter,
+            method: method(c.solver),
             ..Default::default()
         },
     };
@@ -219,6 +240,7 @@ fn run(cli: Cli) -> Result<String> {
             edges,
             seed,
             single,
+            solver,
         } => {
             let persistence = match commands::parse_persistence(&persistence)? {
                 Selection::Relative(r) => r,
@@ -235,6 +257,7 @@ fn run(cli: Cli) -> Result<String> {
                 edges: edge_set(edges),
                 seed,
                 single,
+                method: method(solver),
             })
         }
     }

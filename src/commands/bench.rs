@@ -8,6 +8,7 @@ use crate::domain::Series;
 use crate::error::{Error, Result};
 use crate::operators::Energy;
 use crate::pipeline::{smooth, SmoothSettings};
+use crate::solve::{Method, QpSettings};
 use crate::topology::Selection;
 use std::time::Instant;
 
@@ -26,6 +27,8 @@ pub struct BenchArgs {
     pub seed: u64,
     /// Run one size in this process and print one JSON line.
     pub single: Option<usize>,
+    /// QP solver.
+    pub method: Method,
 }
 
 /// A Gaussian random walk of `n` steps from a fixed seed (splitmix64 + Box–Muller).
@@ -68,6 +71,10 @@ pub fn bench(args: &BenchArgs) -> Result<String> {
             selection: Selection::Relative(args.persistence),
             energy: args.energy.clone(),
             edges: args.edges,
+            qp: QpSettings {
+                method: args.method,
+                ..Default::default()
+            },
             ..Default::default()
         };
         let t = Instant::now();

@@ -141,8 +141,14 @@ pub fn smooth(args: &SmoothArgs) -> Result<String> {
         r.max_deviation
     );
     text += &format!(
-        "solver {:?} in {} iterations, {} constraints, margin {:.3e}; repair changed {} vertices\n",
-        r.solver_status, r.solver_iterations, r.constraints, r.margin[0], r.repair.changed_vertices
+        "solver {:?} {:?} in {} iterations{}, {} constraints, margin {:.3e}; repair changed {} vertices\n",
+        r.solver,
+        r.solver_status,
+        r.solver_iterations,
+        r.solver_fallback.as_ref().map(|w| format!(" (structured solver gave up: {w})")).unwrap_or_default(),
+        r.constraints,
+        r.margin[0],
+        r.repair.changed_vertices
     );
     text += &format!(
         "seconds: read {:.3}, persistence {:.3}, representative {:.3}, operators {:.3}, constraints {:.3}, solve {:.3}, repair {:.3}, verify {:.3}, write {:.3}, total {:.3}\n",

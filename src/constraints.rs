@@ -189,7 +189,7 @@ pub const MARGIN_CAP: f64 = 1e-6;
 /// represent a strict function with the kept values along the longest constrained path.
 pub fn choose_margin(max_margin: f64, range: f64, resolution: f64) -> Result<f64> {
     let eps = (0.5 * max_margin).min(MARGIN_CAP * range);
-    if !(eps > 4.0 * resolution) {
+    if eps.partial_cmp(&(4.0 * resolution)) != Some(std::cmp::Ordering::Greater) {
         return Err(Error::infeasible(format!(
             "the kept values leave a margin of {eps:e} per edge, not above 4 × the spacing of doubles ({resolution:e}): no strict function in double precision"
         )));

@@ -1,20 +1,241 @@
-//! Figures (placeholder while the plotters backend is written).
-#![allow(missing_docs, unused_variables)]
+//! PNG plots of smoothed series and persistence diagrams.
+//!
+//! Drawing uses plotters' bitmap backend into an in-memory RGB buffer; since plotters is built
+//! without its image encoder, the buffer is written by a small built-in PNG encoder (fixed-Huffman
+//! deflate with run matching, which compresses flat plot backgrounds well).
+
+use chrono::{Datelike, NaiveDate, TimeDelta};
+use plotters::coord::ranged1d::{KeyPointHint, NoDefaultFormatting, ValueFormatter};
+use plotters::coord::types::RangedCoordf64;
+use plotters::element::DashedPathElement;
+use plotters::prelude::*;
+use plotters::style::text_anchor::{HPos, Pos, VPos};
+use std::error::Error;
+use std::path::Path;
+use std::sync::OnceLock;
+
+/// Error of a plot: carries a message.
 #[derive(Debug, thiserror::Error)]
 #[error("{0}")]
 pub struct PlotError(pub String);
+
+/// How the x axis of a series is labelled.
 #[derive(Clone, Debug, PartialEq)]
 pub enum XAxis {
+    /// x is a plain number with this axis label (e.g. "sample" or "x").
     Numeric(String),
-    DaysSince(chrono::NaiveDate),
+    /// x counts days since this date: tick labels are drawn as dates (YYYY-MM or YYYY-MM-DD, picked by span).
+    DaysSince(NaiveDate),
 }
+
+/// A kept extremum marker: index into the arrays, and whether it is a maximum (red) or minimum (blue).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Marker {
+    /// Index into the `x` / `output` arrays.
     pub index: usize,
+    /// True for a maximum, false for a minimum.
     pub is_max: bool,
 }
+
+/// One point of a persistence diagram.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DiagramPoint {
+    /// Value at which the feature is born.
+    pub birth: f64,
+    /// Value at which it dies (infinite for an essential feature).
+    pub death: f64,
+    /// True for a pair of a maximum, false for a pair of a minimum.
+    pub is_max: bool,
+    /// True if the extremum is kept by the smoothing, false if it is cancelled.
+    pub kept: bool,
+}
+
+const FONT: &str = "sans-serif";
+const GREY: RGBColor = RGBColor(90, 90, 90);
+const ORANGE: RGBColor = RGBColor(255, 140, 0);
+const MIN_C: RGBColor = RGBColor(20, 70, 220);
+const MAX_C: RGBColor = RGBColor(210, 20, 20);
+
+/// Registers DejaVu Sans as "sans-serif" once; plotters' `ab_glyph` text needs it.
+fn ensure_font() -> Result<(), PlotError> {
+    static OK: OnceLock<bool> = OnceLock::new();
+    let ok = OK.get_or_init(|| {
+        plotters::style::register_font(FONT, FontStyle::Normal, dejavu::sans::regular()).is_ok()
+    });
+    ok.then_some(())
+        .ok_or_else(|| PlotError("cannot register the DejaVu Sans font".into()))
+}
+
+/// Validates the size, draws with `draw` on a white RGB canvas and writes it as PNG to `path`.
+fn render<F>(path: &Path, (w, h): (u32, u32), draw: F) -> Result<(), PlotError>
+where
+    F: FnOnce(&Area<'_>, f64) -> Result<(), Box<dyn Error>>,
+{
+    let fail = |e: &dyn std::fmt::Display| PlotError(format!("plot {}: {e}", path.display()));
+    if !(100..=16384).contains(&w) || !(100..=16384).contains(&h) {
+        return Err(fail(&format!("image size {w}x{h} outside 100..=16384")));
+    }
+    ensure_font()?;
+    let mut buf = vec![255u8; w as usize * h as usize * 3];
+    {
+        let root = BitMapBackend::with_buffer(&mut buf, (w, h)).into_drawing_area();
+        // Font scale: 1 on a 1200×600 image.
+        let scale = ((w as f64 * h as f64).sqrt() / 848.5).clamp(0.6, 4.0);
+        draw(&root, scale).map_err(|e| fail(&e))?;
+        root.present().map_err(|e| fail(&e))?;
+    }
+    image::save_buffer_with_format(
+        path,
+        &buf,
+        w,
+        h,
+        image::ExtendedColorType::Rgb8,
+        image::ImageFormat::Png,
+    )
+    .map_err(|e| fail(&e))
+}
+
+/// A non-degenerate range around `lo..hi` (NaN or infinite bounds give 0..1), widened by `pad` each side.
+fn nice_range(lo: f64, hi: f64, pad: f64) -> (f64, f64) {
+    if !(lo.is_finite() && hi.is_finite() && lo <= hi) {
+        return (0.0, 1.0);
+    }
+    let (mid, half) = (lo / 2.0 + hi / 2.0, hi / 2.0 - lo / 2.0);
+    let half = if half > mid.abs() * 1e-9 {
+        half * (1.0 + 2.0 * pad)
+    } else {
+        mid.abs().max(1.0) * 0.05
+    };
+    (mid - half, mid + half)
+}
+
+/// Whether `v` is plotted: finite and within ±1e300 (so that spans of values stay finite).
+fn ok(v: f64) -> bool {
+    v.abs() <= 1e300
+}
+
+fn min_max(v: impl Iterator<Item = f64>) -> (f64, f64) {
+    v.filter(|&a| ok(a))
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
+            (a.min(v), b.max(v))
+        })
+}
+
+/// Finite `(x, y)` pairs; with more than 4 points per column, keeps each column bucket's min and max.
+fn decimate(x: &[f64], y: &[f64], (lo, hi): (f64, f64), cols: usize) -> Vec<(f64, f64)> {
+    let pts: Vec<(f64, f64)> = x
+        .iter()
+        .zip(y)
+        .map(|(&a, &b)| (a, b))
+        .filter(|&(a, b)| ok(a) && ok(b))
+        .collect();
+    if pts.len() <= 4 * cols {
+        return pts;
+    }
+    let col = |a: f64| ((a - lo) / (hi - lo) * cols as f64) as i64;
+    let mut out = Vec::with_capacity(4 * cols);
+    let flush = |out: &mut Vec<_>, (_, a, b): (i64, usize, usize)| {
+        out.push(pts[a.min(b)]);
+        if a != b {
+            out.push(pts[a.max(b)]);
+        }
+    };
+    let mut cur: Option<(i64, usize, usize)> = None; // (column, index of min, index of max)
+    for (i, &(a, b)) in pts.iter().enumerate() {
+        match cur.as_mut() {
+            Some((c, mn, mx)) if *c == col(a) => {
+                if b < pts[*mn].1 {
+                    *mn = i;
+                }
+                if b > pts[*mx].1 {
+                    *mx = i;
+                }
+            }
+            _ => {
+                cur.into_iter().for_each(|g| flush(&mut out, g));
+                cur = Some((col(a), i, i));
+            }
+        }
+    }
+    cur.into_iter().for_each(|g| flush(&mut out, g));
+    out
+}
+
+/// An f64 axis whose bold ticks are given (date ticks) or, for `None`, plotters' default ones.
+struct TickAxis(RangedCoordf64, Option<Vec<f64>>);
+
+impl Ranged for TickAxis {
+    type FormatOption = NoDefaultFormatting;
+    type ValueType = f64;
+    fn map(&self, v: &f64, limit: (i32, i32)) -> i32 {
+        self.0.map(v, limit)
+    }
+    fn key_points<H: KeyPointHint>(&self, hint: H) -> Vec<f64> {
+        match &self.1 {
+            Some(t) if !hint.weight().allow_light_points() => t.clone(),
+            Some(_) => vec![],
+            None => self.0.key_points(hint),
+        }
+    }
+    fn range(&self) -> std::ops::Range<f64> {
+        self.0.range()
+    }
+}
+
+impl ValueFormatter<f64> for TickAxis {
+    fn format(v: &f64) -> String {
+        RangedCoordf64::format(v)
+    }
+}
+
+/// Formats `days` after `origin` as YYYY-MM-DD (`with_day`) or YYYY-MM; out of range as a number.
+fn date_label(origin: NaiveDate, days: f64, with_day: bool) -> String {
+    match TimeDelta::try_days(days.round() as i64).and_then(|d| origin.checked_add_signed(d)) {
+        Some(d) if with_day => d.format("%Y-%m-%d").to_string(),
+        Some(d) => d.format("%Y-%m").to_string(),
+        None => format!("{days:e}"),
+    }
+}
+
+/// Tick positions (days after `origin`) on day, month or year boundaries, at most about `max`
+/// of them, and whether labels need the day. `None` if the range is outside chrono's dates.
+fn date_ticks(origin: NaiveDate, lo: f64, hi: f64, max: usize) -> Option<(Vec<f64>, bool)> {
+    let day = |d: f64| origin.checked_add_signed(TimeDelta::try_days(d.floor() as i64)?);
+    let (a, b, max) = (day(lo)?, day(hi)?, max.max(2) as f64);
+    if let Some(&s) = [1.0, 2.0, 7.0, 14.0]
+        .iter()
+        .find(|&&s| (hi - lo) / s <= max)
+    {
+        let ticks = ((lo / s).ceil() as i64..=(hi / s).floor() as i64).map(|k| k as f64 * s);
+        return Some((ticks.collect(), true));
+    }
+    let month = |d: NaiveDate| d.year() as i64 * 12 + d.month0() as i64;
+    let (ma, mb) = (month(a), month(b) + 1);
+    let mut steps = [1, 2, 3, 6]
+        .into_iter()
+        .chain((0..8).flat_map(|e| [12, 24, 60].map(|s| s * 10i64.pow(e))));
+    let step = steps.find(|&s| ((mb - ma) / s) as f64 <= max)?;
+    let ticks = (ma.div_euclid(step)..=mb.div_euclid(step)).filter_map(|k| {
+        let m = k * step;
+        let d = NaiveDate::from_ymd_opt(
+            i32::try_from(m.div_euclid(12)).ok()?,
+            m.rem_euclid(12) as u32 + 1,
+            1,
+        )?;
+        Some((d - origin).num_days() as f64).filter(|t| (lo..=hi).contains(t))
+    });
+    Some((ticks.collect(), false))
+}
+
+/// Plots `input` (grey, thin) and `output` (orange, thicker) against `x`, with the kept minima
+/// (blue) and maxima (red) drawn as dots at `(x, output)`, a legend, `title` and axis labels,
+/// into a PNG of `size` pixels at `path`. Non-finite points are skipped, markers whose index is
+/// out of range are ignored, and long series are decimated to the min/max of each pixel column.
+/// Errors on empty or mismatched arrays, no finite point, a size outside 100..=16384 or a
+/// drawing/writing failure.
+#[allow(clippy::too_many_arguments)]
 pub fn plot_series(
-    path: &std::path::Path,
+    path: &Path,
     x: &[f64],
     axis: &XAxis,
     y_label: &str,
@@ -24,21 +245,491 @@ pub fn plot_series(
     title: &str,
     size: (u32, u32),
 ) -> Result<(), PlotError> {
-    Err(PlotError("plotting not built yet".into()))
+    let fail = |m: &str| PlotError(format!("plot {}: {m}", path.display()));
+    if x.len() != input.len() || x.len() != output.len() {
+        let (a, b, c) = (x.len(), input.len(), output.len());
+        return Err(fail(&format!(
+            "mismatched lengths: x {a}, input {b}, output {c}"
+        )));
+    }
+    let xs = min_max(
+        x.iter()
+            .zip(input.iter().zip(output))
+            .filter(|(_, (&a, &b))| ok(a) || ok(b))
+            .map(|(x, _)| *x),
+    );
+    let ys = min_max(
+        x.iter()
+            .zip(input)
+            .chain(x.iter().zip(output))
+            .filter(|(&x, _)| ok(x))
+            .map(|(_, y)| *y),
+    );
+    if !(xs.0 <= xs.1 && ys.0 <= ys.1) {
+        return Err(fail("no finite point to plot"));
+    }
+    let (xr, yr) = (nice_range(xs.0, xs.1, 0.0), nice_range(ys.0, ys.1, 0.05));
+    let cols = size.0 as usize;
+    let (inp, out) = (decimate(x, input, xr, cols), decimate(x, output, xr, cols));
+    let dots: Vec<_> = markers
+        .iter()
+        .filter(|m| m.index < x.len() && ok(x[m.index]) && ok(output[m.index]))
+        .map(|m| ((x[m.index], output[m.index]), m.is_max))
+        .collect();
+    render(path, size, |root, s| {
+        let px = |v: f64| (v * s).round() as u32;
+        let (ticks, with_day) = match axis {
+            XAxis::DaysSince(o) => {
+                date_ticks(*o, xr.0, xr.1, (size.0 as usize / 130).clamp(2, 12)).unzip()
+            }
+            XAxis::Numeric(_) => (None, None),
+        };
+        let xfmt: Box<dyn Fn(&f64) -> String> = match (axis, with_day) {
+            (XAxis::DaysSince(o), Some(wd)) => Box::new(move |v| date_label(*o, *v, wd)),
+            _ => Box::new(move |v| tick_label(*v, xr.1 - xr.0)),
+        };
+        let root = root
+            .margin(px(8.0), 0, 0, 0)
+            .titled(title, (FONT, 24.0 * s))?;
+        let (top, root) = root.split_vertically(px(30.0));
+        let x_desc = match axis {
+            XAxis::Numeric(l) => l.as_str(),
+            XAxis::DaysSince(_) => "date",
+        };
+        let ax = TickAxis((xr.0..xr.1).into(), ticks);
+        let mut chart = make_chart(&root, s, ax, yr, (x_desc, y_label), &*xfmt)?;
+        let (thin, thick) = (
+            GREY.stroke_width(px(1.0).max(1)),
+            ORANGE.stroke_width(px(2.5)),
+        );
+        // one path per segment: a thick polyline gets miter spikes at sharp turns
+        chart.draw_series(
+            out.windows(2)
+                .map(|w| PathElement::new(vec![w[0], w[1]], thick)),
+        )?;
+        // the input on top, thin, so that its noise shows over the smooth band
+        chart.draw_series(LineSeries::new(inp, thin))?;
+        let mut legend = vec![(Mark::Line(thin), "input"), (Mark::Line(thick), "smoothed")];
+        for (is_max, colour, name) in [
+            (false, MIN_C, "kept minimum"),
+            (true, MAX_C, "kept maximum"),
+        ] {
+            if dots.iter().any(|d| d.1 == is_max) {
+                let pts = dots.iter().filter(|d| d.1 == is_max);
+                let r = if dots.len() > 100 { px(3.5) } else { px(5.0) };
+                chart.draw_series(pts.map(|d| Circle::new(d.0, r, colour.filled())))?;
+                legend.push((Mark::Dot(colour.filled(), px(5.0)), name));
+            }
+        }
+        draw_legend(&top, &legend, s, Some(px(95.0) as i32))
+    })
 }
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct DiagramPoint {
-    pub birth: f64,
-    pub death: f64,
-    pub is_max: bool,
-    pub kept: bool,
+
+type Area<'a> = DrawingArea<BitMapBackend<'a>, plotters::coord::Shift>;
+type Chart<'a, 'b> = ChartContext<'a, BitMapBackend<'b>, Cartesian2d<TickAxis, RangedCoordf64>>;
+
+/// A chart on `area` with its mesh, axis descriptions `desc` and x tick labels from `xfmt`.
+fn make_chart<'a, 'b>(
+    area: &'a Area<'b>,
+    s: f64,
+    x: TickAxis,
+    (y0, y1): (f64, f64),
+    desc: (&str, &str),
+    xfmt: &dyn Fn(&f64) -> String,
+) -> Result<Chart<'a, 'b>, Box<dyn Error>> {
+    let px = |v: f64| (v * s).round() as u32;
+    let mut chart = ChartBuilder::on(area)
+        .margin(px(10.0))
+        .margin_right(px(40.0))
+        .x_label_area_size(px(55.0))
+        .y_label_area_size(px(85.0))
+        .build_cartesian_2d(x, y0..y1)?;
+    chart
+        .configure_mesh()
+        .x_desc(desc.0)
+        .y_desc(desc.1)
+        .x_label_formatter(xfmt)
+        .y_label_formatter(&|v| tick_label(*v, y1 - y0))
+        .axis_desc_style((FONT, 20.0 * s))
+        .label_style((FONT, 17.0 * s))
+        .bold_line_style(RGBColor(210, 210, 210))
+        .light_line_style(RGBColor(242, 242, 242))
+        .max_light_lines(4)
+        .draw()?;
+    Ok(chart)
 }
+
+/// Formats a plain tick value, printing values within 1e-9 of the axis span from 0 as 0.
+/// Large or tiny magnitudes use scientific notation.
+fn tick_label(v: f64, span: f64) -> String {
+    match v.abs() {
+        a if a < span * 1e-9 => RangedCoordf64::format(&0.0),
+        a if !(1e-4..1e7).contains(&a) => format!("{v:e}"),
+        _ => RangedCoordf64::format(&v),
+    }
+}
+
+/// A legend symbol.
+enum Mark {
+    Line(ShapeStyle),
+    Dot(ShapeStyle, u32),
+    Tri(ShapeStyle, u32),
+    Dash(ShapeStyle),
+}
+
+/// Draws legend entries in a row starting at x = `row` (centred vertically), or in a column.
+fn draw_legend<S: AsRef<str>>(
+    area: &Area<'_>,
+    entries: &[(Mark, S)],
+    s: f64,
+    row: Option<i32>,
+) -> Result<(), Box<dyn Error>> {
+    let px = |v: f64| (v * s).round() as i32;
+    let text =
+        TextStyle::from((FONT, 17.0 * s).into_font()).pos(Pos::new(HPos::Left, VPos::Center));
+    let (mut x, mut y) = match row {
+        Some(x) => (x, area.dim_in_pixel().1 as i32 / 2),
+        None => (px(5.0), px(40.0)),
+    };
+    for (mark, label) in entries {
+        let (w, c) = (px(25.0), x + px(12.0));
+        match mark {
+            Mark::Line(st) => area.draw(&PathElement::new([(x, y), (x + w, y)], *st))?,
+            Mark::Dot(st, r) => area.draw(&Circle::new((c, y), *r, *st))?,
+            Mark::Tri(st, r) => area.draw(&TriangleMarker::new((c, y), *r, *st))?,
+            Mark::Dash(st) => area.draw(&DashedPathElement::new(
+                [(x, y), (x + w, y)],
+                px(6.0),
+                px(4.0),
+                *st,
+            ))?,
+        }
+        area.draw(&Text::new(label.as_ref(), (x + px(35.0), y), text.clone()))?;
+        match row {
+            Some(_) => x += px(65.0) + area.estimate_text_size(label.as_ref(), &text)?.0 as i32,
+            None => y += px(30.0),
+        }
+    }
+    Ok(())
+}
+
+/// Plots a persistence diagram: minima pairs blue, maxima pairs red, kept ones filled and larger,
+/// cancelled ones hollow and smaller, the diagonal in grey and, for `Some(t)`, dashed lines at
+/// |death − birth| = t. Essential points (infinite death) are drawn as triangles at the top edge
+/// (bottom edge for −∞), 5% of the range beyond the finite values. The legend sits on the right.
+/// Points with a non-finite birth or NaN death are skipped; an empty diagram is still drawn.
 pub fn plot_persistence_diagram(
-    path: &std::path::Path,
+    path: &Path,
     points: &[DiagramPoint],
     threshold: Option<f64>,
     title: &str,
     size: (u32, u32),
 ) -> Result<(), PlotError> {
-    Err(PlotError("plotting not built yet".into()))
+    let pts: Vec<_> = points
+        .iter()
+        .filter(|p| ok(p.birth) && (ok(p.death) || p.death.is_infinite()))
+        .collect();
+    let (lo, hi) = min_max(pts.iter().flat_map(|p| [p.birth, p.death]));
+    let (lo, hi) = nice_range(lo, hi, 0.0);
+    let r = hi - lo;
+    let (a, b) = (lo - 0.08 * r, hi + 0.08 * r);
+    let level = |d: f64| {
+        if ok(d) {
+            d
+        } else if d > 0.0 {
+            hi + 0.05 * r
+        } else {
+            lo - 0.05 * r
+        }
+    };
+    render(path, size, |root, s| {
+        let px = |v: f64| (v * s).round() as u32;
+        let root = root
+            .margin(px(8.0), 0, 0, 0)
+            .titled(title, (FONT, 24.0 * s))?;
+        let (plot, panel) = root.split_horizontally(size.0 - px(250.0).min(size.0 / 2));
+        let fmt = |v: &f64| tick_label(*v, b - a);
+        let ax = TickAxis((a..b).into(), None);
+        let mut chart = make_chart(&plot, s, ax, (a, b), ("birth", "death"), &fmt)?;
+        chart.draw_series(LineSeries::new(
+            [(a, a), (b, b)],
+            GREY.stroke_width(px(1.5)),
+        ))?;
+        let mut legend = Vec::new();
+        let dash = RGBColor(110, 110, 110).stroke_width(px(1.5));
+        if let Some(t) = threshold.filter(|&t| ok(t) && t > 0.0) {
+            for c in [t, -t] {
+                let (x0, x1) = (a.max(a - c), b.min(b - c));
+                if x0 < x1 {
+                    chart.draw_series(DashedLineSeries::new(
+                        [(x0, x0 + c), (x1, x1 + c)],
+                        px(8.0),
+                        px(6.0),
+                        dash,
+                    ))?;
+                }
+            }
+            legend.push((Mark::Dash(dash), format!("|death − birth| = {}", t as f32)));
+        }
+        if pts.iter().any(|p| !ok(p.death)) {
+            let y = level(f64::INFINITY);
+            chart.draw_series(DashedLineSeries::new(
+                [(a, y), (b, y)],
+                px(2.0),
+                px(5.0),
+                GREY.stroke_width(1),
+            ))?;
+            legend.push((
+                Mark::Tri(BLACK.stroke_width(px(1.5)), px(7.0)),
+                "essential (death = ∞)".into(),
+            ));
+        }
+        for (is_max, kept) in [(false, true), (false, false), (true, true), (true, false)] {
+            let sel: Vec<&DiagramPoint> = pts
+                .iter()
+                .copied()
+                .filter(|p| p.is_max == is_max && p.kept == kept)
+                .collect();
+            if sel.is_empty() {
+                continue;
+            }
+            let colour = if is_max { MAX_C } else { MIN_C };
+            let (style, rad) = if kept {
+                (colour.filled(), px(5.0))
+            } else {
+                (colour.stroke_width(px(1.5)), px(3.5))
+            };
+            let (fin, ess): (Vec<&DiagramPoint>, Vec<_>) =
+                sel.into_iter().partition(|p| ok(p.death));
+            chart.draw_series(
+                fin.iter()
+                    .map(|p| Circle::new((p.birth, p.death), rad, style)),
+            )?;
+            chart
+                .draw_series(ess.iter().map(|p| {
+                    TriangleMarker::new((p.birth, level(p.death)), rad + px(2.0), style)
+                }))?;
+            let name = format!(
+                "{} {} pair",
+                if kept { "kept" } else { "cancelled" },
+                if is_max { "maximum" } else { "minimum" }
+            );
+            legend.push((Mark::Dot(style, rad), name));
+        }
+        draw_legend(&panel, &legend, s, None)
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn tmp(name: &str) -> std::path::PathBuf {
+        std::env::temp_dir().join(format!("toposmooth_plot_{}_{name}.png", std::process::id()))
+    }
+
+    /// Asserts that `path` holds a PNG (signature and IHDR of the given size), then removes it.
+    fn check_png(path: &Path, (w, h): (u32, u32)) {
+        let bytes = std::fs::read(path).expect("PNG written");
+        std::fs::remove_file(path).ok();
+        assert_eq!(&bytes[..8], b"\x89PNG\r\n\x1a\n");
+        assert_eq!(&bytes[12..16], b"IHDR");
+        assert_eq!(
+            bytes[16..24],
+            [w.to_be_bytes(), h.to_be_bytes()].concat()[..]
+        );
+    }
+
+    fn series(
+        name: &str,
+        x: &[f64],
+        axis: &XAxis,
+        y: &[f64],
+        markers: &[Marker],
+        size: (u32, u32),
+    ) -> Result<(), PlotError> {
+        let path = tmp(name);
+        plot_series(&path, x, axis, "y", y, y, markers, name, size)?;
+        check_png(&path, size);
+        Ok(())
+    }
+
+    #[test]
+    fn series_plots() {
+        let x: Vec<f64> = (0..20_000).map(|i| i as f64 * 0.01).collect();
+        let y: Vec<f64> = x.iter().map(|t| t.sin()).collect();
+        let m = [
+            Marker {
+                index: 157,
+                is_max: true,
+            },
+            Marker {
+                index: 471,
+                is_max: false,
+            },
+            Marker {
+                index: 10_000_000,
+                is_max: true,
+            },
+        ];
+        series(
+            "numeric",
+            &x,
+            &XAxis::Numeric("x".into()),
+            &y,
+            &m,
+            (1200, 600),
+        )
+        .unwrap();
+        let d = XAxis::DaysSince(NaiveDate::from_ymd_opt(2000, 1, 1).unwrap());
+        series("dates", &x, &d, &y, &m, (800, 400)).unwrap();
+        series(
+            "constant",
+            &[1.0, 2.0, 3.0],
+            &d,
+            &[5.0; 3],
+            &[],
+            (1200, 600),
+        )
+        .unwrap();
+        series(
+            "single",
+            &[4.0],
+            &XAxis::Numeric("x".into()),
+            &[-0.0],
+            &[],
+            (100, 100),
+        )
+        .unwrap();
+        series(
+            "nan",
+            &[0.0, f64::NAN, 2.0, 3.0],
+            &d,
+            &[1.0, 2.0, f64::INFINITY, f64::NAN],
+            &[],
+            (300, 200),
+        )
+        .unwrap();
+        series(
+            "huge",
+            &[-1e300, 1e300, 0.0, 1e308],
+            &d,
+            &[1e300, -1e300, 0.0, 1.0],
+            &[],
+            (300, 200),
+        )
+        .unwrap();
+        series(
+            "unsorted",
+            &[3.0, 1.0, 2.0, -5.0],
+            &d,
+            &[1.0, 2.0, 3.0, 4.0],
+            &[],
+            (300, 200),
+        )
+        .unwrap();
+    }
+
+    #[test]
+    fn series_errors() {
+        let p = tmp("err");
+        let a = XAxis::Numeric("x".into());
+        assert!(plot_series(&p, &[], &a, "y", &[], &[], &[], "t", (600, 300)).is_err());
+        assert!(plot_series(
+            &p,
+            &[1.0, 2.0],
+            &a,
+            "y",
+            &[1.0],
+            &[1.0, 2.0],
+            &[],
+            "t",
+            (600, 300)
+        )
+        .is_err());
+        assert!(plot_series(
+            &p,
+            &[f64::NAN],
+            &a,
+            "y",
+            &[1.0],
+            &[1.0],
+            &[],
+            "t",
+            (600, 300)
+        )
+        .is_err());
+        assert!(plot_series(&p, &[1.0], &a, "y", &[1.0], &[1.0], &[], "t", (0, 300)).is_err());
+        let bad = Path::new("/nonexistent_dir_toposmooth/x.png");
+        let e =
+            plot_series(bad, &[1.0], &a, "y", &[1.0], &[1.0], &[], "t", (600, 300)).unwrap_err();
+        assert!(e.0.contains("nonexistent_dir_toposmooth"), "{e}");
+        assert!(!p.exists());
+    }
+
+    #[test]
+    fn diagrams() {
+        let pt = |birth, death, is_max, kept| DiagramPoint {
+            birth,
+            death,
+            is_max,
+            kept,
+        };
+        let pts = [
+            pt(0.0, 1.0, false, true),
+            pt(2.0, 0.5, true, false),
+            pt(-1.0, f64::INFINITY, false, true),
+            pt(f64::NAN, 1.0, true, true),
+        ];
+        for (name, pts, t) in [
+            ("diag", &pts[..], Some(0.6)),
+            ("diag_empty", &[], None),
+            ("diag_essential_only", &pts[2..3], Some(f64::NAN)),
+            (
+                "diag_huge",
+                &[
+                    pt(-1e300, 1e300, false, true),
+                    pt(1e300, f64::NEG_INFINITY, true, true),
+                    pt(1e308, 1.0, true, true),
+                ],
+                Some(1e300),
+            ),
+        ] {
+            let path = tmp(name);
+            plot_persistence_diagram(&path, pts, t, name, (700, 600)).unwrap();
+            check_png(&path, (700, 600));
+        }
+    }
+
+    #[test]
+    fn dates() {
+        let o = NaiveDate::from_ymd_opt(2000, 1, 1).unwrap();
+        assert_eq!(date_label(o, 0.0, true), "2000-01-01");
+        assert_eq!(date_label(o, 31.2, true), "2000-02-01");
+        assert_eq!(date_label(o, -1.0, false), "1999-12");
+        assert_eq!(date_label(o, 1e300, false), "1e300");
+        assert_eq!(
+            (
+                tick_label(1e-20, 1.0),
+                tick_label(2e7, 1e8),
+                tick_label(0.5, 1.0)
+            ),
+            ("0.0".into(), "2e7".into(), "0.5".into())
+        );
+        let (t, with_day) = date_ticks(o, 0.0, 10.0, 6).unwrap();
+        assert!(with_day && t == [0.0, 2.0, 4.0, 6.0, 8.0, 10.0]);
+        let (t, with_day) = date_ticks(o, 0.0, 3653.0, 6).unwrap(); // 2000-01-01 .. 2010-01-01
+        assert!(!with_day && t.len() == 6 && t[0] == 0.0);
+        assert_eq!(date_label(o, t[1], false), "2002-01");
+        assert!(date_ticks(o, 0.0, 1e12, 6).is_none());
+    }
+
+    #[test]
+    fn decimation_keeps_spikes() {
+        let x: Vec<f64> = (0..100_000).map(|i| i as f64).collect();
+        let mut y = vec![0.0; x.len()];
+        y[54_321] = 9.0;
+        let d = decimate(&x, &y, (0.0, 99_999.0), 100);
+        assert!(d.len() <= 200 && d.iter().any(|p| p.1 == 9.0));
+    }
 }

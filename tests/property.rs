@@ -122,8 +122,7 @@ proptest! {
         let sos_less = |a: usize, b: usize| (h[a], a) < (h[b], b);
         let mut minima = vec![];
         let mut maxima = vec![];
-        for v in 0..h.len() {
-            if !picks[v] { continue; }
+        for (v, _) in picks.iter().enumerate().take(h.len()).filter(|p| *p.1) {
             if series.neighbors(v).all(|w| sos_less(v, w)) { minima.push(v); }
             else if series.neighbors(v).all(|w| sos_less(w, v)) { maxima.push(v); }
         }

@@ -217,8 +217,8 @@ pub fn solve(
     // starting point: slacks of x (shifted to be positive), unit multipliers, then balanced
     let mut s = vec![0.0; m];
     ax(&x, &mut s);
-    for k in 0..m {
-        s[k] = r.b[k] - s[k];
+    for (sk, bk) in s.iter_mut().zip(&r.b) {
+        *sk = bk - *sk;
     }
     let mut z = vec![1.0; m];
     let smin = s.iter().cloned().fold(f64::INFINITY, f64::min);

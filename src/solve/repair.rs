@@ -29,7 +29,14 @@ pub fn repair(
     delta: f64,
 ) -> RepairSummary {
     let n = f.len();
-    let violated = |f: &[f64]| edges.iter().filter(|&&(i, j)| !(f[j] > f[i])).count();
+    // `strictly_below(a, b)` is false for NaN too, so NaN counts as a violation
+    let strictly_below = |a: f64, b: f64| a.partial_cmp(&b) == Some(std::cmp::Ordering::Less);
+    let violated = |f: &[f64]| {
+        edges
+            .iter()
+            .filter(|&&(i, j)| !strictly_below(f[i], f[j]))
+            .count()
+    };
     let mut summary = RepairSummary {
         violated_edges: violated(f),
         ..Default::default()
@@ -53,7 +60,7 @@ pub fn repair(
                 continue;
             }
             if let Some(lo) = preds[v].iter().map(|&p| f[p]).reduce(f64::max) {
-                if !(f[v] > lo) {
+                if !strictly_below(lo, f[v]) {
                     f[v] = above(lo);
                 }
             }
@@ -63,7 +70,7 @@ pub fn repair(
                 continue;
             }
             if let Some(hi) = succs[v].iter().map(|&s| f[s]).reduce(f64::min) {
-                if !(f[v] < hi) {
+                if !strictly_below(f[v], hi) {
                     f[v] = below(hi);
                 }
             }

@@ -172,76 +172,75 @@ pub fn select<D: Domain>(domain: &D, values: &[f64], selection: &Selection) -> R
     let mut warnings = Vec::new();
     let mut threshold = None;
     let minima_pairs = sublevel_pairs(domain, values);
-    let (kept_min, kept_max): (Vec<(usize, Option<f64>)>, Vec<(usize, Option<f64>)>) =
-        match selection {
-            Selection::Explicit { minima, maxima } => {
-                check_explicit(domain, values, minima, maxima)?;
-                let pers_min = |v: usize| {
-                    minima_pairs
-                        .iter()
-                        .find(|p| p.extremum == v)
-                        .map(|p| p.persistence)
-                };
-                (
-                    minima.iter().map(|&v| (v, pers_min(v))).collect(),
-                    maxima.iter().map(|&v| (v, None)).collect(),
-                )
-            }
-            Selection::Absolute(t) | Selection::Relative(t) => {
-                if !(t.is_finite() && *t > 0.0) {
-                    return Err(Error::Usage(format!(
-                        "the persistence threshold must be > 0, got {t}"
-                    )));
-                }
-                let t = if matches!(selection, Selection::Relative(_)) {
-                    t * (hi - lo)
-                } else {
-                    *t
-                };
-                threshold = Some(t);
-                match domain.pairing_rule() {
-                    PairingRule::Path => {
-                        path_by_rank(values, &minima_pairs, |p| p.persistence >= t, usize::MAX)
-                    }
-                    PairingRule::Surface => {
-                        let maxima_pairs = superlevel_pairs(domain, values);
-                        (
-                            by_threshold(&minima_pairs, t),
-                            by_threshold(&maxima_pairs, t),
-                        )
-                    }
-                }
-            }
-            Selection::Pairs(count) => {
-                if domain.pairing_rule() != PairingRule::Path {
-                    return Err(Error::Usage(
-                        "--pairs applies to series; use --minima/--maxima".into(),
-                    ));
-                }
-                let available = minima_pairs
+    let (kept_min, kept_max): (Kept, Kept) = match selection {
+        Selection::Explicit { minima, maxima } => {
+            check_explicit(domain, values, minima, maxima)?;
+            let pers_min = |v: usize| {
+                minima_pairs
                     .iter()
-                    .filter(|p| p.partner.is_some() && p.persistence > 0.0)
-                    .count();
-                if *count > available {
-                    warnings.push(format!(
-                        "asked for {count} pairs, the series has {available}: keeping all"
-                    ));
-                }
-                path_by_rank(values, &minima_pairs, |p| p.persistence > 0.0, *count)
+                    .find(|p| p.extremum == v)
+                    .map(|p| p.persistence)
+            };
+            (
+                minima.iter().map(|&v| (v, pers_min(v))).collect(),
+                maxima.iter().map(|&v| (v, None)).collect(),
+            )
+        }
+        Selection::Absolute(t) | Selection::Relative(t) => {
+            if !(t.is_finite() && *t > 0.0) {
+                return Err(Error::Usage(format!(
+                    "the persistence threshold must be > 0, got {t}"
+                )));
             }
-            Selection::Count { minima, maxima } => {
-                if domain.pairing_rule() == PairingRule::Path {
-                    return Err(Error::Usage(
-                        "on a series a count means pairs: use --pairs N".into(),
-                    ));
+            let t = if matches!(selection, Selection::Relative(_)) {
+                t * (hi - lo)
+            } else {
+                *t
+            };
+            threshold = Some(t);
+            match domain.pairing_rule() {
+                PairingRule::Path => {
+                    path_by_rank(values, &minima_pairs, |p| p.persistence >= t, usize::MAX)
                 }
-                let maxima_pairs = superlevel_pairs(domain, values);
-                let (a, w1) = by_count(values, &minima_pairs, *minima, true);
-                let (b, w2) = by_count(values, &maxima_pairs, *maxima, false);
-                warnings.extend(w1.into_iter().chain(w2));
-                (a, b)
+                PairingRule::Surface => {
+                    let maxima_pairs = superlevel_pairs(domain, values);
+                    (
+                        by_threshold(&minima_pairs, t),
+                        by_threshold(&maxima_pairs, t),
+                    )
+                }
             }
-        };
+        }
+        Selection::Pairs(count) => {
+            if domain.pairing_rule() != PairingRule::Path {
+                return Err(Error::Usage(
+                    "--pairs applies to series; use --minima/--maxima".into(),
+                ));
+            }
+            let available = minima_pairs
+                .iter()
+                .filter(|p| p.partner.is_some() && p.persistence > 0.0)
+                .count();
+            if *count > available {
+                warnings.push(format!(
+                    "asked for {count} pairs, the series has {available}: keeping all"
+                ));
+            }
+            path_by_rank(values, &minima_pairs, |p| p.persistence > 0.0, *count)
+        }
+        Selection::Count { minima, maxima } => {
+            if domain.pairing_rule() == PairingRule::Path {
+                return Err(Error::Usage(
+                    "on a series a count means pairs: use --pairs N".into(),
+                ));
+            }
+            let maxima_pairs = superlevel_pairs(domain, values);
+            let (a, w1) = by_count(values, &minima_pairs, *minima, true);
+            let (b, w2) = by_count(values, &maxima_pairs, *maxima, false);
+            warnings.extend(w1.into_iter().chain(w2));
+            (a, b)
+        }
+    };
 
     let mut roles = vec![Role::Other; n];
     let mut kept = Vec::new();

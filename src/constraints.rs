@@ -31,12 +31,7 @@ pub enum EdgeSet {
 }
 
 /// Constrained edges `(i, j)` meaning `f_j − f_i ≥ ε`, sorted and without duplicates.
-pub fn constraint_edges<D: Domain>(
-    domain: &D,
-    u: &[f64],
-    fixed: &[Option<f64>],
-    set: EdgeSet,
-) -> Vec<(usize, usize)> {
+pub fn constraint_edges<D: Domain>(domain: &D, u: &[f64], fixed: &[Option<f64>], set: EdgeSet) -> Vec<(usize, usize)> {
     let n = domain.n_vertices();
     let orient = |a: usize, b: usize| if sos_less(u, a, b) { (a, b) } else { (b, a) };
     let mut edges = Vec::new();
@@ -87,12 +82,7 @@ pub fn constraint_edges<D: Domain>(
 /// # Errors
 /// Infeasible if even ε = 0 is infeasible: an edge path runs from a fixed value down to a
 /// smaller one (u disagrees with the fixed values).
-pub fn max_margin(
-    u: &[f64],
-    edges: &[(usize, usize)],
-    fixed: &[Option<f64>],
-    cap: Option<f64>,
-) -> Result<f64> {
+pub fn max_margin(u: &[f64], edges: &[(usize, usize)], fixed: &[Option<f64>], cap: Option<f64>) -> Result<f64> {
     let n = u.len();
     let order = sos_sort(u);
     // out-edges in compressed form
@@ -136,12 +126,8 @@ pub fn max_margin(
             "the constraint graph runs from a fixed value down to the smaller fixed value at vertex {w}"
         )));
     }
-    let (fmin, fmax) = fixed
-        .iter()
-        .flatten()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
-            (a.min(v), b.max(v))
-        });
+    let (fmin, fmax) =
+        fixed.iter().flatten().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| (a.min(v), b.max(v)));
     let span = if fmax > fmin { fmax - fmin } else { 1.0 };
     // the usual case: the cap of `choose_margin` is feasible twice over; one pass decides
     if let Some(cap) = cap.filter(|&c| c < span) {
@@ -152,11 +138,7 @@ pub fn max_margin(
     if violated(span).is_none() {
         // a path of one edge between fixed values already allows the whole span: no bound
         // short of it matters; report +inf when no fixed pair is linked at all
-        return Ok(if violated(2.0 * span + 1.0).is_none() {
-            f64::INFINITY
-        } else {
-            span
-        });
+        return Ok(if violated(2.0 * span + 1.0).is_none() { f64::INFINITY } else { span });
     }
     let (mut ok, mut bad) = (0.0, span);
     while bad - ok > 1e-12 * span {

@@ -78,18 +78,12 @@ fn prefix(path: &Option<PathBuf>) -> String {
 impl Error {
     /// An input error without a file (the caller attaches one with [`Error::in_file`]).
     pub fn input(message: impl Into<String>) -> Self {
-        Error::Input {
-            path: None,
-            message: message.into(),
-        }
+        Error::Input { path: None, message: message.into() }
     }
 
     /// An infeasibility error without a file.
     pub fn infeasible(message: impl Into<String>) -> Self {
-        Error::Infeasible {
-            path: None,
-            message: message.into(),
-        }
+        Error::Infeasible { path: None, message: message.into() }
     }
 
     /// Attaches `file` to an error that does not name one yet.

@@ -88,10 +88,7 @@ struct CsvArgs {
 
 impl CsvArgs {
     fn options(&self) -> SeriesCsvOptions {
-        SeriesCsvOptions {
-            column: self.column.clone(),
-            x_column: self.x_column.clone(),
-        }
+        SeriesCsvOptions { column: self.column.clone(), x_column: self.x_column.clone() }
     }
 }
 
@@ -179,10 +176,9 @@ fn smooth_args(c: SmoothCli) -> Result<SmoothArgs> {
     let selection = match (&c.persistence, c.pairs, &c.keep_min, &c.keep_max) {
         (Some(p), _, _, _) => commands::parse_persistence(p)?,
         (None, Some(n), _, _) => Selection::Pairs(n),
-        (None, None, Some(mn), Some(mx)) => Selection::Explicit {
-            minima: commands::parse_indices(mn)?,
-            maxima: commands::parse_indices(mx)?,
-        },
+        (None, None, Some(mn), Some(mx)) => {
+            Selection::Explicit { minima: commands::parse_indices(mn)?, maxima: commands::parse_indices(mx)? }
+        }
         _ => commands::parse_persistence("5%")?,
     };
     let mut energy = Energy::parse(&c.order)?;
@@ -196,31 +192,14 @@ fn smooth_args(c: SmoothCli) -> Result<SmoothArgs> {
         smooth_weight: c.smooth_weight,
         smooth_length: c.smooth_length,
         edges: edge_set(c.edges),
-        qp: QpSettings {
-            max_iter: c.max_iter,
-            method: method(c.solver),
-            ..Default::default()
-        },
+        qp: QpSettings { max_iter: c.max_iter, method: method(c.solver), ..Default::default() },
     };
-    Ok(SmoothArgs {
-        input: c.input,
-        csv: c.csv.options(),
-        output: c.output,
-        settings,
-        plot: c.plot,
-        report: c.report,
-    })
+    Ok(SmoothArgs { input: c.input, csv: c.csv.options(), output: c.output, settings, plot: c.plot, report: c.report })
 }
 
 fn run(cli: Cli) -> Result<String> {
     match cli.command {
-        Command::Extrema {
-            input,
-            csv,
-            json,
-            plot,
-            persistence,
-        } => commands::extrema(&ExtremaArgs {
+        Command::Extrema { input, csv, json, plot, persistence } => commands::extrema(&ExtremaArgs {
             input,
             csv: csv.options(),
             json,
@@ -228,27 +207,11 @@ fn run(cli: Cli) -> Result<String> {
             selection: commands::parse_persistence(&persistence)?,
         }),
         Command::Smooth(c) => commands::smooth(&smooth_args(c)?),
-        Command::Verify { file, input, csv } => commands::verify(&VerifyArgs {
-            file,
-            input,
-            csv: csv.options(),
-        }),
-        Command::Bench {
-            sizes,
-            order,
-            persistence,
-            edges,
-            seed,
-            single,
-            solver,
-        } => {
+        Command::Verify { file, input, csv } => commands::verify(&VerifyArgs { file, input, csv: csv.options() }),
+        Command::Bench { sizes, order, persistence, edges, seed, single, solver } => {
             let persistence = match commands::parse_persistence(&persistence)? {
                 Selection::Relative(r) => r,
-                _ => {
-                    return Err(Error::Usage(
-                        "bench takes --persistence as a percentage".into(),
-                    ))
-                }
+                _ => return Err(Error::Usage("bench takes --persistence as a percentage".into())),
             };
             commands::bench(&BenchArgs {
                 sizes,

@@ -15,13 +15,10 @@ use crate::constraints::{choose_margin, constraint_edges, max_margin, EdgeSet, M
 use crate::domain::{sos_sort, Domain, Series};
 use crate::error::{Error, Result};
 use crate::operators::{
-    polyharmonic, quadratic_form, scaled_plus_diagonal, series_mass, series_stiffness, Energy,
-    Sparse,
+    polyharmonic, quadratic_form, scaled_plus_diagonal, series_mass, series_stiffness, Energy, Sparse,
 };
 use crate::representative::series_representative;
-use crate::solve::{
-    repair, solve_monotone_qp, Method, MonotoneQp, QpSettings, RepairSummary, SolveStatus,
-};
+use crate::solve::{repair, solve_monotone_qp, Method, MonotoneQp, QpSettings, RepairSummary, SolveStatus};
 use crate::topology::{count_sos_extrema, select, KeptExtremum, KeptSet, Role, Selection};
 use crate::verify::{certify, Certificate};
 use std::time::Instant;
@@ -86,23 +83,15 @@ impl SmoothSettings {
     pub fn validate(&self) -> Result<()> {
         self.energy.validate()?;
         if !(self.data_weight.is_finite() && self.data_weight >= 0.0) {
-            return Err(Error::Usage(format!(
-                "--data-weight must be finite and ≥ 0, got {}",
-                self.data_weight
-            )));
+            return Err(Error::Usage(format!("--data-weight must be finite and ≥ 0, got {}", self.data_weight)));
         }
         if let Some(w) = self.smooth_weight {
             if !(w.is_finite() && w > 0.0) {
-                return Err(Error::Usage(format!(
-                    "--smooth-weight must be finite and > 0, got {w}"
-                )));
+                return Err(Error::Usage(format!("--smooth-weight must be finite and > 0, got {w}")));
             }
         }
         if !(self.smooth_length.is_finite() && self.smooth_length > 0.0) {
-            return Err(Error::Usage(format!(
-                "--smooth-length must be finite and > 0, got {}",
-                self.smooth_length
-            )));
+            return Err(Error::Usage(format!("--smooth-length must be finite and > 0, got {}", self.smooth_length)));
         }
         Ok(())
     }
@@ -216,15 +205,10 @@ pub fn smooth<D: Smoothable>(domain: &D, h: &[f64], settings: &SmoothSettings) -
     settings.validate()?;
     let n = domain.n_vertices();
     if h.len() != n {
-        return Err(Error::input(format!(
-            "the field has {} values, the domain {n} vertices",
-            h.len()
-        )));
+        return Err(Error::input(format!("the field has {} values, the domain {n} vertices", h.len())));
     }
     if let Some(&v) = settings.energy.sharp.iter().find(|&&v| v >= n) {
-        return Err(Error::Usage(format!(
-            "sharp vertex {v} is out of range (the input has {n} vertices)"
-        )));
+        return Err(Error::Usage(format!("sharp vertex {v} is out of range (the input has {n} vertices)")));
     }
     let mut seconds = StageSeconds::default();
 
@@ -237,20 +221,13 @@ pub fn smooth<D: Smoothable>(domain: &D, h: &[f64], settings: &SmoothSettings) -
     let u = domain.representative(h, &kept)?;
     let representative_certificate = certify(domain, &u, &kept.roles, None);
     if !representative_certificate.passed {
-        return Err(Error::Representative {
-            path: None,
-            message: representative_certificate.summary(),
-        });
+        return Err(Error::Representative { path: None, message: representative_certificate.summary() });
     }
     seconds.representative = t.elapsed().as_secs_f64();
 
     // work in units where the field spans [0, 1]
     let t = Instant::now();
-    let (lo, hi) = h
-        .iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
-            (a.min(v), b.max(v))
-        });
+    let (lo, hi) = h.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| (a.min(v), b.max(v)));
     let range = hi - lo;
     let z: Vec<f64> = h.iter().map(|v| (v - lo) / range).collect();
     let k = domain.stiffness();
@@ -270,9 +247,7 @@ pub fn smooth<D: Smoothable>(domain: &D, h: &[f64], settings: &SmoothSettings) -
     seconds.operators = t.elapsed().as_secs_f64();
 
     let t = Instant::now();
-    let fixed: Vec<Option<f64>> = (0..n)
-        .map(|i| kept.roles[i].is_fixed().then_some(z[i]))
-        .collect();
+    let fixed: Vec<Option<f64>> = (0..n).map(|i| kept.roles[i].is_fixed().then_some(z[i])).collect();
     let edges = constraint_edges(domain, &u, &fixed, settings.edges);
     check_fixed_neighbours(domain, h, &kept.roles)?;
     let eps_max = max_margin(&u, &edges, &fixed, Some(MARGIN_CAP))?;
@@ -283,14 +258,7 @@ pub fn smooth<D: Smoothable>(domain: &D, h: &[f64], settings: &SmoothSettings) -
 
     let t = Instant::now();
     let hint: Vec<f64> = u.iter().map(|v| (v - lo) / range).collect();
-    let qp = MonotoneQp {
-        p: &p,
-        q: &q,
-        fixed: &fixed,
-        edges: &edges,
-        margin: eps,
-        hint: Some(&hint),
-    };
+    let qp = MonotoneQp { p: &p, q: &q, fixed: &fixed, edges: &edges, margin: eps, hint: Some(&hint) };
     let sol = solve_monotone_qp(&qp, &settings.qp)?;
     seconds.solve = t.elapsed().as_secs_f64();
 
@@ -342,11 +310,7 @@ pub fn smooth<D: Smoothable>(domain: &D, h: &[f64], settings: &SmoothSettings) -
         kept: kept.kept.clone(),
         warnings: kept.warnings.clone(),
         seconds,
-        energy: EnergyReport {
-            smoothness,
-            data,
-            total: smoothness + data,
-        },
+        energy: EnergyReport { smoothness, data, total: smoothness + data },
         rms_deviation: (sq / n as f64).sqrt(),
         max_deviation,
         solver_status: sol.status,
@@ -357,12 +321,7 @@ pub fn smooth<D: Smoothable>(domain: &D, h: &[f64], settings: &SmoothSettings) -
         representative_certificate,
         certificate,
     };
-    Ok(Smoothed {
-        output: f,
-        u,
-        roles: kept.roles,
-        report,
-    })
+    Ok(Smoothed { output: f, u, roles: kept.roles, report })
 }
 
 /// Two adjacent fixed vertices of different roles must differ in value (SPEC.md).

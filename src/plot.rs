@@ -59,11 +59,9 @@ const MAX_C: RGBColor = RGBColor(210, 20, 20);
 /// Registers DejaVu Sans as "sans-serif" once; plotters' `ab_glyph` text needs it.
 fn ensure_font() -> Result<(), PlotError> {
     static OK: OnceLock<bool> = OnceLock::new();
-    let ok = OK.get_or_init(|| {
-        plotters::style::register_font(FONT, FontStyle::Normal, dejavu::sans::regular()).is_ok()
-    });
-    ok.then_some(())
-        .ok_or_else(|| PlotError("cannot register the DejaVu Sans font".into()))
+    let ok =
+        OK.get_or_init(|| plotters::style::register_font(FONT, FontStyle::Normal, dejavu::sans::regular()).is_ok());
+    ok.then_some(()).ok_or_else(|| PlotError("cannot register the DejaVu Sans font".into()))
 }
 
 /// Validates the size, draws with `draw` on a white RGB canvas and writes it as PNG to `path`.
@@ -84,15 +82,8 @@ where
         draw(&root, scale).map_err(|e| fail(&e))?;
         root.present().map_err(|e| fail(&e))?;
     }
-    image::save_buffer_with_format(
-        path,
-        &buf,
-        w,
-        h,
-        image::ExtendedColorType::Rgb8,
-        image::ImageFormat::Png,
-    )
-    .map_err(|e| fail(&e))
+    image::save_buffer_with_format(path, &buf, w, h, image::ExtendedColorType::Rgb8, image::ImageFormat::Png)
+        .map_err(|e| fail(&e))
 }
 
 /// A non-degenerate range around `lo..hi` (NaN or infinite bounds give 0..1), widened by `pad` each side.
@@ -101,11 +92,7 @@ fn nice_range(lo: f64, hi: f64, pad: f64) -> (f64, f64) {
         return (0.0, 1.0);
     }
     let (mid, half) = (lo / 2.0 + hi / 2.0, hi / 2.0 - lo / 2.0);
-    let half = if half > mid.abs() * 1e-9 {
-        half * (1.0 + 2.0 * pad)
-    } else {
-        mid.abs().max(1.0) * 0.05
-    };
+    let half = if half > mid.abs() * 1e-9 { half * (1.0 + 2.0 * pad) } else { mid.abs().max(1.0) * 0.05 };
     (mid - half, mid + half)
 }
 
@@ -115,20 +102,12 @@ fn ok(v: f64) -> bool {
 }
 
 fn min_max(v: impl Iterator<Item = f64>) -> (f64, f64) {
-    v.filter(|&a| ok(a))
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
-            (a.min(v), b.max(v))
-        })
+    v.filter(|&a| ok(a)).fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| (a.min(v), b.max(v)))
 }
 
 /// Finite `(x, y)` pairs; with more than 4 points per column, keeps each column bucket's min and max.
 fn decimate(x: &[f64], y: &[f64], (lo, hi): (f64, f64), cols: usize) -> Vec<(f64, f64)> {
-    let pts: Vec<(f64, f64)> = x
-        .iter()
-        .zip(y)
-        .map(|(&a, &b)| (a, b))
-        .filter(|&(a, b)| ok(a) && ok(b))
-        .collect();
+    let pts: Vec<(f64, f64)> = x.iter().zip(y).map(|(&a, &b)| (a, b)).filter(|&(a, b)| ok(a) && ok(b)).collect();
     if pts.len() <= 4 * cols {
         return pts;
     }
@@ -202,26 +181,17 @@ fn date_label(origin: NaiveDate, days: f64, with_day: bool) -> String {
 fn date_ticks(origin: NaiveDate, lo: f64, hi: f64, max: usize) -> Option<(Vec<f64>, bool)> {
     let day = |d: f64| origin.checked_add_signed(TimeDelta::try_days(d.floor() as i64)?);
     let (a, b, max) = (day(lo)?, day(hi)?, max.max(2) as f64);
-    if let Some(&s) = [1.0, 2.0, 7.0, 14.0]
-        .iter()
-        .find(|&&s| (hi - lo) / s <= max)
-    {
+    if let Some(&s) = [1.0, 2.0, 7.0, 14.0].iter().find(|&&s| (hi - lo) / s <= max) {
         let ticks = ((lo / s).ceil() as i64..=(hi / s).floor() as i64).map(|k| k as f64 * s);
         return Some((ticks.collect(), true));
     }
     let month = |d: NaiveDate| d.year() as i64 * 12 + d.month0() as i64;
     let (ma, mb) = (month(a), month(b) + 1);
-    let mut steps = [1, 2, 3, 6]
-        .into_iter()
-        .chain((0..8).flat_map(|e| [12, 24, 60].map(|s| s * 10i64.pow(e))));
+    let mut steps = [1, 2, 3, 6].into_iter().chain((0..8).flat_map(|e| [12, 24, 60].map(|s| s * 10i64.pow(e))));
     let step = steps.find(|&s| ((mb - ma) / s) as f64 <= max)?;
     let ticks = (ma.div_euclid(step)..=mb.div_euclid(step)).filter_map(|k| {
         let m = k * step;
-        let d = NaiveDate::from_ymd_opt(
-            i32::try_from(m.div_euclid(12)).ok()?,
-            m.rem_euclid(12) as u32 + 1,
-            1,
-        )?;
+        let d = NaiveDate::from_ymd_opt(i32::try_from(m.div_euclid(12)).ok()?, m.rem_euclid(12) as u32 + 1, 1)?;
         Some((d - origin).num_days() as f64).filter(|t| (lo..=hi).contains(t))
     });
     Some((ticks.collect(), false))
@@ -248,23 +218,10 @@ pub fn plot_series(
     let fail = |m: &str| PlotError(format!("plot {}: {m}", path.display()));
     if x.len() != input.len() || x.len() != output.len() {
         let (a, b, c) = (x.len(), input.len(), output.len());
-        return Err(fail(&format!(
-            "mismatched lengths: x {a}, input {b}, output {c}"
-        )));
+        return Err(fail(&format!("mismatched lengths: x {a}, input {b}, output {c}")));
     }
-    let xs = min_max(
-        x.iter()
-            .zip(input.iter().zip(output))
-            .filter(|(_, (&a, &b))| ok(a) || ok(b))
-            .map(|(x, _)| *x),
-    );
-    let ys = min_max(
-        x.iter()
-            .zip(input)
-            .chain(x.iter().zip(output))
-            .filter(|(&x, _)| ok(x))
-            .map(|(_, y)| *y),
-    );
+    let xs = min_max(x.iter().zip(input.iter().zip(output)).filter(|(_, (&a, &b))| ok(a) || ok(b)).map(|(x, _)| *x));
+    let ys = min_max(x.iter().zip(input).chain(x.iter().zip(output)).filter(|(&x, _)| ok(x)).map(|(_, y)| *y));
     if !(xs.0 <= xs.1 && ys.0 <= ys.1) {
         return Err(fail("no finite point to plot"));
     }
@@ -279,18 +236,14 @@ pub fn plot_series(
     render(path, size, |root, s| {
         let px = |v: f64| (v * s).round() as u32;
         let (ticks, with_day) = match axis {
-            XAxis::DaysSince(o) => {
-                date_ticks(*o, xr.0, xr.1, (size.0 as usize / 130).clamp(2, 12)).unzip()
-            }
+            XAxis::DaysSince(o) => date_ticks(*o, xr.0, xr.1, (size.0 as usize / 130).clamp(2, 12)).unzip(),
             XAxis::Numeric(_) => (None, None),
         };
         let xfmt: Box<dyn Fn(&f64) -> String> = match (axis, with_day) {
             (XAxis::DaysSince(o), Some(wd)) => Box::new(move |v| date_label(*o, *v, wd)),
             _ => Box::new(move |v| tick_label(*v, xr.1 - xr.0)),
         };
-        let root = root
-            .margin(px(8.0), 0, 0, 0)
-            .titled(title, (FONT, 24.0 * s))?;
+        let root = root.margin(px(8.0), 0, 0, 0).titled(title, (FONT, 24.0 * s))?;
         let (top, root) = root.split_vertically(px(30.0));
         let x_desc = match axis {
             XAxis::Numeric(l) => l.as_str(),
@@ -298,22 +251,13 @@ pub fn plot_series(
         };
         let ax = TickAxis((xr.0..xr.1).into(), ticks);
         let mut chart = make_chart(&root, s, ax, yr, (x_desc, y_label), &*xfmt)?;
-        let (thin, thick) = (
-            GREY.stroke_width(px(1.0).max(1)),
-            ORANGE.stroke_width(px(2.5)),
-        );
+        let (thin, thick) = (GREY.stroke_width(px(1.0).max(1)), ORANGE.stroke_width(px(2.5)));
         // one path per segment: a thick polyline gets miter spikes at sharp turns
-        chart.draw_series(
-            out.windows(2)
-                .map(|w| PathElement::new(vec![w[0], w[1]], thick)),
-        )?;
+        chart.draw_series(out.windows(2).map(|w| PathElement::new(vec![w[0], w[1]], thick)))?;
         // the input on top, thin, so that its noise shows over the smooth band
         chart.draw_series(LineSeries::new(inp, thin))?;
         let mut legend = vec![(Mark::Line(thin), "input"), (Mark::Line(thick), "smoothed")];
-        for (is_max, colour, name) in [
-            (false, MIN_C, "kept minimum"),
-            (true, MAX_C, "kept maximum"),
-        ] {
+        for (is_max, colour, name) in [(false, MIN_C, "kept minimum"), (true, MAX_C, "kept maximum")] {
             if dots.iter().any(|d| d.1 == is_max) {
                 let pts = dots.iter().filter(|d| d.1 == is_max);
                 let r = if dots.len() > 100 { px(3.5) } else { px(5.0) };
@@ -385,8 +329,7 @@ fn draw_legend<S: AsRef<str>>(
     row: Option<i32>,
 ) -> Result<(), Box<dyn Error>> {
     let px = |v: f64| (v * s).round() as i32;
-    let text =
-        TextStyle::from((FONT, 17.0 * s).into_font()).pos(Pos::new(HPos::Left, VPos::Center));
+    let text = TextStyle::from((FONT, 17.0 * s).into_font()).pos(Pos::new(HPos::Left, VPos::Center));
     let (mut x, mut y) = match row {
         Some(x) => (x, area.dim_in_pixel().1 as i32 / 2),
         None => (px(5.0), px(40.0)),
@@ -397,12 +340,7 @@ fn draw_legend<S: AsRef<str>>(
             Mark::Line(st) => area.draw(&PathElement::new([(x, y), (x + w, y)], *st))?,
             Mark::Dot(st, r) => area.draw(&Circle::new((c, y), *r, *st))?,
             Mark::Tri(st, r) => area.draw(&TriangleMarker::new((c, y), *r, *st))?,
-            Mark::Dash(st) => area.draw(&DashedPathElement::new(
-                [(x, y), (x + w, y)],
-                px(6.0),
-                px(4.0),
-                *st,
-            ))?,
+            Mark::Dash(st) => area.draw(&DashedPathElement::new([(x, y), (x + w, y)], px(6.0), px(4.0), *st))?,
         }
         area.draw(&Text::new(label.as_ref(), (x + px(35.0), y), text.clone()))?;
         match row {
@@ -425,10 +363,7 @@ pub fn plot_persistence_diagram(
     title: &str,
     size: (u32, u32),
 ) -> Result<(), PlotError> {
-    let pts: Vec<_> = points
-        .iter()
-        .filter(|p| ok(p.birth) && (ok(p.death) || p.death.is_infinite()))
-        .collect();
+    let pts: Vec<_> = points.iter().filter(|p| ok(p.birth) && (ok(p.death) || p.death.is_infinite())).collect();
     let (lo, hi) = min_max(pts.iter().flat_map(|p| [p.birth, p.death]));
     let (lo, hi) = nice_range(lo, hi, 0.0);
     let r = hi - lo;
@@ -444,71 +379,41 @@ pub fn plot_persistence_diagram(
     };
     render(path, size, |root, s| {
         let px = |v: f64| (v * s).round() as u32;
-        let root = root
-            .margin(px(8.0), 0, 0, 0)
-            .titled(title, (FONT, 24.0 * s))?;
+        let root = root.margin(px(8.0), 0, 0, 0).titled(title, (FONT, 24.0 * s))?;
         let (plot, panel) = root.split_horizontally(size.0 - px(250.0).min(size.0 / 2));
         let fmt = |v: &f64| tick_label(*v, b - a);
         let ax = TickAxis((a..b).into(), None);
         let mut chart = make_chart(&plot, s, ax, (a, b), ("birth", "death"), &fmt)?;
-        chart.draw_series(LineSeries::new(
-            [(a, a), (b, b)],
-            GREY.stroke_width(px(1.5)),
-        ))?;
+        chart.draw_series(LineSeries::new([(a, a), (b, b)], GREY.stroke_width(px(1.5))))?;
         let mut legend = Vec::new();
         let dash = RGBColor(110, 110, 110).stroke_width(px(1.5));
         if let Some(t) = threshold.filter(|&t| ok(t) && t > 0.0) {
             for c in [t, -t] {
                 let (x0, x1) = (a.max(a - c), b.min(b - c));
                 if x0 < x1 {
-                    chart.draw_series(DashedLineSeries::new(
-                        [(x0, x0 + c), (x1, x1 + c)],
-                        px(8.0),
-                        px(6.0),
-                        dash,
-                    ))?;
+                    chart.draw_series(DashedLineSeries::new([(x0, x0 + c), (x1, x1 + c)], px(8.0), px(6.0), dash))?;
                 }
             }
             legend.push((Mark::Dash(dash), format!("|death − birth| = {}", t as f32)));
         }
         if pts.iter().any(|p| !ok(p.death)) {
             let y = level(f64::INFINITY);
-            chart.draw_series(DashedLineSeries::new(
-                [(a, y), (b, y)],
-                px(2.0),
-                px(5.0),
-                GREY.stroke_width(1),
-            ))?;
-            legend.push((
-                Mark::Tri(BLACK.stroke_width(px(1.5)), px(7.0)),
-                "essential (death = ∞)".into(),
-            ));
+            chart.draw_series(DashedLineSeries::new([(a, y), (b, y)], px(2.0), px(5.0), GREY.stroke_width(1)))?;
+            legend.push((Mark::Tri(BLACK.stroke_width(px(1.5)), px(7.0)), "essential (death = ∞)".into()));
         }
         for (is_max, kept) in [(false, true), (false, false), (true, true), (true, false)] {
-            let sel: Vec<&DiagramPoint> = pts
-                .iter()
-                .copied()
-                .filter(|p| p.is_max == is_max && p.kept == kept)
-                .collect();
+            let sel: Vec<&DiagramPoint> =
+                pts.iter().copied().filter(|p| p.is_max == is_max && p.kept == kept).collect();
             if sel.is_empty() {
                 continue;
             }
             let colour = if is_max { MAX_C } else { MIN_C };
-            let (style, rad) = if kept {
-                (colour.filled(), px(5.0))
-            } else {
-                (colour.stroke_width(px(1.5)), px(3.5))
-            };
-            let (fin, ess): (Vec<&DiagramPoint>, Vec<_>) =
-                sel.into_iter().partition(|p| ok(p.death));
+            let (style, rad) = if kept { (colour.filled(), px(5.0)) } else { (colour.stroke_width(px(1.5)), px(3.5)) };
+            let (fin, ess): (Vec<&DiagramPoint>, Vec<_>) = sel.into_iter().partition(|p| ok(p.death));
+            chart.draw_series(fin.iter().map(|p| Circle::new((p.birth, p.death), rad, style)))?;
             chart.draw_series(
-                fin.iter()
-                    .map(|p| Circle::new((p.birth, p.death), rad, style)),
+                ess.iter().map(|p| TriangleMarker::new((p.birth, level(p.death)), rad + px(2.0), style)),
             )?;
-            chart
-                .draw_series(ess.iter().map(|p| {
-                    TriangleMarker::new((p.birth, level(p.death)), rad + px(2.0), style)
-                }))?;
             let name = format!(
                 "{} {} pair",
                 if kept { "kept" } else { "cancelled" },
@@ -534,10 +439,7 @@ mod tests {
         std::fs::remove_file(path).ok();
         assert_eq!(&bytes[..8], b"\x89PNG\r\n\x1a\n");
         assert_eq!(&bytes[12..16], b"IHDR");
-        assert_eq!(
-            bytes[16..24],
-            [w.to_be_bytes(), h.to_be_bytes()].concat()[..]
-        );
+        assert_eq!(bytes[16..24], [w.to_be_bytes(), h.to_be_bytes()].concat()[..]);
     }
 
     fn series(
@@ -559,75 +461,18 @@ mod tests {
         let x: Vec<f64> = (0..20_000).map(|i| i as f64 * 0.01).collect();
         let y: Vec<f64> = x.iter().map(|t| t.sin()).collect();
         let m = [
-            Marker {
-                index: 157,
-                is_max: true,
-            },
-            Marker {
-                index: 471,
-                is_max: false,
-            },
-            Marker {
-                index: 10_000_000,
-                is_max: true,
-            },
+            Marker { index: 157, is_max: true },
+            Marker { index: 471, is_max: false },
+            Marker { index: 10_000_000, is_max: true },
         ];
-        series(
-            "numeric",
-            &x,
-            &XAxis::Numeric("x".into()),
-            &y,
-            &m,
-            (1200, 600),
-        )
-        .unwrap();
+        series("numeric", &x, &XAxis::Numeric("x".into()), &y, &m, (1200, 600)).unwrap();
         let d = XAxis::DaysSince(NaiveDate::from_ymd_opt(2000, 1, 1).unwrap());
         series("dates", &x, &d, &y, &m, (800, 400)).unwrap();
-        series(
-            "constant",
-            &[1.0, 2.0, 3.0],
-            &d,
-            &[5.0; 3],
-            &[],
-            (1200, 600),
-        )
-        .unwrap();
-        series(
-            "single",
-            &[4.0],
-            &XAxis::Numeric("x".into()),
-            &[-0.0],
-            &[],
-            (100, 100),
-        )
-        .unwrap();
-        series(
-            "nan",
-            &[0.0, f64::NAN, 2.0, 3.0],
-            &d,
-            &[1.0, 2.0, f64::INFINITY, f64::NAN],
-            &[],
-            (300, 200),
-        )
-        .unwrap();
-        series(
-            "huge",
-            &[-1e300, 1e300, 0.0, 1e308],
-            &d,
-            &[1e300, -1e300, 0.0, 1.0],
-            &[],
-            (300, 200),
-        )
-        .unwrap();
-        series(
-            "unsorted",
-            &[3.0, 1.0, 2.0, -5.0],
-            &d,
-            &[1.0, 2.0, 3.0, 4.0],
-            &[],
-            (300, 200),
-        )
-        .unwrap();
+        series("constant", &[1.0, 2.0, 3.0], &d, &[5.0; 3], &[], (1200, 600)).unwrap();
+        series("single", &[4.0], &XAxis::Numeric("x".into()), &[-0.0], &[], (100, 100)).unwrap();
+        series("nan", &[0.0, f64::NAN, 2.0, 3.0], &d, &[1.0, 2.0, f64::INFINITY, f64::NAN], &[], (300, 200)).unwrap();
+        series("huge", &[-1e300, 1e300, 0.0, 1e308], &d, &[1e300, -1e300, 0.0, 1.0], &[], (300, 200)).unwrap();
+        series("unsorted", &[3.0, 1.0, 2.0, -5.0], &d, &[1.0, 2.0, 3.0, 4.0], &[], (300, 200)).unwrap();
     }
 
     #[test]
@@ -635,46 +480,18 @@ mod tests {
         let p = tmp("err");
         let a = XAxis::Numeric("x".into());
         assert!(plot_series(&p, &[], &a, "y", &[], &[], &[], "t", (600, 300)).is_err());
-        assert!(plot_series(
-            &p,
-            &[1.0, 2.0],
-            &a,
-            "y",
-            &[1.0],
-            &[1.0, 2.0],
-            &[],
-            "t",
-            (600, 300)
-        )
-        .is_err());
-        assert!(plot_series(
-            &p,
-            &[f64::NAN],
-            &a,
-            "y",
-            &[1.0],
-            &[1.0],
-            &[],
-            "t",
-            (600, 300)
-        )
-        .is_err());
+        assert!(plot_series(&p, &[1.0, 2.0], &a, "y", &[1.0], &[1.0, 2.0], &[], "t", (600, 300)).is_err());
+        assert!(plot_series(&p, &[f64::NAN], &a, "y", &[1.0], &[1.0], &[], "t", (600, 300)).is_err());
         assert!(plot_series(&p, &[1.0], &a, "y", &[1.0], &[1.0], &[], "t", (0, 300)).is_err());
         let bad = Path::new("/nonexistent_dir_toposmooth/x.png");
-        let e =
-            plot_series(bad, &[1.0], &a, "y", &[1.0], &[1.0], &[], "t", (600, 300)).unwrap_err();
+        let e = plot_series(bad, &[1.0], &a, "y", &[1.0], &[1.0], &[], "t", (600, 300)).unwrap_err();
         assert!(e.0.contains("nonexistent_dir_toposmooth"), "{e}");
         assert!(!p.exists());
     }
 
     #[test]
     fn diagrams() {
-        let pt = |birth, death, is_max, kept| DiagramPoint {
-            birth,
-            death,
-            is_max,
-            kept,
-        };
+        let pt = |birth, death, is_max, kept| DiagramPoint { birth, death, is_max, kept };
         let pts = [
             pt(0.0, 1.0, false, true),
             pt(2.0, 0.5, true, false),
@@ -687,11 +504,7 @@ mod tests {
             ("diag_essential_only", &pts[2..3], Some(f64::NAN)),
             (
                 "diag_huge",
-                &[
-                    pt(-1e300, 1e300, false, true),
-                    pt(1e300, f64::NEG_INFINITY, true, true),
-                    pt(1e308, 1.0, true, true),
-                ],
+                &[pt(-1e300, 1e300, false, true), pt(1e300, f64::NEG_INFINITY, true, true), pt(1e308, 1.0, true, true)],
                 Some(1e300),
             ),
         ] {
@@ -709,11 +522,7 @@ mod tests {
         assert_eq!(date_label(o, -1.0, false), "1999-12");
         assert_eq!(date_label(o, 1e300, false), "1e300");
         assert_eq!(
-            (
-                tick_label(1e-20, 1.0),
-                tick_label(2e7, 1e8),
-                tick_label(0.5, 1.0)
-            ),
+            (tick_label(1e-20, 1.0), tick_label(2e7, 1e8), tick_label(0.5, 1.0)),
             ("0.0".into(), "2e7".into(), "0.5".into())
         );
         let (t, with_day) = date_ticks(o, 0.0, 10.0, 6).unwrap();

@@ -36,26 +36,14 @@ pub fn series_representative(series: &Series, h: &[f64], kept: &KeptSet) -> Resu
     let anchors: Vec<(usize, Role)> = kept.kept.iter().map(|k| (k.index, k.role)).collect();
     let mut u = h.to_vec();
     if anchors.is_empty() {
-        return Err(Error::Representative {
-            path: None,
-            message: "no kept extremum".into(),
-        });
+        return Err(Error::Representative { path: None, message: "no kept extremum".into() });
     }
-    let (lo, hi) = h
-        .iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
-            (a.min(v), b.max(v))
-        });
+    let (lo, hi) = h.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| (a.min(v), b.max(v)));
     let slope = (hi - lo) / series.diameter();
     // free ends: the end opposite in type to the nearest kept extremum
     let (first, first_role) = anchors[0];
     if first > 0 {
-        let end = end_value(
-            &h[..=first],
-            h[first],
-            first_role,
-            slope * (x[first] - x[0]),
-        );
+        let end = end_value(&h[..=first], h[first], first_role, slope * (x[first] - x[0]));
         linear(&mut u, x, 0, first, end, h[first]);
     }
     let (last, last_role) = anchors[anchors.len() - 1];
@@ -176,14 +164,7 @@ mod tests {
         let b = a + 2.0 * f64::EPSILON; // one double strictly between
         let h = [a, 0.5 * (a + b), a, a, b];
         let s = Series::uniform(5);
-        let kept = select(
-            &s,
-            &h,
-            &Selection::Explicit {
-                minima: vec![0],
-                maxima: vec![4],
-            },
-        );
+        let kept = select(&s, &h, &Selection::Explicit { minima: vec![0], maxima: vec![4] });
         // vertex 0 must be a minimum of the input: it is (SoS), vertex 4 the global maximum
         let kept = kept.unwrap();
         let e = series_representative(&s, &h, &kept).unwrap_err();
@@ -196,15 +177,7 @@ mod tests {
         let b = a + 4.0 * f64::EPSILON; // three doubles between: exactly enough for 3 samples
         let h = [a, a, a, a, b];
         let s = Series::uniform(5);
-        let kept = select(
-            &s,
-            &h,
-            &Selection::Explicit {
-                minima: vec![0],
-                maxima: vec![4],
-            },
-        )
-        .unwrap();
+        let kept = select(&s, &h, &Selection::Explicit { minima: vec![0], maxima: vec![4] }).unwrap();
         let u = series_representative(&s, &h, &kept).unwrap();
         assert!(u.windows(2).all(|w| w[0] < w[1]), "{u:?}");
     }

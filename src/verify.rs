@@ -58,11 +58,7 @@ impl Certificate {
             .take(5)
             .map(|f| format!("item {}: vertex {} {}", f.item, f.vertex, f.reason))
             .collect();
-        format!(
-            "{} failure(s); first: {}",
-            self.failure_count,
-            list.join("; ")
-        )
+        format!("{} failure(s); first: {}", self.failure_count, list.join("; "))
     }
 }
 
@@ -75,24 +71,13 @@ impl Certificate {
 /// * `Fixed`: exempt.
 ///
 /// Item 5 (the values as written and read back) is this function applied to the file's values.
-pub fn certify<D: Domain>(
-    domain: &D,
-    f: &[f64],
-    roles: &[Role],
-    input: Option<&[f64]>,
-) -> Certificate {
+pub fn certify<D: Domain>(domain: &D, f: &[f64], roles: &[Role], input: Option<&[f64]>) -> Certificate {
     let n = domain.n_vertices();
     assert_eq!(f.len(), n);
     assert_eq!(roles.len(), n);
     let mut failures = Vec::new();
     let (mut strict_minima, mut strict_maxima, mut flat) = (0, 0, 0);
-    let mut fail = |item: u8, vertex: usize, reason: String| {
-        failures.push(Failure {
-            item,
-            vertex,
-            reason,
-        })
-    };
+    let mut fail = |item: u8, vertex: usize, reason: String| failures.push(Failure { item, vertex, reason });
     for v in 0..n {
         if !f[v].is_finite() {
             fail(4, v, format!("is not finite ({})", f[v]));
@@ -115,16 +100,12 @@ pub fn certify<D: Domain>(
         strict_maxima += is_max as usize;
         flat += (!is_min && !is_max && !regular) as usize;
         match roles[v] {
-            Role::Min if !is_min => fail(
-                1,
-                v,
-                format!("should be a strict minimum ({lower} lower, {equal} equal neighbours)"),
-            ),
-            Role::Max if !is_max => fail(
-                1,
-                v,
-                format!("should be a strict maximum ({higher} higher, {equal} equal neighbours)"),
-            ),
+            Role::Min if !is_min => {
+                fail(1, v, format!("should be a strict minimum ({lower} lower, {equal} equal neighbours)"))
+            }
+            Role::Max if !is_max => {
+                fail(1, v, format!("should be a strict maximum ({higher} higher, {equal} equal neighbours)"))
+            }
             Role::Other if !regular => fail(
                 2,
                 v,
@@ -136,20 +117,12 @@ pub fn certify<D: Domain>(
                     format!("is a flat spot ({equal} equal neighbours)")
                 },
             ),
-            Role::End if !(is_min || is_max) => {
-                fail(2, v, "free end is not a strict extremum".into())
-            }
+            Role::End if !(is_min || is_max) => fail(2, v, "free end is not a strict extremum".into()),
             _ => {}
         }
         if let Some(h) = input {
-            if matches!(roles[v], Role::Min | Role::Max | Role::Fixed)
-                && f[v].to_bits() != h[v].to_bits()
-            {
-                fail(
-                    3,
-                    v,
-                    format!("kept value {} differs from the input {}", f[v], h[v]),
-                );
+            if matches!(roles[v], Role::Min | Role::Max | Role::Fixed) && f[v].to_bits() != h[v].to_bits() {
+                fail(3, v, format!("kept value {} differs from the input {}", f[v], h[v]));
             }
         }
     }
@@ -174,14 +147,7 @@ mod tests {
     #[test]
     fn finds_each_kind_of_defect() {
         let s = Series::uniform(6);
-        let roles = [
-            Role::End,
-            Role::Other,
-            Role::Min,
-            Role::Other,
-            Role::Max,
-            Role::End,
-        ];
+        let roles = [Role::End, Role::Other, Role::Min, Role::Other, Role::Max, Role::End];
         let good = [1.0, 0.5, 0.0, 1.0, 2.0, 1.5];
         let c = certify(&s, &good, &roles, Some(&good));
         assert!(c.passed, "{}", c.summary());
@@ -199,9 +165,6 @@ mod tests {
         assert!(c.failures.iter().any(|f| f.item == 3 && f.vertex == 2));
         let mut nan = good;
         nan[1] = f64::NAN;
-        assert!(certify(&s, &nan, &roles, None)
-            .failures
-            .iter()
-            .any(|f| f.item == 4));
+        assert!(certify(&s, &nan, &roles, None).failures.iter().any(|f| f.item == 4));
     }
 }

@@ -7,26 +7,15 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 fn toposmooth(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_toposmooth"))
-        .args(args)
-        .output()
-        .expect("runs")
+    Command::new(env!("CARGO_BIN_EXE_toposmooth")).args(args).output().expect("runs")
 }
 
 fn dataset(name: &str) -> String {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("datasets")
-        .join(name)
-        .display()
-        .to_string()
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("datasets").join(name).display().to_string()
 }
 
 fn text(o: &Output) -> String {
-    format!(
-        "{}{}",
-        String::from_utf8_lossy(&o.stdout),
-        String::from_utf8_lossy(&o.stderr)
-    )
+    format!("{}{}", String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr))
 }
 
 fn write(dir: &Path, name: &str, content: &str) -> String {
@@ -41,53 +30,64 @@ fn smooth_then_verify_the_exchange_rate() {
     let out = dir.join("fx.csv").display().to_string();
     let report = dir.join("run.json").display().to_string();
     let fx = dataset("fx_eur_per_usd_daily_1999_2017.csv");
-    let o = toposmooth(&[
-        "smooth",
-        &fx,
-        "-o",
-        &out,
-        "--persistence",
-        "2%",
-        "--report",
-        &report,
-    ]);
+    let o = toposmooth(&["smooth", &fx, "-o", &out, "--persistence", "2%", "--report", &report]);
     assert!(o.status.success(), "{}", text(&o));
     assert!(text(&o).contains("certified"));
     let v = toposmooth(&["verify", &out, "--input", &fx]);
     assert_eq!(v.status.code(), Some(0), "{}", text(&v));
-    let r: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    let r: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
     assert_eq!(r["certificate"]["passed"], true);
     assert_eq!(r["vertices"], 4754);
     assert!(r["kept"].as_array().unwrap().len() >= 2);
     assert!(r["seconds"]["solve"].as_f64().unwrap() >= 0.0);
     // the x column keeps its dates
     let csv = std::fs::read_to_string(&out).unwrap();
-    assert!(
-        csv.starts_with("x,input,output,u,role\n1999-01-04,0.8466,0.8466,"),
-        "{}",
-        &csv[..80]
-    );
+    assert!(csv.starts_with("x,input,output,u,role\n1999-01-04,0.8466,0.8466,"), "{}", &csv[..80]);
 
     // tamper: a spurious maximum in the output is caught, and so is a changed input column
     let mut lines: Vec<String> = csv.lines().map(str::to_string).collect();
-    let row = (2..lines.len() - 1)
-        .find(|&i| lines[i].ends_with(','))
-        .unwrap();
+    let row = (2..lines.len() - 1).find(|&i| lines[i].ends_with(',')).unwrap();
     let mut cells: Vec<String> = lines[row].split(',').map(str::to_string).collect();
     cells[2] = "100".into();
     lines[row] = cells.join(",");
     let bad = write(&dir, "bad.csv", &(lines.join("\n") + "\n"));
     let v = toposmooth(&["verify", &bad]);
     assert_eq!(v.status.code(), Some(1), "{}", text(&v));
-    assert!(
-        text(&v).contains("spurious maximum") && text(&v).contains("bad.csv"),
-        "{}",
-        text(&v)
-    );
+    assert!(text(&v).contains("spurious maximum") && text(&v).contains("bad.csv"), "{}", text(&v));
     let seattle = dataset("seattle_weather_daily_2012_2015.csv");
     let v = toposmooth(&["verify", &out, "--input", &seattle, "--column", "temp_max"]);
     assert_eq!(v.status.code(), Some(1), "{}", text(&v));
+}
+
+fn is_png(path: &Path) -> bool {
+    std::fs::read(path).map(|b| b.starts_with(b"\x89PNG\r\n\x1a\n") && b.len() > 1000).unwrap_or(false)
+}
+
+#[test]
+fn plots_are_written_as_png() {
+    let dir = scratch("plots");
+    let fx = dataset("fx_eur_per_usd_daily_1999_2017.csv");
+    let (out, fig, diag) = (dir.join("o.csv"), dir.join("smooth.png"), dir.join("diagram.png"));
+    let o = toposmooth(&[
+        "smooth",
+        &fx,
+        "-o",
+        out.to_str().unwrap(),
+        "--persistence",
+        "8%",
+        "--plot",
+        fig.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", text(&o));
+    assert!(is_png(&fig));
+    let o = toposmooth(&["extrema", &fx, "--plot", diag.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", text(&o));
+    assert!(is_png(&diag));
+    let bad = dir.join("figure.jpg");
+    let out2 = dir.join("o2.csv");
+    let o = toposmooth(&["smooth", &fx, "-o", out2.to_str().unwrap(), "--plot", bad.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2), "{}", text(&o));
+    assert!(!bad.exists() && !out2.exists(), "nothing written");
 }
 
 #[test]
@@ -108,11 +108,7 @@ fn seattle_by_column_name_and_pairs() {
     ]);
     assert!(o.status.success(), "{}", text(&o));
     assert!(text(&o).contains("`temp_max`"), "{}", text(&o));
-    assert!(
-        text(&o).contains("kept 9 minima and 8 maxima"),
-        "{}",
-        text(&o)
-    );
+    assert!(text(&o).contains("kept 9 minima and 8 maxima"), "{}", text(&o));
     assert_eq!(toposmooth(&["verify", &out]).status.code(), Some(0));
 }
 
@@ -157,96 +153,36 @@ fn input_errors_exit_3_naming_the_file() {
     let out = dir.join("out.csv");
     let o = out.display().to_string();
     let nan = write(&dir, "nan.csv", "v\n1\n2\nNaN\n0\n");
-    assert_input_error(
-        &["smooth", &nan, "-o", &o],
-        &["nan.csv", "line 4", "not finite"],
-        Some(&out),
-    );
+    assert_input_error(&["smooth", &nan, "-o", &o], &["nan.csv", "line 4", "not finite"], Some(&out));
     let empty = write(&dir, "empty.csv", "");
-    assert_input_error(
-        &["smooth", &empty, "-o", &o],
-        &["empty.csv", "empty"],
-        Some(&out),
-    );
+    assert_input_error(&["smooth", &empty, "-o", &o], &["empty.csv", "empty"], Some(&out));
     let constant = write(&dir, "const.csv", "1\n1\n1\n");
-    assert_input_error(
-        &["smooth", &constant, "-o", &o],
-        &["const.csv", "constant"],
-        Some(&out),
-    );
+    assert_input_error(&["smooth", &constant, "-o", &o], &["const.csv", "constant"], Some(&out));
     let good = write(&dir, "good.csv", "v\n0\n2\n5\n2\n0.5\n1\n1.5\n1\n0.2\n");
+    assert_input_error(&["smooth", &good, "--column", "w", "-o", &o], &["good.csv", "no column `w`"], Some(&out));
     assert_input_error(
-        &["smooth", &good, "--column", "w", "-o", &o],
-        &["good.csv", "no column `w`"],
-        Some(&out),
-    );
-    assert_input_error(
-        &[
-            "smooth",
-            &good,
-            "--keep-min",
-            "4,8",
-            "--keep-max",
-            "2",
-            "-o",
-            &o,
-        ],
+        &["smooth", &good, "--keep-min", "4,8", "--keep-max", "2", "-o", &o],
         &["good.csv", "4 and 8"],
         Some(&out),
     );
     assert_input_error(
-        &[
-            "smooth",
-            &good,
-            "--keep-min",
-            "3",
-            "--keep-max",
-            "2",
-            "-o",
-            &o,
-        ],
+        &["smooth", &good, "--keep-min", "3", "--keep-max", "2", "-o", &o],
         &["vertex 3", "not a local minimum"],
         Some(&out),
     );
     assert_input_error(
-        &[
-            "smooth",
-            &good,
-            "--keep-min",
-            "4",
-            "--keep-max",
-            "99",
-            "-o",
-            &o,
-        ],
+        &["smooth", &good, "--keep-min", "4", "--keep-max", "99", "-o", &o],
         &["out of range"],
         Some(&out),
     );
     let missing = dir.join("nope.csv").display().to_string();
     assert_input_error(&["smooth", &missing, "-o", &o], &["nope.csv"], Some(&out));
-    let unsorted = write(
-        &dir,
-        "dates.csv",
-        "date,v\n2010-01-02,1\n2010-01-01,2\n2010-01-03,0\n",
-    );
-    assert_input_error(
-        &["smooth", &unsorted, "-o", &o],
-        &["dates.csv", "line 3", "strictly increase"],
-        Some(&out),
-    );
+    let unsorted = write(&dir, "dates.csv", "date,v\n2010-01-02,1\n2010-01-01,2\n2010-01-03,0\n");
+    assert_input_error(&["smooth", &unsorted, "-o", &o], &["dates.csv", "line 3", "strictly increase"], Some(&out));
     let ragged = write(&dir, "ragged.csv", "a,b\n1,2\n3\n");
     assert_input_error(&["extrema", &ragged], &["ragged.csv"], None);
     // explicit list that is fine is certified and written
-    let ok = toposmooth(&[
-        "smooth",
-        &good,
-        "--keep-min",
-        "4",
-        "--keep-max",
-        "2,6",
-        "-o",
-        &o,
-    ]);
+    let ok = toposmooth(&["smooth", &good, "--keep-min", "4", "--keep-max", "2,6", "-o", &o]);
     assert!(ok.status.success(), "{}", text(&ok));
     assert!(out.exists());
 }
@@ -261,16 +197,7 @@ fn usage_errors_exit_2() {
         vec!["smooth", &good, "-o", &o, "--persistence", "abc"],
         vec!["smooth", &good, "-o", &o, "--order", "7"],
         vec!["smooth", &good, "-o", &o, "--order", "2:-1"],
-        vec![
-            "smooth",
-            &good,
-            "-o",
-            &o,
-            "--persistence",
-            "5%",
-            "--pairs",
-            "2",
-        ],
+        vec!["smooth", &good, "-o", &o, "--persistence", "5%", "--pairs", "2"],
         vec!["smooth", &good, "-o", &o, "--keep-min", "0"],
         vec!["smooth", &good, "-o", &o, "--sharp", "17"],
         vec!["smooth", &good, "-o", &o, "--data-weight", "-1"],

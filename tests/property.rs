@@ -60,11 +60,7 @@ fn check_certified(h: &[f64], out: &Smoothed) -> Result<(), TestCaseError> {
     prop_assert!(c.flat.is_empty(), "flat spots {:?}", c.flat);
     let kept_min: Vec<usize> = (0..n).filter(|&i| out.roles[i] == Role::Min).collect();
     let kept_max: Vec<usize> = (0..n).filter(|&i| out.roles[i] == Role::Max).collect();
-    let not_end = |v: Vec<usize>| {
-        v.into_iter()
-            .filter(|&i| out.roles[i] != Role::End)
-            .collect::<Vec<_>>()
-    };
+    let not_end = |v: Vec<usize>| v.into_iter().filter(|&i| out.roles[i] != Role::End).collect::<Vec<_>>();
     prop_assert_eq!(not_end(c.minima), kept_min.clone());
     prop_assert_eq!(not_end(c.maxima), kept_max.clone());
     for &i in kept_min.iter().chain(&kept_max) {

@@ -55,9 +55,7 @@ fn peak_rss_mib() -> f64 {
     std::fs::read_to_string("/proc/self/status")
         .ok()
         .and_then(|s| {
-            s.lines()
-                .find(|l| l.starts_with("VmHWM:"))
-                .and_then(|l| l.split_whitespace().nth(1)?.parse::<f64>().ok())
+            s.lines().find(|l| l.starts_with("VmHWM:")).and_then(|l| l.split_whitespace().nth(1)?.parse::<f64>().ok())
         })
         .map(|kib| kib / 1024.0)
         .unwrap_or(f64::NAN)
@@ -71,10 +69,7 @@ pub fn bench(args: &BenchArgs) -> Result<String> {
             selection: Selection::Relative(args.persistence),
             energy: args.energy.clone(),
             edges: args.edges,
-            qp: QpSettings {
-                method: args.method,
-                ..Default::default()
-            },
+            qp: QpSettings { method: args.method, ..Default::default() },
             ..Default::default()
         };
         let t = Instant::now();
@@ -97,53 +92,26 @@ pub fn bench(args: &BenchArgs) -> Result<String> {
         });
         return Ok(format!("{line}\n"));
     }
-    let exe = std::env::current_exe().map_err(|source| Error::Io {
-        path: "current executable".into(),
-        source,
-    })?;
-    let order = args
-        .energy
-        .terms
-        .iter()
-        .map(|(k, w)| format!("{k}:{w}"))
-        .collect::<Vec<_>>()
-        .join(",");
+    let exe = std::env::current_exe().map_err(|source| Error::Io { path: "current executable".into(), source })?;
+    let order = args.energy.terms.iter().map(|(k, w)| format!("{k}:{w}")).collect::<Vec<_>>().join(",");
     let mut out = String::from(
         "| samples | input extrema | kept | constraints | iterations | persistence s | representative s | operators s | constraints s | solve s | repair s | verify s | total s | peak MiB |\n|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n",
     );
     for &n in &args.sizes {
         let child = std::process::Command::new(&exe)
-            .args([
-                "bench",
-                "--single",
-                &n.to_string(),
-                "--order",
-                &order,
-                "--seed",
-                &args.seed.to_string(),
-            ])
+            .args(["bench", "--single", &n.to_string(), "--order", &order, "--seed", &args.seed.to_string()])
             .args(["--persistence", &format!("{}%", args.persistence * 100.0)])
-            .args([
-                "--edges",
-                if args.edges == EdgeSet::All {
-                    "all"
-                } else {
-                    "minimal"
-                },
-            ])
+            .args(["--edges", if args.edges == EdgeSet::All { "all" } else { "minimal" }])
             .output()
-            .map_err(|source| Error::Io {
-                path: exe.clone(),
-                source,
-            })?;
+            .map_err(|source| Error::Io { path: exe.clone(), source })?;
         if !child.status.success() {
             return Err(Error::input(format!(
                 "bench of {n} samples failed: {}",
                 String::from_utf8_lossy(&child.stderr).trim()
             )));
         }
-        let v: serde_json::Value = serde_json::from_slice(&child.stdout)
-            .map_err(|e| Error::input(format!("bench output: {e}")))?;
+        let v: serde_json::Value =
+            serde_json::from_slice(&child.stdout).map_err(|e| Error::input(format!("bench output: {e}")))?;
         let s = &v["seconds"];
         let f = |x: &serde_json::Value| x.as_f64().unwrap_or(f64::NAN);
         out += &format!(

@@ -1,6 +1,6 @@
 //! `toposmooth extrema`: list the extrema with persistence and strictness; draw the diagram.
 
-use super::plot_atomic;
+use super::{check_png_name, plot_atomic};
 use crate::domain::Series;
 use crate::error::{Error, Result};
 use crate::io::series_csv::{read_series, SeriesCsvOptions};
@@ -47,17 +47,13 @@ struct Row<'a> {
 
 /// Runs `extrema`; returns the text printed on standard output.
 pub fn extrema(args: &ExtremaArgs) -> Result<String> {
+    check_png_name(args.plot.as_deref())?;
     let data = read_series(&args.input, &args.csv)?;
     let series = Series::with_coordinates(data.x.clone()).map_err(|e| e.in_file(&args.input))?;
     let h = &data.values;
     let table = extrema_table(&series, h);
     let kept = select(&series, h, &args.selection).map_err(|e| e.in_file(&args.input))?;
-    let count = |k: ExtremumKind, strict: bool| {
-        table
-            .iter()
-            .filter(|r| r.kind == k && (!strict || r.strict))
-            .count()
-    };
+    let count = |k: ExtremumKind, strict: bool| table.iter().filter(|r| r.kind == k && (!strict || r.strict)).count();
     let listing = Listing {
         file: args.input.display().to_string(),
         column: &data.column,
@@ -84,12 +80,7 @@ pub fn extrema(args: &ExtremaArgs) -> Result<String> {
                 continue;
             }
             let death = r.partner.map(|p| h[p]).unwrap_or(f64::INFINITY);
-            points.push(DiagramPoint {
-                birth: r.value,
-                death,
-                is_max: false,
-                kept: kept.roles[r.index] == Role::Min,
-            });
+            points.push(DiagramPoint { birth: r.value, death, is_max: false, kept: kept.roles[r.index] == Role::Min });
         }
         let title = format!(
             "{} — {} ({} pairs)",
@@ -97,9 +88,7 @@ pub fn extrema(args: &ExtremaArgs) -> Result<String> {
             data.column,
             points.len()
         );
-        plot_atomic(path, |p| {
-            plot_persistence_diagram(p, &points, kept.threshold, &title, (900, 800))
-        })?;
+        plot_atomic(path, |p| plot_persistence_diagram(p, &points, kept.threshold, &title, (900, 800)))?;
     }
     if args.json {
         return serde_json::to_string_pretty(&listing).map_err(|e| Error::input(e.to_string()));
@@ -137,11 +126,8 @@ pub fn extrema(args: &ExtremaArgs) -> Result<String> {
         listing.file, listing.samples, listing.column, listing.sos_minima, listing.sos_maxima, listing.ends, listing.strict_minima, listing.strict_maxima
     );
     if let Some(t) = kept.threshold {
-        out += &format!(
-            "kept at persistence ≥ {t:e}: {} minima, {} maxima\n",
-            kept.minima().len(),
-            kept.maxima().len()
-        );
+        out +=
+            &format!("kept at persistence ≥ {t:e}: {} minima, {} maxima\n", kept.minima().len(), kept.maxima().len());
     }
     Ok(out)
 }

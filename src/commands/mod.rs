@@ -24,32 +24,19 @@ pub fn parse_persistence(s: &str) -> Result<Selection> {
         Some(p) => (p.trim(), true),
         None => (t, false),
     };
-    let v: f64 = num.parse().map_err(|_| {
-        Error::Usage(format!(
-            "--persistence `{s}` is not a number or a percentage"
-        ))
-    })?;
+    let v: f64 =
+        num.parse().map_err(|_| Error::Usage(format!("--persistence `{s}` is not a number or a percentage")))?;
     if !(v.is_finite() && v > 0.0) {
-        return Err(Error::Usage(format!(
-            "--persistence must be > 0, got `{s}`"
-        )));
+        return Err(Error::Usage(format!("--persistence must be > 0, got `{s}`")));
     }
-    Ok(if relative {
-        Selection::Relative(v / 100.0)
-    } else {
-        Selection::Absolute(v)
-    })
+    Ok(if relative { Selection::Relative(v / 100.0) } else { Selection::Absolute(v) })
 }
 
 /// Parses a comma-separated list of vertex indices.
 pub fn parse_indices(s: &str) -> Result<Vec<usize>> {
     s.split(',')
         .filter(|p| !p.trim().is_empty())
-        .map(|p| {
-            p.trim()
-                .parse::<usize>()
-                .map_err(|_| Error::Usage(format!("`{p}` in `{s}` is not a vertex index")))
-        })
+        .map(|p| p.trim().parse::<usize>().map_err(|_| Error::Usage(format!("`{p}` in `{s}` is not a vertex index"))))
         .collect()
 }
 
@@ -65,34 +52,25 @@ fn x_axis(source: &XSource, x: &[f64]) -> (XAxis, Vec<f64>) {
     }
 }
 
-/// Runs `draw` on a temporary sibling of `path` and renames it into place.
-fn plot_atomic(
-    path: &Path,
-    draw: impl FnOnce(&Path) -> std::result::Result<(), crate::plot::PlotError>,
-) -> Result<()> {
-    let ext = path
-        .extension()
-        .and_then(|e| e.to_str())
-        .unwrap_or("")
-        .to_ascii_lowercase();
-    if ext != "png" {
-        return Err(Error::Usage(format!(
-            "{}: plots are written as PNG; use a .png name",
-            path.display()
-        )));
+/// Plots are PNG files: checked before any work so that a bad name writes nothing.
+fn check_png_name(path: Option<&Path>) -> Result<()> {
+    match path {
+        Some(p) if !p.extension().and_then(|e| e.to_str()).is_some_and(|e| e.eq_ignore_ascii_case("png")) => {
+            Err(Error::Usage(format!("{}: plots are written as PNG; use a .png name", p.display())))
+        }
+        _ => Ok(()),
     }
+}
+
+/// Runs `draw` on a temporary sibling of `path` and renames it into place.
+fn plot_atomic(path: &Path, draw: impl FnOnce(&Path) -> std::result::Result<(), crate::plot::PlotError>) -> Result<()> {
+    check_png_name(Some(path))?;
     let tmp = crate::io::temp_sibling(path).with_extension("png");
     draw(&tmp).map_err(|e| {
         let _ = std::fs::remove_file(&tmp);
-        Error::Io {
-            path: path.to_path_buf(),
-            source: std::io::Error::other(e.to_string()),
-        }
+        Error::Io { path: path.to_path_buf(), source: std::io::Error::other(e.to_string()) }
     })?;
-    std::fs::rename(&tmp, path).map_err(|source| Error::Io {
-        path: path.to_path_buf(),
-        source,
-    })
+    std::fs::rename(&tmp, path).map_err(|source| Error::Io { path: path.to_path_buf(), source })
 }
 
 #[cfg(test)]
@@ -102,10 +80,7 @@ mod tests {
     #[test]
     fn persistence_and_indices() {
         assert_eq!(parse_persistence("5%").unwrap(), Selection::Relative(0.05));
-        assert_eq!(
-            parse_persistence("0.25").unwrap(),
-            Selection::Absolute(0.25)
-        );
+        assert_eq!(parse_persistence("0.25").unwrap(), Selection::Absolute(0.25));
         assert!(parse_persistence("-1").is_err());
         assert!(parse_persistence("abc").is_err());
         assert!(parse_persistence("0%").is_err());

@@ -1,6 +1,6 @@
 //! `toposmooth smooth`: the whole pipeline on a file, with output, plot and report.
 
-use super::{plot_atomic, x_axis};
+use super::{check_png_name, plot_atomic, x_axis};
 use crate::domain::Series;
 use crate::error::Result;
 use crate::io::series_csv::{read_series, write_series_output, SeriesCsvOptions, SeriesOutput};
@@ -42,12 +42,12 @@ struct RunReport<'a> {
 
 /// Runs `smooth`; returns the summary printed on standard output.
 pub fn smooth(args: &SmoothArgs) -> Result<String> {
+    check_png_name(args.plot.as_deref())?;
     let start = Instant::now();
     let data = read_series(&args.input, &args.csv)?;
     let series = Series::with_coordinates(data.x.clone()).map_err(|e| e.in_file(&args.input))?;
     let read_seconds = start.elapsed().as_secs_f64();
-    let result =
-        run_pipeline(&series, &data.values, &args.settings).map_err(|e| e.in_file(&args.input))?;
+    let result = run_pipeline(&series, &data.values, &args.settings).map_err(|e| e.in_file(&args.input))?;
     let t = Instant::now();
     let out = SeriesOutput {
         x_text: data.x_text.clone(),
@@ -64,14 +64,8 @@ pub fn smooth(args: &SmoothArgs) -> Result<String> {
             .iter()
             .enumerate()
             .filter_map(|(i, r)| match r {
-                Role::Min => Some(Marker {
-                    index: i,
-                    is_max: false,
-                }),
-                Role::Max => Some(Marker {
-                    index: i,
-                    is_max: true,
-                }),
+                Role::Min => Some(Marker { index: i, is_max: false }),
+                Role::Max => Some(Marker { index: i, is_max: true }),
                 _ => None,
             })
             .collect();
@@ -85,17 +79,7 @@ pub fn smooth(args: &SmoothArgs) -> Result<String> {
             r.rms_deviation
         );
         plot_atomic(path, |p| {
-            plot_series(
-                p,
-                &x,
-                &axis,
-                &data.column,
-                &data.values,
-                &result.output,
-                &markers,
-                &title,
-                (1400, 700),
-            )
+            plot_series(p, &x, &axis, &data.column, &data.values, &result.output, &markers, &title, (1400, 700))
         })?;
     }
     let write_seconds = t.elapsed().as_secs_f64();
@@ -130,9 +114,7 @@ pub fn smooth(args: &SmoothArgs) -> Result<String> {
         "kept {} minima and {} maxima{}\n",
         kmin,
         r.kept.len() - kmin,
-        r.threshold
-            .map(|t| format!(" (persistence ≥ {t:.6e})"))
-            .unwrap_or_default()
+        r.threshold.map(|t| format!(" (persistence ≥ {t:.6e})")).unwrap_or_default()
     );
     text += &format!(
         "{}; RMS deviation {:.6e}, max deviation {:.6e}\n",

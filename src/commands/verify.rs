@@ -32,8 +32,7 @@ pub fn verify(args: &VerifyArgs) -> Result<String> {
                 data.values.len(),
                 args.file.display()
             ));
-        } else if let Some(i) = (0..n).find(|&i| data.values[i].to_bits() != out.input[i].to_bits())
-        {
+        } else if let Some(i) = (0..n).find(|&i| data.values[i].to_bits() != out.input[i].to_bits()) {
             problems.push(format!(
                 "input column differs from {} at sample {i}: {} vs {}",
                 orig.display(),
@@ -51,20 +50,13 @@ pub fn verify(args: &VerifyArgs) -> Result<String> {
         problems.push(format!("representative u: {}", ucert.summary()));
     }
     if !problems.is_empty() {
-        return Err(Error::Uncertified {
-            path: Some(args.file.clone()),
-            message: problems.join("; "),
-        });
+        return Err(Error::Uncertified { path: Some(args.file.clone()), message: problems.join("; ") });
     }
     let kept = out.roles.iter().filter(|r| r.is_fixed()).count();
     Ok(format!(
         "{}: {} ({n} samples, {kept} kept extrema at their input values, u consistent{})\n",
         args.file.display(),
         cert.summary(),
-        if args.input.is_some() {
-            ", input column matches"
-        } else {
-            ""
-        }
+        if args.input.is_some() { ", input column matches" } else { "" }
     ))
 }

@@ -16,9 +16,7 @@ impl Series {
     /// If `n < 2` (a contract violation; readers reject such input first).
     pub fn uniform(n: usize) -> Self {
         assert!(n >= 2, "a series needs at least 2 samples");
-        Series {
-            x: (0..n).map(|i| i as f64).collect(),
-        }
+        Series { x: (0..n).map(|i| i as f64).collect() }
     }
 
     /// Series with the given coordinates.
@@ -28,15 +26,10 @@ impl Series {
     /// increase (the message names the first offending sample).
     pub fn with_coordinates(x: Vec<f64>) -> Result<Self> {
         if x.len() < 2 {
-            return Err(Error::input(format!(
-                "a series needs at least 2 samples, found {}",
-                x.len()
-            )));
+            return Err(Error::input(format!("a series needs at least 2 samples, found {}", x.len())));
         }
         if let Some(i) = x.iter().position(|v| !v.is_finite()) {
-            return Err(Error::input(format!(
-                "x coordinate of sample {i} is not finite"
-            )));
+            return Err(Error::input(format!("x coordinate of sample {i} is not finite")));
         }
         if let Some(i) = (1..x.len()).find(|&i| x[i] <= x[i - 1]) {
             return Err(Error::input(format!(

@@ -9,15 +9,9 @@ use std::path::{Path, PathBuf};
 
 /// Writes `path` atomically: `fill` writes into a temporary sibling, which is flushed, synced
 /// and renamed over `path`. On any error the temporary file is removed.
-pub fn write_atomic(
-    path: &Path,
-    fill: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
-) -> Result<()> {
+pub fn write_atomic(path: &Path, fill: impl FnOnce(&mut dyn Write) -> std::io::Result<()>) -> Result<()> {
     let tmp = temp_sibling(path);
-    let io_err = |source| Error::Io {
-        path: path.to_path_buf(),
-        source,
-    };
+    let io_err = |source| Error::Io { path: path.to_path_buf(), source };
     let result = (|| -> std::io::Result<()> {
         let file = std::fs::File::create(&tmp)?;
         let mut w = std::io::BufWriter::new(file);
@@ -35,10 +29,7 @@ pub fn write_atomic(
 
 /// A temporary name next to `path` (same directory, so the rename is atomic).
 pub fn temp_sibling(path: &Path) -> PathBuf {
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_else(|| "out".into());
+    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_else(|| "out".into());
     path.with_file_name(format!(".{name}.{}.tmp", std::process::id()))
 }
 
@@ -61,15 +52,7 @@ mod tests {
 
     #[test]
     fn shortest_round_trip() {
-        for v in [
-            0.1,
-            1.0 / 3.0,
-            1e-300,
-            6.02e23,
-            -0.0,
-            123_456_789.123_456_78,
-            f64::MIN_POSITIVE,
-        ] {
+        for v in [0.1, 1.0 / 3.0, 1e-300, 6.02e23, -0.0, 123_456_789.123_456_78, f64::MIN_POSITIVE] {
             let s = format_f64(v);
             assert_eq!(s.parse::<f64>().unwrap().to_bits(), v.to_bits(), "{s}");
         }

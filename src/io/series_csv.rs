@@ -58,12 +58,7 @@ pub fn parse_date_days(s: &str) -> Option<f64> {
     if let Ok(d) = NaiveDate::parse_from_str(t, "%Y-%m-%d") {
         return Some((d - epoch).num_days() as f64);
     }
-    for fmt in [
-        "%Y-%m-%dT%H:%M:%S",
-        "%Y-%m-%d %H:%M:%S",
-        "%Y-%m-%dT%H:%M",
-        "%Y-%m-%d %H:%M",
-    ] {
+    for fmt in ["%Y-%m-%dT%H:%M:%S", "%Y-%m-%d %H:%M:%S", "%Y-%m-%dT%H:%M", "%Y-%m-%d %H:%M"] {
         if let Ok(dt) = NaiveDateTime::parse_from_str(t, fmt) {
             let secs = (dt - epoch.and_hms_opt(0, 0, 0)?).num_seconds();
             return Some(secs as f64 / 86400.0);
@@ -101,21 +96,11 @@ fn kind(s: &str) -> Kind {
 /// values that do not strictly increase, fewer than 2 samples.
 pub fn read_series(path: &Path, options: &SeriesCsvOptions) -> Result<SeriesCsv> {
     let err = |msg: String| Error::input(msg).in_file(path);
-    let bytes = std::fs::read(path).map_err(|source| Error::Io {
-        path: path.to_path_buf(),
-        source,
-    })?;
-    let text = String::from_utf8(bytes).map_err(|e| {
-        err(format!(
-            "not UTF-8 text (byte {})",
-            e.utf8_error().valid_up_to()
-        ))
-    })?;
+    let bytes = std::fs::read(path).map_err(|source| Error::Io { path: path.to_path_buf(), source })?;
+    let text =
+        String::from_utf8(bytes).map_err(|e| err(format!("not UTF-8 text (byte {})", e.utf8_error().valid_up_to())))?;
     let text = text.strip_prefix('\u{feff}').unwrap_or(&text);
-    let mut reader = csv::ReaderBuilder::new()
-        .has_headers(false)
-        .trim(csv::Trim::All)
-        .from_reader(text.as_bytes());
+    let mut reader = csv::ReaderBuilder::new().has_headers(false).trim(csv::Trim::All).from_reader(text.as_bytes());
     let mut rows: Vec<(u64, Vec<String>)> = Vec::new();
     for rec in reader.records() {
         let rec = rec.map_err(|e| err(format!("malformed CSV: {e}")))?;
@@ -131,15 +116,9 @@ pub fn read_series(path: &Path, options: &SeriesCsvOptions) -> Result<SeriesCsv>
     let ncols = rows[0].1.len();
     // a header: a cell that is text where the next row holds a number or a date
     let has_header = rows.len() >= 2
-        && (0..ncols).any(|c| {
-            kind(&rows[0].1[c]) == Kind::Text
-                && matches!(kind(&rows[1].1[c]), Kind::Number | Kind::Date)
-        });
-    let names: Vec<String> = if has_header {
-        rows[0].1.clone()
-    } else {
-        (0..ncols).map(|c| c.to_string()).collect()
-    };
+        && (0..ncols)
+            .any(|c| kind(&rows[0].1[c]) == Kind::Text && matches!(kind(&rows[1].1[c]), Kind::Number | Kind::Date));
+    let names: Vec<String> = if has_header { rows[0].1.clone() } else { (0..ncols).map(|c| c.to_string()).collect() };
     let data = if has_header { &rows[1..] } else { &rows[..] };
     if data.is_empty() {
         return Err(err("the file has a header but no data rows".into()));
@@ -167,62 +146,38 @@ pub fn read_series(path: &Path, options: &SeriesCsvOptions) -> Result<SeriesCsv>
         }
         match spec.parse::<usize>() {
             Ok(c) if c < ncols => Ok(c),
-            _ => Err(err(format!(
-                "no column `{spec}` (columns: {})",
-                names.join(", ")
-            ))),
+            _ => Err(err(format!("no column `{spec}` (columns: {})", names.join(", ")))),
         }
     };
     let value_col = match &options.column {
         Some(spec) => find(spec)?,
-        None => (0..ncols)
-            .rev()
-            .find(|&c| kinds[c] == Kind::Number)
-            .ok_or_else(|| {
-                err(format!(
-                    "no numeric column (columns: {}); choose one with --column",
-                    names.join(", ")
-                ))
-            })?,
+        None => (0..ncols).rev().find(|&c| kinds[c] == Kind::Number).ok_or_else(|| {
+            err(format!("no numeric column (columns: {}); choose one with --column", names.join(", ")))
+        })?,
     };
     let x_col = match options.x_column.as_deref() {
         Some("none") => None,
         Some(spec) => Some(find(spec)?),
         None => {
-            let named = ["x", "t", "time", "date"]
-                .contains(&names[0].to_ascii_lowercase().as_str())
-                && has_header;
-            (value_col != 0 && (kinds[0] == Kind::Date || (named && kinds[0] == Kind::Number)))
-                .then_some(0)
+            let named = ["x", "t", "time", "date"].contains(&names[0].to_ascii_lowercase().as_str()) && has_header;
+            (value_col != 0 && (kinds[0] == Kind::Date || (named && kinds[0] == Kind::Number))).then_some(0)
         }
     };
     if x_col == Some(value_col) {
-        return Err(err(format!(
-            "the x column and the value column are both `{}`",
-            names[value_col]
-        )));
+        return Err(err(format!("the x column and the value column are both `{}`", names[value_col])));
     }
     let mut values = Vec::with_capacity(data.len());
     for (line, r) in data {
         let cell = &r[value_col];
         let v = parse_number(cell).ok_or_else(|| {
             if cell.trim().is_empty() {
-                err(format!(
-                    "line {line}: missing value in column `{}`",
-                    names[value_col]
-                ))
+                err(format!("line {line}: missing value in column `{}`", names[value_col]))
             } else {
-                err(format!(
-                    "line {line}: `{cell}` in column `{}` is not a number",
-                    names[value_col]
-                ))
+                err(format!("line {line}: `{cell}` in column `{}` is not a number", names[value_col]))
             }
         })?;
         if !v.is_finite() {
-            return Err(err(format!(
-                "line {line}: value {v} in column `{}` is not finite",
-                names[value_col]
-            )));
+            return Err(err(format!("line {line}: value {v} in column `{}` is not finite", names[value_col])));
         }
         values.push(v);
     }
@@ -238,12 +193,7 @@ pub fn read_series(path: &Path, options: &SeriesCsvOptions) -> Result<SeriesCsv>
             let mut text = Vec::with_capacity(values.len());
             for (line, r) in data {
                 let cell = r[c].trim();
-                let v = if dates {
-                    parse_date_days(cell)
-                } else {
-                    parse_number(cell)
-                }
-                .filter(|v| v.is_finite());
+                let v = if dates { parse_date_days(cell) } else { parse_number(cell) }.filter(|v| v.is_finite());
                 let v = v.ok_or_else(|| {
                     err(format!(
                         "line {line}: `{cell}` in x column `{}` is not a {}",
@@ -264,8 +214,8 @@ pub fn read_series(path: &Path, options: &SeriesCsvOptions) -> Result<SeriesCsv>
                 )));
             }
             let source = if dates {
-                let first = NaiveDate::from_ymd_opt(1970, 1, 1).expect("valid")
-                    + chrono::Duration::days(x[0].floor() as i64);
+                let first =
+                    NaiveDate::from_ymd_opt(1970, 1, 1).expect("valid") + chrono::Duration::days(x[0].floor() as i64);
                 XSource::Dates(names[c].clone(), first)
             } else {
                 XSource::Numeric(names[c].clone())
@@ -274,18 +224,9 @@ pub fn read_series(path: &Path, options: &SeriesCsvOptions) -> Result<SeriesCsv>
         }
     };
     if values.len() < 2 {
-        return Err(err(format!(
-            "a series needs at least 2 samples, found {}",
-            values.len()
-        )));
+        return Err(err(format!("a series needs at least 2 samples, found {}", values.len())));
     }
-    Ok(SeriesCsv {
-        column: names[value_col].clone(),
-        values,
-        x,
-        x_text,
-        x_source,
-    })
+    Ok(SeriesCsv { column: names[value_col].clone(), values, x, x_text, x_source })
 }
 
 /// The verifiable output of `smooth` on a series.
@@ -336,62 +277,36 @@ fn csv_cell(s: &str) -> String {
 /// Input errors naming the file and line: missing columns, unparsable numbers, unknown roles.
 pub fn read_series_output(path: &Path) -> Result<SeriesOutput> {
     let err = |msg: String| Error::input(msg).in_file(path);
-    let file = std::fs::File::open(path).map_err(|source| Error::Io {
-        path: path.to_path_buf(),
-        source,
-    })?;
-    let mut reader = csv::ReaderBuilder::new()
-        .has_headers(true)
-        .trim(csv::Trim::All)
-        .from_reader(file);
-    let header = reader
-        .headers()
-        .map_err(|e| err(format!("malformed CSV: {e}")))?
-        .clone();
+    let file = std::fs::File::open(path).map_err(|source| Error::Io { path: path.to_path_buf(), source })?;
+    let mut reader = csv::ReaderBuilder::new().has_headers(true).trim(csv::Trim::All).from_reader(file);
+    let header = reader.headers().map_err(|e| err(format!("malformed CSV: {e}")))?.clone();
     let col = |name: &str| {
         header.iter().position(|h| h == name).ok_or_else(|| {
-            err(format!(
-                "no `{name}` column: a verifiable series file has the header x,input,output,u,role"
-            ))
+            err(format!("no `{name}` column: a verifiable series file has the header x,input,output,u,role"))
         })
     };
     let (ci, co, cu, cr) = (col("input")?, col("output")?, col("u")?, col("role")?);
     let cx = header.iter().position(|h| h == "x");
-    let mut out = SeriesOutput {
-        x_text: vec![],
-        input: vec![],
-        output: vec![],
-        u: vec![],
-        roles: vec![],
-    };
+    let mut out = SeriesOutput { x_text: vec![], input: vec![], output: vec![], u: vec![], roles: vec![] };
     for rec in reader.records() {
         let rec = rec.map_err(|e| err(format!("malformed CSV: {e}")))?;
         let line = rec.position().map(|p| p.line()).unwrap_or(0);
         let num = |c: usize, name: &str| -> Result<f64> {
             let cell = rec.get(c).unwrap_or("");
-            cell.parse::<f64>().map_err(|_| {
-                err(format!(
-                    "line {line}: `{cell}` in column `{name}` is not a number"
-                ))
-            })
+            cell.parse::<f64>().map_err(|_| err(format!("line {line}: `{cell}` in column `{name}` is not a number")))
         };
         out.input.push(num(ci, "input")?);
         out.output.push(num(co, "output")?);
         out.u.push(num(cu, "u")?);
         let role = rec.get(cr).unwrap_or("");
-        out.roles.push(Role::from_label(role).ok_or_else(|| {
-            err(format!(
-                "line {line}: unknown role `{role}` (min, max, fixed, end or empty)"
-            ))
-        })?);
-        out.x_text
-            .push(cx.and_then(|c| rec.get(c)).unwrap_or("").to_string());
+        out.roles.push(
+            Role::from_label(role)
+                .ok_or_else(|| err(format!("line {line}: unknown role `{role}` (min, max, fixed, end or empty)")))?,
+        );
+        out.x_text.push(cx.and_then(|c| rec.get(c)).unwrap_or("").to_string());
     }
     if out.input.len() < 2 {
-        return Err(err(format!(
-            "a series needs at least 2 samples, found {}",
-            out.input.len()
-        )));
+        return Err(err(format!("a series needs at least 2 samples, found {}", out.input.len())));
     }
     Ok(out)
 }
@@ -410,39 +325,17 @@ mod tests {
 
     #[test]
     fn dates_headers_and_default_column() {
-        let p = tmp(
-            "a.csv",
-            "date,a,b,label\n2010-03-01,1,10,x\n2010-03-02,2,20,y\n2010-03-05,3,30,z\n",
-        );
+        let p = tmp("a.csv", "date,a,b,label\n2010-03-01,1,10,x\n2010-03-02,2,20,y\n2010-03-05,3,30,z\n");
         let s = read_series(&p, &SeriesCsvOptions::default()).unwrap();
         assert_eq!(s.column, "b");
         assert_eq!(s.values, vec![10.0, 20.0, 30.0]);
         assert_eq!(s.x[1] - s.x[0], 1.0);
         assert_eq!(s.x[2] - s.x[1], 3.0);
-        assert!(
-            matches!(s.x_source, XSource::Dates(_, d) if d == NaiveDate::from_ymd_opt(2010, 3, 1).unwrap())
-        );
-        let s = read_series(
-            &p,
-            &SeriesCsvOptions {
-                column: Some("a".into()),
-                ..Default::default()
-            },
-        )
-        .unwrap();
+        assert!(matches!(s.x_source, XSource::Dates(_, d) if d == NaiveDate::from_ymd_opt(2010, 3, 1).unwrap()));
+        let s = read_series(&p, &SeriesCsvOptions { column: Some("a".into()), ..Default::default() }).unwrap();
         assert_eq!(s.values, vec![1.0, 2.0, 3.0]);
-        let s = read_series(
-            &p,
-            &SeriesCsvOptions {
-                column: Some("1".into()),
-                x_column: Some("none".into()),
-            },
-        )
-        .unwrap();
-        assert_eq!(
-            (s.values.clone(), s.x_source),
-            (vec![1.0, 2.0, 3.0], XSource::Index)
-        );
+        let s = read_series(&p, &SeriesCsvOptions { column: Some("1".into()), x_column: Some("none".into()) }).unwrap();
+        assert_eq!((s.values.clone(), s.x_source), (vec![1.0, 2.0, 3.0], XSource::Index));
     }
 
     #[test]
@@ -460,11 +353,7 @@ mod tests {
             ("nan.csv", "v\n1\nNaN\n3\n", "line 3"),
             ("missing.csv", "v,w\n1,2\n3,\n4,5\n", "line 3"),
             ("ragged.csv", "a,b\n1,2\n3\n", "malformed"),
-            (
-                "dup.csv",
-                "date,v\n2010-01-01,1\n2010-01-01,2\n",
-                "strictly increase",
-            ),
+            ("dup.csv", "date,v\n2010-01-01,1\n2010-01-01,2\n", "strictly increase"),
             ("one.csv", "v\n1\n", "at least 2"),
             ("text.csv", "a,b\nx,y\nz,w\n", "no numeric column"),
         ];
@@ -476,14 +365,7 @@ mod tests {
             assert_eq!(e.exit_code(), 3);
         }
         let p = tmp("c.csv", "a\n1\n2\n");
-        let e = read_series(
-            &p,
-            &SeriesCsvOptions {
-                column: Some("zz".into()),
-                ..Default::default()
-            },
-        )
-        .unwrap_err();
+        let e = read_series(&p, &SeriesCsvOptions { column: Some("zz".into()), ..Default::default() }).unwrap_err();
         assert!(e.to_string().contains("no column `zz`"));
     }
 

@@ -17,10 +17,7 @@ pub struct Energy {
 impl Energy {
     /// A single order with weight 1.
     pub fn order(k: u8) -> Self {
-        Energy {
-            terms: vec![(k, 1.0)],
-            sharp: Vec::new(),
-        }
+        Energy { terms: vec![(k, 1.0)], sharp: Vec::new() }
     }
 
     /// Parses `2` or a blend `1:0.2,2:1`.
@@ -35,18 +32,12 @@ impl Energy {
                 Some((k, w)) => (k.trim(), w.trim()),
                 None => (part.trim(), "1"),
             };
-            let k: u8 = k.parse().map_err(|_| {
-                Error::Usage(format!("order `{k}` in `{spec}` is not an integer 1..4"))
-            })?;
-            let w: f64 = w
-                .parse()
-                .map_err(|_| Error::Usage(format!("weight `{w}` in `{spec}` is not a number")))?;
+            let k: u8 =
+                k.parse().map_err(|_| Error::Usage(format!("order `{k}` in `{spec}` is not an integer 1..4")))?;
+            let w: f64 = w.parse().map_err(|_| Error::Usage(format!("weight `{w}` in `{spec}` is not a number")))?;
             terms.push((k, w));
         }
-        let e = Energy {
-            terms,
-            sharp: Vec::new(),
-        };
+        let e = Energy { terms, sharp: Vec::new() };
         e.validate()?;
         Ok(e)
     }
@@ -58,27 +49,18 @@ impl Energy {
                 return Err(Error::Usage(format!("energy order {k} is outside 1..4")));
             }
             if !(w.is_finite() && w >= 0.0) {
-                return Err(Error::Usage(format!(
-                    "weight {w} of order {k} must be finite and ≥ 0"
-                )));
+                return Err(Error::Usage(format!("weight {w} of order {k} must be finite and ≥ 0")));
             }
         }
         if self.terms.iter().all(|&(_, w)| w == 0.0) {
-            return Err(Error::Usage(
-                "the smoothness energy needs a positive weight".into(),
-            ));
+            return Err(Error::Usage("the smoothness energy needs a positive weight".into()));
         }
         Ok(())
     }
 
     /// Highest order with a positive weight.
     pub fn max_order(&self) -> u8 {
-        self.terms
-            .iter()
-            .filter(|t| t.1 > 0.0)
-            .map(|t| t.0)
-            .max()
-            .unwrap_or(1)
+        self.terms.iter().filter(|t| t.1 > 0.0).map(|t| t.0).max().unwrap_or(1)
     }
 }
 
@@ -101,23 +83,12 @@ pub fn polyharmonic(k: &Sparse, m: &[f64], energy: &Energy, scale: &[f64]) -> Sp
     for &v in &energy.sharp {
         sharp[v] = true;
     }
-    let d: Vec<f64> = (0..n)
-        .map(|i| if sharp[i] { 0.0 } else { 1.0 / m[i] })
-        .collect();
-    let k_cut = if energy.sharp.is_empty() {
-        k.clone()
-    } else {
-        cut_edges(k, &sharp)
-    };
+    let d: Vec<f64> = (0..n).map(|i| if sharp[i] { 0.0 } else { 1.0 / m[i] }).collect();
+    let k_cut = if energy.sharp.is_empty() { k.clone() } else { cut_edges(k, &sharp) };
     let minv: Vec<f64> = m.iter().map(|x| 1.0 / x).collect();
     let mut all = Vec::new();
     let mut single: Option<Sparse> = None;
-    let active = energy
-        .terms
-        .iter()
-        .zip(scale)
-        .filter(|(t, s)| t.1 * **s != 0.0)
-        .count();
+    let active = energy.terms.iter().zip(scale).filter(|(t, s)| t.1 * **s != 0.0).count();
     for (&(order, w), &s) in energy.terms.iter().zip(scale) {
         let c = w * s;
         if c == 0.0 {
@@ -139,11 +110,7 @@ pub fn polyharmonic(k: &Sparse, m: &[f64], energy: &Energy, scale: &[f64]) -> Sp
         if active == 1 {
             single = Some(super::sparse::scaled_plus_diagonal(&q, c, &vec![0.0; n]));
         } else {
-            all.extend(
-                triplets(&q)
-                    .into_iter()
-                    .map(|t| Triplet::new(t.row, t.col, c * t.val)),
-            );
+            all.extend(triplets(&q).into_iter().map(|t| Triplet::new(t.row, t.col, c * t.val)));
         }
     }
     single.unwrap_or_else(|| from_triplets(n, n, &all))
@@ -184,9 +151,7 @@ mod tests {
             let dense = q.to_dense();
             for i in 0..7 {
                 for j in 0..7 {
-                    assert!(
-                        (dense[(i, j)] - dense[(j, i)]).abs() < 1e-9 * (1.0 + dense[(i, j)].abs())
-                    );
+                    assert!((dense[(i, j)] - dense[(j, i)]).abs() < 1e-9 * (1.0 + dense[(i, j)].abs()));
                 }
             }
         }
@@ -214,11 +179,7 @@ mod tests {
             e.sharp = vec![0, 4, 8];
             let sharp = polyharmonic(&k, &m, &e, &[1.0]);
             assert!(quadratic_form(&plain, &f) > 1.0, "order {order}");
-            assert!(
-                quadratic_form(&sharp, &f).abs() < 1e-10,
-                "order {order}: {}",
-                quadratic_form(&sharp, &f)
-            );
+            assert!(quadratic_form(&sharp, &f).abs() < 1e-10, "order {order}: {}", quadratic_form(&sharp, &f));
         }
     }
 

@@ -49,11 +49,7 @@ mod tests {
         }
         // f = x² sampled: ∫ (f')² of the interpolant = Σ (Δf)²/h
         let f: Vec<f64> = s.x().iter().map(|x| x * x).collect();
-        let exact: f64 = s
-            .x()
-            .windows(2)
-            .map(|w| (w[1] * w[1] - w[0] * w[0]).powi(2) / (w[1] - w[0]))
-            .sum();
+        let exact: f64 = s.x().windows(2).map(|w| (w[1] * w[1] - w[0] * w[0]).powi(2) / (w[1] - w[0])).sum();
         assert!((quadratic_form(&k, &f) - exact).abs() < 1e-12 * exact);
         let m = series_mass(&s);
         assert!((m.iter().sum::<f64>() - 2.25).abs() < 1e-15);

@@ -7,13 +7,8 @@ use faer::Par;
 pub type Sparse = SparseColMat<usize, f64>;
 
 /// Builds an `n × n` matrix from `(row, col, value)` triplets; duplicates are summed.
-pub(crate) fn from_triplets(
-    nrows: usize,
-    ncols: usize,
-    t: &[Triplet<usize, usize, f64>],
-) -> Sparse {
-    SparseColMat::try_new_from_triplets(nrows, ncols, t)
-        .expect("triplets are in range by construction")
+pub(crate) fn from_triplets(nrows: usize, ncols: usize, t: &[Triplet<usize, usize, f64>]) -> Sparse {
+    SparseColMat::try_new_from_triplets(nrows, ncols, t).expect("triplets are in range by construction")
 }
 
 /// All stored entries as triplets.
@@ -66,18 +61,14 @@ pub fn scaled_plus_diagonal(a: &Sparse, c: f64, d: &[f64]) -> Sparse {
         }
         return out;
     }
-    let mut t: Vec<_> = triplets(a)
-        .into_iter()
-        .map(|t| Triplet::new(t.row, t.col, c * t.val))
-        .collect();
+    let mut t: Vec<_> = triplets(a).into_iter().map(|t| Triplet::new(t.row, t.col, c * t.val)).collect();
     t.extend((0..n).map(|i| Triplet::new(i, i, d[i])));
     from_triplets(n, n, &t)
 }
 
 /// `A · B`.
 pub(crate) fn matmul(a: &Sparse, b: &Sparse) -> Sparse {
-    sparse_sparse_matmul(a.as_ref(), b.as_ref(), 1.0, Par::Seq)
-        .expect("sparse product fits in memory")
+    sparse_sparse_matmul(a.as_ref(), b.as_ref(), 1.0, Par::Seq).expect("sparse product fits in memory")
 }
 
 /// `fᵀ A f`.

@@ -81,10 +81,7 @@ impl Normal {
             col_ptr[j + 1] = row_idx.len();
         }
         let find = |i: usize, j: usize| {
-            col_ptr[j]
-                + row_idx[col_ptr[j]..col_ptr[j + 1]]
-                    .binary_search(&i)
-                    .expect("in pattern")
+            col_ptr[j] + row_idx[col_ptr[j]..col_ptr[j + 1]].binary_search(&i).expect("in pattern")
         };
         let pos_p = r.p.iter().map(|&(i, j, _)| find(i, j)).collect();
         let pos_row = row_cols
@@ -92,11 +89,7 @@ impl Normal {
             .zip(row_len)
             .map(|(c, &len)| {
                 if len == 2 {
-                    [
-                        find(c[0], c[0]),
-                        find(c[1], c[1]),
-                        find(c[0].min(c[1]), c[0].max(c[1])),
-                    ]
+                    [find(c[0], c[0]), find(c[1], c[1]), find(c[0].min(c[1]), c[0].max(c[1]))]
                 } else {
                     let d = find(c[0], c[0]);
                     [d, d, d]
@@ -105,12 +98,7 @@ impl Normal {
             .collect();
         let pos_diag = (0..n).map(|j| find(j, j)).collect();
         let symbolic = SymbolicSparseColMat::new_checked(n, n, col_ptr, None, row_idx);
-        Normal {
-            symbolic,
-            pos_p,
-            pos_row,
-            pos_diag,
-        }
+        Normal { symbolic, pos_p, pos_row, pos_diag }
     }
 }
 
@@ -164,8 +152,8 @@ pub fn solve(
     };
 
     let normal = Normal::new(r, &row_cols, &row_len);
-    let symbolic = SymbolicLlt::try_new(normal.symbolic.as_ref(), Side::Upper)
-        .map_err(|e| format!("symbolic Cholesky: {e:?}"))?;
+    let symbolic =
+        SymbolicLlt::try_new(normal.symbolic.as_ref(), Side::Upper).map_err(|e| format!("symbolic Cholesky: {e:?}"))?;
     let nnz = normal.symbolic.row_idx().len();
     let mut vals = vec![0.0f64; nnz];
     let factor = |w: &[f64], vals: &mut Vec<f64>| -> Result<Llt<usize, f64>, String> {
@@ -233,16 +221,11 @@ pub fn solve(
     let bnorm = 1.0 + r.b.iter().fold(0.0f64, |a, v| a.max(v.abs()));
     let qnorm = 1.0 + r.q.iter().fold(0.0f64, |a, v| a.max(v.abs()));
     let tol = settings.tolerance;
-    let (mut rd, mut rp, mut tmp_n, mut tmp_m) =
-        (vec![0.0; n], vec![0.0; m], vec![0.0; n], vec![0.0; m]);
+    let (mut rd, mut rp, mut tmp_n, mut tmp_m) = (vec![0.0; n], vec![0.0; m], vec![0.0; n], vec![0.0; m]);
     let (mut dx, mut ds, mut dz, mut rc) = (vec![0.0; n], vec![0.0; m], vec![0.0; m], vec![0.0; m]);
     let mut w = vec![0.0; m];
-    let step = |v: &[f64], d: &[f64]| {
-        v.iter().zip(d).fold(
-            1.0f64,
-            |a, (&v, &d)| if d < 0.0 { a.min(-v / d) } else { a },
-        )
-    };
+    let step =
+        |v: &[f64], d: &[f64]| v.iter().zip(d).fold(1.0f64, |a, (&v, &d)| if d < 0.0 { a.min(-v / d) } else { a });
     let mut last = (f64::INFINITY, f64::INFINITY, f64::INFINITY);
     for it in 0..settings.max_iter {
         // residuals
@@ -270,33 +253,29 @@ pub fn solve(
         }
         let f = factor(&w, &mut vals)?;
         // one Newton direction for complementarity target rc (s∘z − rc → 0)
-        let mut direction =
-            |rc: &[f64], dx: &mut Vec<f64>, ds: &mut Vec<f64>, dz: &mut Vec<f64>| {
-                for k in 0..m {
-                    tmp_m[k] = w[k] * rp[k] - rc[k] / s[k];
-                }
-                atz(&tmp_m, dx);
-                for i in 0..n {
-                    dx[i] = -rd[i] - dx[i];
-                }
-                solve_with(&f, dx);
-                ax(dx, ds);
-                for k in 0..m {
-                    let adx = ds[k];
-                    dz[k] = w[k] * (adx + rp[k]) - rc[k] / s[k];
-                    ds[k] = -rp[k] - adx;
-                }
-            };
+        let mut direction = |rc: &[f64], dx: &mut Vec<f64>, ds: &mut Vec<f64>, dz: &mut Vec<f64>| {
+            for k in 0..m {
+                tmp_m[k] = w[k] * rp[k] - rc[k] / s[k];
+            }
+            atz(&tmp_m, dx);
+            for i in 0..n {
+                dx[i] = -rd[i] - dx[i];
+            }
+            solve_with(&f, dx);
+            ax(dx, ds);
+            for k in 0..m {
+                let adx = ds[k];
+                dz[k] = w[k] * (adx + rp[k]) - rc[k] / s[k];
+                ds[k] = -rp[k] - adx;
+            }
+        };
         // predictor
         for k in 0..m {
             rc[k] = s[k] * z[k];
         }
         direction(&rc, &mut dx, &mut ds, &mut dz);
         let alpha_aff = step(&s, &ds).min(step(&z, &dz)).min(1.0);
-        let mu_aff = (0..m)
-            .map(|k| (s[k] + alpha_aff * ds[k]) * (z[k] + alpha_aff * dz[k]))
-            .sum::<f64>()
-            / m as f64;
+        let mu_aff = (0..m).map(|k| (s[k] + alpha_aff * ds[k]) * (z[k] + alpha_aff * dz[k])).sum::<f64>() / m as f64;
         let sigma = (mu_aff / mu).powi(3).min(1.0);
         // corrector
         for k in 0..m {

@@ -9,7 +9,5 @@ mod ipm;
 mod qp;
 mod repair;
 
-pub use qp::{
-    solve_monotone_qp, Method, MonotoneQp, QpSettings, QpSolution, ReducedQp, SolveStatus,
-};
+pub use qp::{solve_monotone_qp, Method, MonotoneQp, QpSettings, QpSolution, ReducedQp, SolveStatus};
 pub use repair::{repair, RepairSummary};

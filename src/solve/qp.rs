@@ -45,11 +45,7 @@ pub struct QpSettings {
 
 impl Default for QpSettings {
     fn default() -> Self {
-        QpSettings {
-            max_iter: 200,
-            tolerance: 1e-9,
-            method: Method::Structured,
-        }
+        QpSettings { max_iter: 200, tolerance: 1e-9, method: Method::Structured }
     }
 }
 
@@ -148,13 +144,7 @@ pub fn solve_monotone_qp(qp: &MonotoneQp<'_>, settings: &QpSettings) -> Result<Q
     for (k, &i) in free.iter().enumerate() {
         x[i] = xf[k];
     }
-    Ok(QpSolution {
-        x,
-        status,
-        iterations,
-        method,
-        fallback,
-    })
+    Ok(QpSolution { x, status, iterations, method, fallback })
 }
 
 /// Eliminates the fixed variables: `P_FF`, `q_F + P_FX x_X`, and one row per constrained edge.
@@ -166,11 +156,7 @@ fn reduce(qp: &MonotoneQp<'_>, free: &[usize]) -> ReducedQp {
     }
     let xfix = |i: usize| qp.fixed[i].unwrap_or(0.0);
     let mut q: Vec<f64> = free.iter().map(|&i| qp.q[i]).collect();
-    let (cp, ri, val) = (
-        qp.p.symbolic().col_ptr(),
-        qp.p.symbolic().row_idx(),
-        qp.p.val(),
-    );
+    let (cp, ri, val) = (qp.p.symbolic().col_ptr(), qp.p.symbolic().row_idx(), qp.p.val());
     let mut p = Vec::new();
     for j in 0..n {
         for k in cp[j]..cp[j + 1] {
@@ -189,15 +175,7 @@ fn reduce(qp: &MonotoneQp<'_>, free: &[usize]) -> ReducedQp {
     p.iter_mut().for_each(|t| t.2 /= scale);
     q.iter_mut().for_each(|v| *v /= scale);
     // f_j − f_i ≥ ε  ⇔  f_i − f_j ≤ −ε
-    let mut r = ReducedQp {
-        n: nf,
-        p,
-        q,
-        a_row: vec![],
-        a_col: vec![],
-        a_val: vec![],
-        b: vec![],
-    };
+    let mut r = ReducedQp { n: nf, p, q, a_row: vec![], a_col: vec![], a_val: vec![], b: vec![] };
     for &(i, j) in qp.edges {
         let row = r.b.len();
         let mut push = |col: usize, v: f64| {
@@ -233,44 +211,19 @@ mod tests {
     #[test]
     fn both_solvers_project_onto_a_monotone_chain() {
         // min Σ (f_i − h_i)² with f_0 = 0, f_3 = 3 fixed and f increasing: h = [0, 2, 1, 3]
-        let p = Sparse::try_new_from_triplets(
-            4,
-            4,
-            &(0..4).map(|i| Triplet::new(i, i, 1.0)).collect::<Vec<_>>(),
-        )
-        .unwrap();
+        let p =
+            Sparse::try_new_from_triplets(4, 4, &(0..4).map(|i| Triplet::new(i, i, 1.0)).collect::<Vec<_>>()).unwrap();
         let q = [0.0, -2.0, -1.0, -3.0];
         let fixed = [Some(0.0), None, None, Some(3.0)];
         let edges = [(0, 1), (1, 2), (2, 3)];
         for method in [Method::Structured, Method::Clarabel] {
             for hint in [None, Some(&[0.0, 1.0, 2.0, 3.0][..])] {
-                let qp = MonotoneQp {
-                    p: &p,
-                    q: &q,
-                    fixed: &fixed,
-                    edges: &edges,
-                    margin: 1e-6,
-                    hint,
-                };
-                let sol = solve_monotone_qp(
-                    &qp,
-                    &QpSettings {
-                        method,
-                        ..Default::default()
-                    },
-                )
-                .unwrap();
+                let qp = MonotoneQp { p: &p, q: &q, fixed: &fixed, edges: &edges, margin: 1e-6, hint };
+                let sol = solve_monotone_qp(&qp, &QpSettings { method, ..Default::default() }).unwrap();
                 assert_eq!(sol.method, method, "{:?}", sol.fallback);
-                assert!(matches!(
-                    sol.status,
-                    SolveStatus::Solved | SolveStatus::AlmostSolved
-                ));
+                assert!(matches!(sol.status, SolveStatus::Solved | SolveStatus::AlmostSolved));
                 // isotonic regression pools 2 and 1 at 1.5 (then the margin splits them)
-                assert!(
-                    (sol.x[1] - 1.5).abs() < 1e-5 && (sol.x[2] - 1.5).abs() < 1e-5,
-                    "{method:?}: {:?}",
-                    sol.x
-                );
+                assert!((sol.x[1] - 1.5).abs() < 1e-5 && (sol.x[2] - 1.5).abs() < 1e-5, "{method:?}: {:?}", sol.x);
                 assert!(sol.x[2] - sol.x[1] > 0.5e-6);
                 assert_eq!((sol.x[0], sol.x[3]), (0.0, 3.0));
             }

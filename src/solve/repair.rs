@@ -21,26 +21,12 @@ pub struct RepairSummary {
 /// given step, or one ulp where that is smaller than the spacing of doubles). Fixed values
 /// never change, so kept values stay bit for bit; the passes repeat (at most 4 sweeps) until
 /// no edge is violated. Whether that succeeded is for the certificate to decide.
-pub fn repair(
-    f: &mut [f64],
-    fixed: &[bool],
-    edges: &[(usize, usize)],
-    order: &[usize],
-    delta: f64,
-) -> RepairSummary {
+pub fn repair(f: &mut [f64], fixed: &[bool], edges: &[(usize, usize)], order: &[usize], delta: f64) -> RepairSummary {
     let n = f.len();
     // `strictly_below(a, b)` is false for NaN too, so NaN counts as a violation
     let strictly_below = |a: f64, b: f64| a.partial_cmp(&b) == Some(std::cmp::Ordering::Less);
-    let violated = |f: &[f64]| {
-        edges
-            .iter()
-            .filter(|&&(i, j)| !strictly_below(f[i], f[j]))
-            .count()
-    };
-    let mut summary = RepairSummary {
-        violated_edges: violated(f),
-        ..Default::default()
-    };
+    let violated = |f: &[f64]| edges.iter().filter(|&&(i, j)| !strictly_below(f[i], f[j])).count();
+    let mut summary = RepairSummary { violated_edges: violated(f), ..Default::default() };
     if summary.violated_edges == 0 {
         return summary;
     }

@@ -7,7 +7,6 @@ pub mod persistence;
 pub mod selection;
 
 pub use persistence::{
-    count_sos_extrema, extrema_table, sublevel_pairs, superlevel_pairs, ExtremumInfo, ExtremumKind,
-    Pair,
+    count_sos_extrema, extrema_table, sublevel_pairs, superlevel_pairs, ExtremumInfo, ExtremumKind, Pair,
 };
 pub use selection::{select, KeptExtremum, KeptSet, Role, Selection};

@@ -66,18 +66,11 @@ fn union_find_pairs<D: Domain>(domain: &D, values: &[f64], order: &[usize]) -> V
         if roots.is_empty() {
             oldest[v] = v;
             pair_of[v] = pairs.len();
-            pairs.push(Pair {
-                extremum: v,
-                partner: None,
-                persistence: f64::INFINITY,
-            });
+            pairs.push(Pair { extremum: v, partner: None, persistence: f64::INFINITY });
             continue;
         }
         // the elder component survives: its oldest extremum entered first
-        let elder = *roots
-            .iter()
-            .min_by_key(|&&r| rank[oldest[r]])
-            .expect("non-empty");
+        let elder = *roots.iter().min_by_key(|&&r| rank[oldest[r]]).expect("non-empty");
         let survivor = oldest[elder];
         for &r in &roots {
             let born = oldest[r];
@@ -100,15 +93,9 @@ fn union_find_pairs<D: Domain>(domain: &D, values: &[f64], order: &[usize]) -> V
 pub fn count_sos_extrema<D: Domain>(domain: &D, values: &[f64]) -> (usize, usize) {
     let (mut minima, mut maxima) = (0, 0);
     for v in 0..domain.n_vertices() {
-        if domain
-            .neighbors(v)
-            .all(|w| crate::domain::sos_greater(values, w, v))
-        {
+        if domain.neighbors(v).all(|w| crate::domain::sos_greater(values, w, v)) {
             minima += 1;
-        } else if domain
-            .neighbors(v)
-            .all(|w| crate::domain::sos_less(values, w, v))
-        {
+        } else if domain.neighbors(v).all(|w| crate::domain::sos_less(values, w, v)) {
             maxima += 1;
         }
     }
@@ -160,13 +147,7 @@ fn finite_or_null<S: serde::Serializer>(v: &Option<f64>, s: S) -> Result<S::Ok, 
 pub fn extrema_table<D: Domain>(domain: &D, values: &[f64]) -> Vec<ExtremumInfo> {
     let n = domain.n_vertices();
     let strict = |v: usize, lower: bool| {
-        domain.neighbors(v).all(|w| {
-            if lower {
-                values[w] > values[v]
-            } else {
-                values[w] < values[v]
-            }
-        })
+        domain.neighbors(v).all(|w| if lower { values[w] > values[v] } else { values[w] < values[v] })
     };
     let mut rows = Vec::new();
     for p in sublevel_pairs(domain, values) {
@@ -188,9 +169,7 @@ pub fn extrema_table<D: Domain>(domain: &D, values: &[f64]) -> Vec<ExtremumInfo>
                 }
             }
             for v in 0..n {
-                let is_max = domain
-                    .neighbors(v)
-                    .all(|w| crate::domain::sos_less(values, w, v));
+                let is_max = domain.neighbors(v).all(|w| crate::domain::sos_less(values, w, v));
                 if !is_max {
                     continue;
                 }
@@ -243,10 +222,7 @@ mod tests {
         assert_eq!(get(0).partner, Some(1));
         assert_eq!(get(0).persistence, 3.0);
         let maxima = superlevel_pairs(&s, &h);
-        assert_eq!(
-            maxima.iter().find(|p| p.extremum == 1).unwrap().persistence,
-            f64::INFINITY
-        );
+        assert_eq!(maxima.iter().find(|p| p.extremum == 1).unwrap().persistence, f64::INFINITY);
     }
 
     #[test]

@@ -125,19 +125,11 @@ pub struct KeptSet {
 impl KeptSet {
     /// Indices of kept minima.
     pub fn minima(&self) -> Vec<usize> {
-        self.kept
-            .iter()
-            .filter(|k| k.role == Role::Min)
-            .map(|k| k.index)
-            .collect()
+        self.kept.iter().filter(|k| k.role == Role::Min).map(|k| k.index).collect()
     }
     /// Indices of kept maxima.
     pub fn maxima(&self) -> Vec<usize> {
-        self.kept
-            .iter()
-            .filter(|k| k.role == Role::Max)
-            .map(|k| k.index)
-            .collect()
+        self.kept.iter().filter(|k| k.role == Role::Max).map(|k| k.index).collect()
     }
 }
 
@@ -154,20 +146,11 @@ pub fn select<D: Domain>(domain: &D, values: &[f64], selection: &Selection) -> R
     let n = domain.n_vertices();
     assert_eq!(values.len(), n, "one value per vertex");
     if let Some(i) = values.iter().position(|v| !v.is_finite()) {
-        return Err(Error::input(format!(
-            "value at vertex {i} is not finite ({})",
-            values[i]
-        )));
+        return Err(Error::input(format!("value at vertex {i} is not finite ({})", values[i])));
     }
-    let (lo, hi) = values
-        .iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
-            (a.min(v), b.max(v))
-        });
+    let (lo, hi) = values.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| (a.min(v), b.max(v)));
     if lo == hi {
-        return Err(Error::input(format!(
-            "the field is constant ({lo}): it has no extrema to keep"
-        )));
+        return Err(Error::input(format!("the field is constant ({lo}): it has no extrema to keep")));
     }
     let mut warnings = Vec::new();
     let mut threshold = None;
@@ -175,64 +158,36 @@ pub fn select<D: Domain>(domain: &D, values: &[f64], selection: &Selection) -> R
     let (kept_min, kept_max): (Kept, Kept) = match selection {
         Selection::Explicit { minima, maxima } => {
             check_explicit(domain, values, minima, maxima)?;
-            let pers_min = |v: usize| {
-                minima_pairs
-                    .iter()
-                    .find(|p| p.extremum == v)
-                    .map(|p| p.persistence)
-            };
-            (
-                minima.iter().map(|&v| (v, pers_min(v))).collect(),
-                maxima.iter().map(|&v| (v, None)).collect(),
-            )
+            let pers_min = |v: usize| minima_pairs.iter().find(|p| p.extremum == v).map(|p| p.persistence);
+            (minima.iter().map(|&v| (v, pers_min(v))).collect(), maxima.iter().map(|&v| (v, None)).collect())
         }
         Selection::Absolute(t) | Selection::Relative(t) => {
             if !(t.is_finite() && *t > 0.0) {
-                return Err(Error::Usage(format!(
-                    "the persistence threshold must be > 0, got {t}"
-                )));
+                return Err(Error::Usage(format!("the persistence threshold must be > 0, got {t}")));
             }
-            let t = if matches!(selection, Selection::Relative(_)) {
-                t * (hi - lo)
-            } else {
-                *t
-            };
+            let t = if matches!(selection, Selection::Relative(_)) { t * (hi - lo) } else { *t };
             threshold = Some(t);
             match domain.pairing_rule() {
-                PairingRule::Path => {
-                    path_by_rank(values, &minima_pairs, |p| p.persistence >= t, usize::MAX)
-                }
+                PairingRule::Path => path_by_rank(values, &minima_pairs, |p| p.persistence >= t, usize::MAX),
                 PairingRule::Surface => {
                     let maxima_pairs = superlevel_pairs(domain, values);
-                    (
-                        by_threshold(&minima_pairs, t),
-                        by_threshold(&maxima_pairs, t),
-                    )
+                    (by_threshold(&minima_pairs, t), by_threshold(&maxima_pairs, t))
                 }
             }
         }
         Selection::Pairs(count) => {
             if domain.pairing_rule() != PairingRule::Path {
-                return Err(Error::Usage(
-                    "--pairs applies to series; use --minima/--maxima".into(),
-                ));
+                return Err(Error::Usage("--pairs applies to series; use --minima/--maxima".into()));
             }
-            let available = minima_pairs
-                .iter()
-                .filter(|p| p.partner.is_some() && p.persistence > 0.0)
-                .count();
+            let available = minima_pairs.iter().filter(|p| p.partner.is_some() && p.persistence > 0.0).count();
             if *count > available {
-                warnings.push(format!(
-                    "asked for {count} pairs, the series has {available}: keeping all"
-                ));
+                warnings.push(format!("asked for {count} pairs, the series has {available}: keeping all"));
             }
             path_by_rank(values, &minima_pairs, |p| p.persistence > 0.0, *count)
         }
         Selection::Count { minima, maxima } => {
             if domain.pairing_rule() == PairingRule::Path {
-                return Err(Error::Usage(
-                    "on a series a count means pairs: use --pairs N".into(),
-                ));
+                return Err(Error::Usage("on a series a count means pairs: use --pairs N".into()));
             }
             let maxima_pairs = superlevel_pairs(domain, values);
             let (a, w1) = by_count(values, &minima_pairs, *minima, true);
@@ -277,12 +232,7 @@ pub fn select<D: Domain>(domain: &D, values: &[f64], selection: &Selection) -> R
             })?;
         }
     }
-    Ok(KeptSet {
-        roles,
-        kept,
-        threshold,
-        warnings,
-    })
+    Ok(KeptSet { roles, kept, threshold, warnings })
 }
 
 /// Series rule: rank (minimum, maximum) pairs by persistence (ties: lower (value, index) of
@@ -290,12 +240,7 @@ pub fn select<D: Domain>(domain: &D, values: &[f64], selection: &Selection) -> R
 /// the global maximum are always kept (when the global maximum's pair is dropped, only its
 /// minimum goes).
 type Kept = Vec<(usize, Option<f64>)>;
-fn path_by_rank(
-    values: &[f64],
-    pairs: &[Pair],
-    keep: impl Fn(&Pair) -> bool,
-    count: usize,
-) -> (Kept, Kept) {
+fn path_by_rank(values: &[f64], pairs: &[Pair], keep: impl Fn(&Pair) -> bool, count: usize) -> (Kept, Kept) {
     let n = values.len();
     let gmax = (0..n).fold(0, |b, v| if sos_greater(values, v, b) { v } else { b });
     let mut ranked: Vec<&Pair> = pairs.iter().filter(|p| p.partner.is_some()).collect();
@@ -312,37 +257,24 @@ fn path_by_rank(
     }
     for p in ranked.into_iter().filter(|p| keep(p)).take(count) {
         mins.push((p.extremum, Some(p.persistence)));
-        maxs.push((
-            p.partner.expect("ranked pairs have partners"),
-            Some(p.persistence),
-        ));
+        maxs.push((p.partner.expect("ranked pairs have partners"), Some(p.persistence)));
     }
     if !maxs.iter().any(|&(v, _)| v == gmax) {
-        let p = pairs
-            .iter()
-            .find(|p| p.partner == Some(gmax))
-            .map(|p| p.persistence);
+        let p = pairs.iter().find(|p| p.partner == Some(gmax)).map(|p| p.persistence);
         maxs.push((gmax, p));
     }
     (mins, maxs)
 }
 
 fn by_threshold(pairs: &[Pair], t: f64) -> Kept {
-    pairs
-        .iter()
-        .filter(|p| p.persistence >= t)
-        .map(|p| (p.extremum, Some(p.persistence)))
-        .collect()
+    pairs.iter().filter(|p| p.persistence >= t).map(|p| (p.extremum, Some(p.persistence))).collect()
 }
 
 fn by_count(values: &[f64], pairs: &[Pair], count: usize, minima: bool) -> (Kept, Option<String>) {
     let mut ranked: Vec<&Pair> = pairs.iter().filter(|p| p.persistence > 0.0).collect();
     ranked.sort_by(|a, b| {
-        let sos = if minima {
-            sos_less(values, b.extremum, a.extremum)
-        } else {
-            sos_greater(values, b.extremum, a.extremum)
-        };
+        let sos =
+            if minima { sos_less(values, b.extremum, a.extremum) } else { sos_greater(values, b.extremum, a.extremum) };
         b.persistence.total_cmp(&a.persistence).then(if sos {
             std::cmp::Ordering::Greater
         } else {
@@ -358,22 +290,10 @@ fn by_count(values: &[f64], pairs: &[Pair], count: usize, minima: bool) -> (Kept
             ranked.len()
         )
     });
-    (
-        ranked
-            .into_iter()
-            .take(count)
-            .map(|p| (p.extremum, Some(p.persistence)))
-            .collect(),
-        warning,
-    )
+    (ranked.into_iter().take(count).map(|p| (p.extremum, Some(p.persistence))).collect(), warning)
 }
 
-fn check_explicit<D: Domain>(
-    domain: &D,
-    values: &[f64],
-    minima: &[usize],
-    maxima: &[usize],
-) -> Result<()> {
+fn check_explicit<D: Domain>(domain: &D, values: &[f64], minima: &[usize], maxima: &[usize]) -> Result<()> {
     let n = domain.n_vertices();
     if minima.is_empty() || maxima.is_empty() {
         return Err(Error::infeasible(format!(
@@ -383,15 +303,9 @@ fn check_explicit<D: Domain>(
         )));
     }
     let mut seen = vec![false; n];
-    for (&v, is_min) in minima
-        .iter()
-        .map(|v| (v, true))
-        .chain(maxima.iter().map(|v| (v, false)))
-    {
+    for (&v, is_min) in minima.iter().map(|v| (v, true)).chain(maxima.iter().map(|v| (v, false))) {
         if v >= n {
-            return Err(Error::infeasible(format!(
-                "vertex {v} is out of range (the input has {n} vertices)"
-            )));
+            return Err(Error::infeasible(format!("vertex {v} is out of range (the input has {n} vertices)")));
         }
         if seen[v] {
             return Err(Error::infeasible(format!("vertex {v} is listed twice")));
@@ -413,12 +327,7 @@ fn check_explicit<D: Domain>(
     if domain.pairing_rule() == PairingRule::Path {
         let mut kept: Vec<KeptExtremum> = minima
             .iter()
-            .map(|&v| KeptExtremum {
-                index: v,
-                role: Role::Min,
-                value: values[v],
-                persistence: None,
-            })
+            .map(|&v| KeptExtremum { index: v, role: Role::Min, value: values[v], persistence: None })
             .chain(maxima.iter().map(|&v| KeptExtremum {
                 index: v,
                 role: Role::Max,
@@ -513,10 +422,7 @@ mod tests {
     fn explicit_lists_are_checked() {
         let h = [0.0, 2.0, 5.0, 2.0, 0.5, 1.0, 1.5, 1.0, 0.2];
         let s = Series::uniform(h.len());
-        let sel = |mn: Vec<usize>, mx: Vec<usize>| Selection::Explicit {
-            minima: mn,
-            maxima: mx,
-        };
+        let sel = |mn: Vec<usize>, mx: Vec<usize>| Selection::Explicit { minima: mn, maxima: mx };
         assert!(select(&s, &h, &sel(vec![4], vec![2, 6])).is_ok());
         let e = select(&s, &h, &sel(vec![4], vec![3])).unwrap_err();
         assert!(e.to_string().contains("vertex 3"), "{e}");

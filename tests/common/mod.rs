@@ -11,17 +11,10 @@ pub struct Counted {
 
 pub fn count_series_extrema(f: &[f64]) -> Counted {
     let n = f.len();
-    let mut c = Counted {
-        minima: vec![],
-        maxima: vec![],
-        flat: vec![],
-    };
+    let mut c = Counted { minima: vec![], maxima: vec![], flat: vec![] };
     for i in 0..n {
-        let nb: Vec<f64> = [i.checked_sub(1), (i + 1 < n).then_some(i + 1)]
-            .into_iter()
-            .flatten()
-            .map(|j| f[j])
-            .collect();
+        let nb: Vec<f64> =
+            [i.checked_sub(1), (i + 1 < n).then_some(i + 1)].into_iter().flatten().map(|j| f[j]).collect();
         let lower = nb.iter().filter(|&&v| v < f[i]).count();
         let higher = nb.iter().filter(|&&v| v > f[i]).count();
         if higher == nb.len() {

@@ -48,7 +48,7 @@ impl Certificate {
     pub fn summary(&self) -> String {
         if self.passed {
             return format!(
-                "certified: {} minima, {} maxima, no other extremum",
+                "certified: {} strict minima and {} strict maxima (free ends included), exactly the kept ones; no other extremum, no flat spot",
                 self.strict_minima, self.strict_maxima
             );
         }

@@ -1,6 +1,6 @@
 //! `toposmooth extrema`: list the extrema with persistence and strictness; draw the diagram.
 
-use super::{check_png_name, plot_atomic};
+use super::{check_png_name, plot_atomic, sig6};
 use crate::domain::Series;
 use crate::error::{Error, Result};
 use crate::io::series_csv::{read_series, SeriesCsvOptions};
@@ -108,14 +108,14 @@ pub fn extrema(args: &ExtremaArgs) -> Result<String> {
         let pers = match r.persistence {
             None => "-".to_string(),
             Some(p) if p.is_infinite() => "inf".to_string(),
-            Some(p) => format!("{p:.6e}"),
+            Some(p) => sig6(p),
         };
         out += &format!(
-            "{:>8} {:>12} {:>4} {:>14.6e} {:>14} {:>6} {:>4}\n",
+            "{:>8} {:>12} {:>4} {:>14} {:>14} {:>6} {:>4}\n",
             r.index,
             row.x,
             kind,
-            r.value,
+            sig6(r.value),
             pers,
             if r.strict { "yes" } else { "no" },
             if row.kept { "yes" } else { "" }
@@ -126,8 +126,12 @@ pub fn extrema(args: &ExtremaArgs) -> Result<String> {
         listing.file, listing.samples, listing.column, listing.sos_minima, listing.sos_maxima, listing.ends, listing.strict_minima, listing.strict_maxima
     );
     if let Some(t) = kept.threshold {
-        out +=
-            &format!("kept at persistence ≥ {t:e}: {} minima, {} maxima\n", kept.minima().len(), kept.maxima().len());
+        out += &format!(
+            "kept at persistence ≥ {}: {} minima, {} maxima\n",
+            sig6(t),
+            kept.minima().len(),
+            kept.maxima().len()
+        );
     }
     Ok(out)
 }

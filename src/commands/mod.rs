@@ -32,6 +32,11 @@ pub fn parse_persistence(s: &str) -> Result<Selection> {
     Ok(if relative { Selection::Relative(v / 100.0) } else { Selection::Absolute(v) })
 }
 
+/// A number rounded to 6 significant digits, printed in its shortest form (for tables).
+pub fn sig6(v: f64) -> String {
+    format!("{:.5e}", v).parse::<f64>().map(|r| format!("{r}")).unwrap_or_else(|_| v.to_string())
+}
+
 /// Parses a comma-separated list of vertex indices.
 pub fn parse_indices(s: &str) -> Result<Vec<usize>> {
     s.split(',')
@@ -85,6 +90,8 @@ mod tests {
         assert!(parse_persistence("abc").is_err());
         assert!(parse_persistence("0%").is_err());
         assert_eq!(parse_indices("1, 5,9").unwrap(), vec![1, 5, 9]);
+        assert_eq!(sig6(1.8600000000000003), "1.86");
+        assert_eq!(sig6(0.011692000000000001), "0.011692");
         assert!(parse_indices("1,x").is_err());
     }
 }

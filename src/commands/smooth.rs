@@ -1,6 +1,6 @@
 //! `toposmooth smooth`: the whole pipeline on a file, with output, plot and report.
 
-use super::{check_png_name, plot_atomic, x_axis};
+use super::{check_png_name, plot_atomic, sig6, x_axis};
 use crate::domain::Series;
 use crate::error::Result;
 use crate::io::series_csv::{read_series, write_series_output, SeriesCsvOptions, SeriesOutput};
@@ -114,13 +114,13 @@ pub fn smooth(args: &SmoothArgs) -> Result<String> {
         "kept {} minima and {} maxima{}\n",
         kmin,
         r.kept.len() - kmin,
-        r.threshold.map(|t| format!(" (persistence ≥ {t:.6e})")).unwrap_or_default()
+        r.threshold.map(|t| format!(" (persistence ≥ {})", sig6(t))).unwrap_or_default()
     );
     text += &format!(
-        "{}; RMS deviation {:.6e}, max deviation {:.6e}\n",
+        "{}; RMS deviation {}, max deviation {}\n",
         r.certificate.summary(),
-        r.rms_deviation,
-        r.max_deviation
+        sig6(r.rms_deviation),
+        sig6(r.max_deviation)
     );
     text += &format!(
         "solver {:?} {:?} in {} iterations{}, {} constraints, margin {:.3e}; repair changed {} vertices\n",

@@ -83,6 +83,8 @@ proptest! {
         energy in energy(),
         all_edges in any::<bool>(),
         seed in 0u64..1000,
+        data_weight in prop_oneof![Just(0.0), Just(1.0), Just(100.0)],
+        smooth_length in prop_oneof![Just(0.001), Just(0.01), Just(0.2)],
     ) {
         let series = coordinates(h.len(), seed);
         let constant = h.iter().all(|&v| v == h[0]);
@@ -91,6 +93,8 @@ proptest! {
             selection,
             energy,
             edges: if all_edges { EdgeSet::All } else { EdgeSet::Minimal },
+            data_weight,
+            smooth_length,
             ..Default::default()
         };
         match smooth(&series, &h, &settings) {

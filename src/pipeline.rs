@@ -11,7 +11,7 @@
 //! # Ok::<(), toposmooth::Error>(())
 //! ```
 
-use crate::constraints::{choose_margin, constraint_edges, max_margin, EdgeSet, MARGIN_CAP};
+use crate::constraints::{choose_margin, constraint_edges, margin_cap, max_margin, EdgeSet};
 use crate::domain::{sos_sort, Domain, Series};
 use crate::error::{Error, Result};
 use crate::operators::{
@@ -152,7 +152,8 @@ pub struct Report {
     pub edge_set: EdgeSet,
     /// Number of constrained edges.
     pub constraints: usize,
-    /// Margin ε (in the field's units) and the largest feasible one.
+    /// Margin ε (in the field's units) and the largest feasible one (a lower bound, twice the
+    /// cap, when that was already feasible).
     pub margin: [f64; 2],
     /// Kept extrema.
     pub kept: Vec<KeptExtremum>,
@@ -250,9 +251,9 @@ pub fn smooth<D: Smoothable>(domain: &D, h: &[f64], settings: &SmoothSettings) -
     let fixed: Vec<Option<f64>> = (0..n).map(|i| kept.roles[i].is_fixed().then_some(z[i])).collect();
     let edges = constraint_edges(domain, &u, &fixed, settings.edges);
     check_fixed_neighbours(domain, h, &kept.roles)?;
-    let eps_max = max_margin(&u, &edges, &fixed, Some(MARGIN_CAP))?;
     let magnitude = h.iter().fold(0.0f64, |a, v| a.max(v.abs()));
     let resolution = (magnitude.next_up() - magnitude) / range;
+    let eps_max = max_margin(&u, &edges, &fixed, Some(margin_cap(1.0, resolution)))?;
     let eps = choose_margin(eps_max, 1.0, resolution)?;
     seconds.constraints = t.elapsed().as_secs_f64();
 

@@ -44,11 +44,13 @@ pub fn series_representative(series: &Series, h: &[f64], kept: &KeptSet) -> Resu
     let (first, first_role) = anchors[0];
     if first > 0 {
         let end = end_value(&h[..=first], h[first], first_role, slope * (x[first] - x[0]));
+        let end = with_room(h[first], end, first);
         linear(&mut u, x, 0, first, end, h[first]);
     }
     let (last, last_role) = anchors[anchors.len() - 1];
     if last + 1 < n {
         let end = end_value(&h[last..], h[last], last_role, slope * (x[n - 1] - x[last]));
+        let end = with_room(h[last], end, n - 1 - last);
         linear(&mut u, x, last, n - 1, h[last], end);
     }
     for w in anchors.windows(2) {
@@ -82,6 +84,20 @@ fn end_value(stretch: &[f64], anchor: f64, role: Role, fallback: f64) -> f64 {
         } else {
             anchor - fallback
         }
+    }
+}
+
+/// The free end's value moved away from the anchor, if needed, so that at least `4 (len + 2)`
+/// doubles lie between them: room for a strictly monotone stretch of `len` edges.
+fn with_room(anchor: f64, end: f64, len: usize) -> f64 {
+    let gap = (end - anchor).abs();
+    let top = anchor.abs().max(end.abs()) + gap;
+    let ulp = top.next_up() - top;
+    let need = 4.0 * (len as f64 + 2.0) * ulp;
+    if gap >= need {
+        end
+    } else {
+        anchor + (end - anchor).signum() * need
     }
 }
 
@@ -169,6 +185,18 @@ mod tests {
         let kept = kept.unwrap();
         let e = series_representative(&s, &h, &kept).unwrap_err();
         assert_eq!(e.exit_code(), 3, "{e}");
+    }
+
+    #[test]
+    fn free_ends_get_room_for_a_strict_stretch() {
+        // the left end is only two doubles above the kept minimum at 4 (review finding)
+        let e = f64::EPSILON;
+        let h = [1.0 + 2.0 * e, 1.0 + e, 1.0 + e, 1.0 + e, 1.0, 5.0, 0.0];
+        let s = Series::uniform(7);
+        let kept = select(&s, &h, &Selection::Relative(0.05)).unwrap();
+        assert_eq!((kept.minima(), kept.maxima()), (vec![4, 6], vec![5]));
+        let u = series_representative(&s, &h, &kept).unwrap();
+        assert!(u[..5].windows(2).all(|w| w[0] > w[1]), "{u:?}");
     }
 
     #[test]

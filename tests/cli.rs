@@ -54,6 +54,15 @@ fn smooth_then_verify_the_exchange_rate() {
     let v = toposmooth(&["verify", &bad]);
     assert_eq!(v.status.code(), Some(1), "{}", text(&v));
     assert!(text(&v).contains("spurious maximum") && text(&v).contains("bad.csv"), "{}", text(&v));
+    // roles that would hide extrema are rejected
+    for (name, body) in [
+        ("interior_end.csv", "x,input,output,u,role\n0,0,0,0,min\n1,3,3,3,end\n2,1,1,1,end\n3,9,9,9,max\n"),
+        ("fixed.csv", "x,input,output,u,role\n0,0,0,0,min\n1,5,5,5,fixed\n2,5,5,5,fixed\n3,3,3,3,\n4,9,9,9,max\n"),
+    ] {
+        let f = write(&dir, name, body);
+        let v = toposmooth(&["verify", &f]);
+        assert_eq!(v.status.code(), Some(1), "{name}: {}", text(&v));
+    }
     let seattle = dataset("seattle_weather_daily_2012_2015.csv");
     let v = toposmooth(&["verify", &out, "--input", &seattle, "--column", "temp_max"]);
     assert_eq!(v.status.code(), Some(1), "{}", text(&v));
@@ -88,6 +97,30 @@ fn plots_are_written_as_png() {
     let o = toposmooth(&["smooth", &fx, "-o", out2.to_str().unwrap(), "--plot", bad.to_str().unwrap()]);
     assert_eq!(o.status.code(), Some(2), "{}", text(&o));
     assert!(!bad.exists() && !out2.exists(), "nothing written");
+    // a report that cannot be written leaves no CSV and no plot behind
+    let (out3, fig3) = (dir.join("o3.csv"), dir.join("f3.png"));
+    let report = dir.join("no-such-dir").join("r.json");
+    let o = toposmooth(&[
+        "smooth",
+        &fx,
+        "-o",
+        out3.to_str().unwrap(),
+        "--plot",
+        fig3.to_str().unwrap(),
+        "--report",
+        report.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(3), "{}", text(&o));
+    assert!(!out3.exists() && !fig3.exists(), "nothing committed");
+    let tmp_left =
+        std::fs::read_dir(&dir).unwrap().flatten().any(|e| e.file_name().to_string_lossy().ends_with(".tmp"));
+    assert!(!tmp_left);
+    // outputs that collide with each other or with the input are usage errors
+    let same = dir.join("same.png");
+    let o = toposmooth(&["smooth", &fx, "-o", same.to_str().unwrap(), "--plot", same.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2), "{}", text(&o));
+    let o = toposmooth(&["smooth", &fx, "-o", &fx]);
+    assert_eq!(o.status.code(), Some(2), "{}", text(&o));
 }
 
 #[test]

@@ -174,3 +174,46 @@ fn adjacent_kept_extrema_are_fine() {
     let out = run(&h, Selection::Explicit { minima: vec![0, 2], maxima: vec![1, 3] });
     assert_exact(&h, &out);
 }
+
+/// Regressions found in the review of issue 3.
+mod issue3_regressions {
+    use super::*;
+
+    #[test]
+    fn signed_zeros_are_one_value() {
+        // −0 and +0 compare equal: the union-find and the local tests must agree (exit 1 before)
+        let h = [-1.0, 0.0, -0.0, -1.0];
+        let out = run(&h, Selection::Relative(0.05));
+        assert_exact(&h, &out);
+    }
+
+    #[test]
+    fn free_end_close_to_its_kept_minimum() {
+        let e = f64::EPSILON;
+        let h = [1.0 + 2.0 * e, 1.0 + e, 1.0 + e, 1.0 + e, 1.0, 5.0, 0.0];
+        let out = run(&h, Selection::Relative(0.05));
+        assert_exact(&h, &out);
+    }
+
+    #[test]
+    fn large_offset_small_range() {
+        // a counter near 1e10 moving by a few units: spacing of doubles 1.9e-6 > 1e-6 × range
+        let noise = uniform(11, 300);
+        let h: Vec<f64> = (0..300).map(|i| 1e10 + (i as f64 / 40.0).sin() + 0.3 * noise[i]).collect();
+        let out = run(&h, Selection::Relative(0.2));
+        assert_exact(&h, &out);
+    }
+
+    #[test]
+    fn tiny_relative_thresholds_keep_everything_or_are_usage_errors() {
+        let h = [0.0, 1.0, 0.5, 2.0];
+        let tiny = |t: f64| SmoothSettings { selection: Selection::Relative(t), ..Default::default() };
+        // a denormal threshold keeps every pair of positive persistence
+        let out = smooth(&Series::uniform(4), &h, &tiny(1e-320)).unwrap();
+        assert_eq!(out.report.kept.len(), 4);
+        assert_exact(&h, &out);
+        // one that underflows to zero is refused (exit 2), never a persistence-0 pair kept
+        let e = smooth(&Series::uniform(4), &h, &tiny(1e-330)).unwrap_err();
+        assert_eq!(e.exit_code(), 2, "{e}");
+    }
+}

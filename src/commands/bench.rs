@@ -63,6 +63,9 @@ fn peak_rss_mib() -> f64 {
 
 /// Runs the benchmark; returns the table (or one JSON line with `single`).
 pub fn bench(args: &BenchArgs) -> Result<String> {
+    if let Some(&n) = args.single.iter().chain(&args.sizes).find(|&&n| n < 2) {
+        return Err(Error::Usage(format!("bench sizes must be at least 2 samples, got {n}")));
+    }
     if let Some(n) = args.single {
         let h = random_walk(n, args.seed);
         let settings = SmoothSettings {
@@ -102,6 +105,7 @@ pub fn bench(args: &BenchArgs) -> Result<String> {
             .args(["bench", "--single", &n.to_string(), "--order", &order, "--seed", &args.seed.to_string()])
             .args(["--persistence", &format!("{}%", args.persistence * 100.0)])
             .args(["--edges", if args.edges == EdgeSet::All { "all" } else { "minimal" }])
+            .args(["--solver", if args.method == Method::Clarabel { "clarabel" } else { "structured" }])
             .output()
             .map_err(|source| Error::Io { path: exe.clone(), source })?;
         if !child.status.success() {

@@ -1,6 +1,6 @@
 //! `toposmooth extrema`: list the extrema with persistence and strictness; draw the diagram.
 
-use super::{check_png_name, plot_atomic, sig6};
+use super::{check_png_name, sig6, stage_plot};
 use crate::domain::Series;
 use crate::error::{Error, Result};
 use crate::io::series_csv::{read_series, SeriesCsvOptions};
@@ -88,19 +88,20 @@ pub fn extrema(args: &ExtremaArgs) -> Result<String> {
             data.column,
             points.len()
         );
-        plot_atomic(path, |p| plot_persistence_diagram(p, &points, kept.threshold, &title, (900, 800)))?;
+        stage_plot(path, |p| plot_persistence_diagram(p, &points, kept.threshold, &title, (900, 800)))?.commit()?;
     }
     if args.json {
         return serde_json::to_string_pretty(&listing).map_err(|e| Error::input(e.to_string()));
     }
     let mut out = String::new();
     out += &format!(
-        "{:>8} {:>12} {:>4} {:>14} {:>14} {:>6} {:>4}\n",
+        "{:>8} {:>12} {:>9} {:>14} {:>14} {:>6} {:>4}\n",
         "index", "x", "type", "value", "persistence", "strict", "kept"
     );
     for row in &listing.extrema {
         let r = row.info;
         let kind = match r.kind {
+            ExtremumKind::Min if r.endpoint => "min (end)",
             ExtremumKind::Min => "min",
             ExtremumKind::Max => "max",
             ExtremumKind::End => "end",
@@ -111,7 +112,7 @@ pub fn extrema(args: &ExtremaArgs) -> Result<String> {
             Some(p) => sig6(p),
         };
         out += &format!(
-            "{:>8} {:>12} {:>4} {:>14} {:>14} {:>6} {:>4}\n",
+            "{:>8} {:>12} {:>9} {:>14} {:>14} {:>6} {:>4}\n",
             r.index,
             row.x,
             kind,

@@ -67,15 +67,29 @@ fn check_png_name(path: Option<&Path>) -> Result<()> {
     }
 }
 
-/// Runs `draw` on a temporary sibling of `path` and renames it into place.
-fn plot_atomic(path: &Path, draw: impl FnOnce(&Path) -> std::result::Result<(), crate::plot::PlotError>) -> Result<()> {
+/// Draws a plot into a staged temporary file (see [`crate::io::Staged`]).
+fn stage_plot(
+    path: &Path,
+    draw: impl FnOnce(&Path) -> std::result::Result<(), crate::plot::PlotError>,
+) -> Result<crate::io::Staged> {
     check_png_name(Some(path))?;
-    let tmp = crate::io::temp_sibling(path).with_extension("png");
-    draw(&tmp).map_err(|e| {
-        let _ = std::fs::remove_file(&tmp);
-        Error::Io { path: path.to_path_buf(), source: std::io::Error::other(e.to_string()) }
-    })?;
-    std::fs::rename(&tmp, path).map_err(|source| Error::Io { path: path.to_path_buf(), source })
+    crate::io::stage_with(path, |tmp| draw(tmp).map_err(|e| std::io::Error::other(e.to_string())))
+}
+
+/// Output paths must differ from each other and from the input.
+fn check_distinct(input: &Path, outputs: &[(&str, Option<&Path>)]) -> Result<()> {
+    let key = |p: &Path| std::path::absolute(p).unwrap_or_else(|_| p.to_path_buf());
+    let mut seen = vec![("the input", key(input))];
+    for (name, p) in outputs {
+        if let Some(p) = p {
+            let k = key(p);
+            if let Some((other, _)) = seen.iter().find(|(_, s)| *s == k) {
+                return Err(Error::Usage(format!("{name} {} is also {other}", p.display())));
+            }
+            seen.push((name, k));
+        }
+    }
+    Ok(())
 }
 
 #[cfg(test)]

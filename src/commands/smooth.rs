@@ -1,10 +1,10 @@
 //! `toposmooth smooth`: the whole pipeline on a file, with output, plot and report.
 
-use super::{check_png_name, plot_atomic, sig6, x_axis};
+use super::{check_distinct, check_png_name, sig6, stage_plot, x_axis};
 use crate::domain::Series;
 use crate::error::Result;
-use crate::io::series_csv::{read_series, write_series_output, SeriesCsvOptions, SeriesOutput};
-use crate::io::write_json;
+use crate::io::series_csv::{read_series, stage_series_output, SeriesCsvOptions, SeriesOutput};
+use crate::io::stage_json;
 use crate::pipeline::{smooth as run_pipeline, Report, SmoothSettings};
 use crate::plot::{plot_series, Marker};
 use crate::topology::Role;
@@ -43,6 +43,10 @@ struct RunReport<'a> {
 /// Runs `smooth`; returns the summary printed on standard output.
 pub fn smooth(args: &SmoothArgs) -> Result<String> {
     check_png_name(args.plot.as_deref())?;
+    check_distinct(
+        &args.input,
+        &[("-o", Some(&args.output)), ("--plot", args.plot.as_deref()), ("--report", args.report.as_deref())],
+    )?;
     let start = Instant::now();
     let data = read_series(&args.input, &args.csv)?;
     let series = Series::with_coordinates(data.x.clone()).map_err(|e| e.in_file(&args.input))?;
@@ -56,7 +60,8 @@ pub fn smooth(args: &SmoothArgs) -> Result<String> {
         u: result.u.clone(),
         roles: result.roles.clone(),
     };
-    write_series_output(&args.output, &out)?;
+    // every output is staged first and committed together at the end
+    let mut staged = vec![stage_series_output(&args.output, &out)?];
     if let Some(path) = &args.plot {
         let (axis, x) = x_axis(&data.x_source, &data.x);
         let markers: Vec<Marker> = result
@@ -78,9 +83,9 @@ pub fn smooth(args: &SmoothArgs) -> Result<String> {
             r.input_minima + r.input_maxima,
             r.rms_deviation
         );
-        plot_atomic(path, |p| {
+        staged.push(stage_plot(path, |p| {
             plot_series(p, &x, &axis, &data.column, &data.values, &result.output, &markers, &title, (1400, 700))
-        })?;
+        })?);
     }
     let write_seconds = t.elapsed().as_secs_f64();
     let r = &result.report;
@@ -94,7 +99,10 @@ pub fn smooth(args: &SmoothArgs) -> Result<String> {
             total_seconds: start.elapsed().as_secs_f64(),
             report: r,
         };
-        write_json(path, &run)?;
+        staged.push(stage_json(path, &run)?);
+    }
+    for s in staged {
+        s.commit()?;
     }
     let s = &r.seconds;
     let mut text = String::new();

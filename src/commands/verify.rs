@@ -3,6 +3,7 @@
 use crate::domain::Series;
 use crate::error::{Error, Result};
 use crate::io::series_csv::{read_series, read_series_output, SeriesCsvOptions};
+use crate::topology::Role;
 use crate::verify::certify;
 use std::path::PathBuf;
 
@@ -40,6 +41,17 @@ pub fn verify(args: &VerifyArgs) -> Result<String> {
                 data.values[i]
             ));
         }
+    }
+    // roles a series output can carry: free ends only at the two ends, no fixed regions, at
+    // least one kept minimum and one kept maximum
+    if let Some(i) = (1..n.saturating_sub(1)).find(|&i| out.roles[i] == Role::End) {
+        problems.push(format!("sample {i} is marked `end` but is not an end of the series"));
+    }
+    if let Some(i) = out.roles.iter().position(|&r| r == Role::Fixed) {
+        problems.push(format!("sample {i} is marked `fixed`: series outputs keep extrema, not regions"));
+    }
+    if !out.roles.contains(&Role::Min) || !out.roles.contains(&Role::Max) {
+        problems.push("the role column keeps no minimum or no maximum".into());
     }
     let cert = certify(&series, &out.output, &out.roles, Some(&out.input));
     if !cert.passed {

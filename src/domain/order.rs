@@ -22,7 +22,8 @@ pub fn sos_greater(values: &[f64], a: usize, b: usize) -> bool {
 /// order of every edge orientation defined by it.
 pub fn sos_sort(values: &[f64]) -> Vec<usize> {
     let mut idx: Vec<usize> = (0..values.len()).collect();
-    idx.sort_unstable_by(|&a, &b| values[a].total_cmp(&values[b]).then(a.cmp(&b)));
+    // partial_cmp, as in `sos_less`: −0 and +0 are equal values, ordered by index
+    idx.sort_unstable_by(|&a, &b| values[a].partial_cmp(&values[b]).unwrap_or(Ordering::Equal).then(a.cmp(&b)));
     idx
 }
 
@@ -38,5 +39,9 @@ mod tests {
         assert!(sos_greater(&v, 1, 0));
         assert!(!sos_greater(&v, 1, 1));
         assert_eq!(sos_sort(&v), vec![2, 0, 1]);
+        // signed zeros are one value: index decides, consistently with sos_less
+        let z = [0.0, -0.0, 0.0];
+        assert_eq!(sos_sort(&z), vec![0, 1, 2]);
+        assert!(sos_less(&z, 0, 1) && sos_less(&z, 1, 2));
     }
 }

@@ -7,24 +7,54 @@ use crate::error::{Error, Result};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
-/// Writes `path` atomically: `fill` writes into a temporary sibling, which is flushed, synced
-/// and renamed over `path`. On any error the temporary file is removed.
-pub fn write_atomic(path: &Path, fill: impl FnOnce(&mut dyn Write) -> std::io::Result<()>) -> Result<()> {
-    let tmp = temp_sibling(path);
-    let io_err = |source| Error::Io { path: path.to_path_buf(), source };
-    let result = (|| -> std::io::Result<()> {
-        let file = std::fs::File::create(&tmp)?;
+/// A complete file waiting under a temporary sibling name: [`Staged::commit`] renames it into
+/// place; dropped uncommitted, it is removed. Staging every output of a command before
+/// committing any means a failure leaves no output behind.
+#[must_use = "a staged file is removed unless committed"]
+pub struct Staged {
+    tmp: PathBuf,
+    path: PathBuf,
+    committed: bool,
+}
+
+impl Staged {
+    /// Renames the temporary file over the target.
+    pub fn commit(mut self) -> Result<()> {
+        std::fs::rename(&self.tmp, &self.path).map_err(|source| Error::Io { path: self.path.clone(), source })?;
+        self.committed = true;
+        Ok(())
+    }
+}
+
+impl Drop for Staged {
+    fn drop(&mut self) {
+        if !self.committed {
+            let _ = std::fs::remove_file(&self.tmp);
+        }
+    }
+}
+
+/// Stages `path`: `create` writes the complete temporary file at the path it is given.
+pub fn stage_with(path: &Path, create: impl FnOnce(&Path) -> std::io::Result<()>) -> Result<Staged> {
+    let staged = Staged { tmp: temp_sibling(path), path: path.to_path_buf(), committed: false };
+    create(&staged.tmp).map_err(|source| Error::Io { path: path.to_path_buf(), source })?;
+    Ok(staged)
+}
+
+/// Stages `path`: `fill` writes the content, which is flushed and synced.
+pub fn stage(path: &Path, fill: impl FnOnce(&mut dyn Write) -> std::io::Result<()>) -> Result<Staged> {
+    stage_with(path, |tmp| {
+        let file = std::fs::File::create(tmp)?;
         let mut w = std::io::BufWriter::new(file);
         fill(&mut w)?;
         let file = w.into_inner().map_err(|e| e.into_error())?;
-        file.sync_all()?;
-        std::fs::rename(&tmp, path)
-    })();
-    if let Err(e) = result {
-        let _ = std::fs::remove_file(&tmp);
-        return Err(io_err(e));
-    }
-    Ok(())
+        file.sync_all()
+    })
+}
+
+/// Writes `path` atomically: [`stage`] then [`Staged::commit`].
+pub fn write_atomic(path: &Path, fill: impl FnOnce(&mut dyn Write) -> std::io::Result<()>) -> Result<()> {
+    stage(path, fill)?.commit()
 }
 
 /// A temporary name next to `path` (same directory, so the rename is atomic).
@@ -33,9 +63,9 @@ pub fn temp_sibling(path: &Path) -> PathBuf {
     path.with_file_name(format!(".{name}.{}.tmp", std::process::id()))
 }
 
-/// Writes a value as pretty JSON, atomically.
-pub fn write_json<T: serde::Serialize>(path: &Path, value: &T) -> Result<()> {
-    write_atomic(path, |w| {
+/// Stages a value as pretty JSON.
+pub fn stage_json<T: serde::Serialize>(path: &Path, value: &T) -> Result<Staged> {
+    stage(path, |w| {
         serde_json::to_writer_pretty(&mut *w, value).map_err(std::io::Error::other)?;
         writeln!(w)
     })

@@ -1,7 +1,7 @@
 //! Series as CSV: the input (header optional, value column by name or index, optional x
 //! column of numbers or ISO dates) and the verifiable output `x,input,output,u,role`.
 
-use super::{format_f64, write_atomic};
+use super::format_f64;
 use crate::error::{Error, Result};
 use crate::topology::Role;
 use chrono::{NaiveDate, NaiveDateTime};
@@ -149,9 +149,13 @@ pub fn read_series(path: &Path, options: &SeriesCsvOptions) -> Result<SeriesCsv>
             _ => Err(err(format!("no column `{spec}` (columns: {})", names.join(", ")))),
         }
     };
+    let explicit_x = match options.x_column.as_deref() {
+        Some("none") | None => None,
+        Some(spec) => Some(find(spec)?),
+    };
     let value_col = match &options.column {
         Some(spec) => find(spec)?,
-        None => (0..ncols).rev().find(|&c| kinds[c] == Kind::Number).ok_or_else(|| {
+        None => (0..ncols).rev().find(|&c| kinds[c] == Kind::Number && Some(c) != explicit_x).ok_or_else(|| {
             err(format!("no numeric column (columns: {}); choose one with --column", names.join(", ")))
         })?,
     };
@@ -246,7 +250,12 @@ pub struct SeriesOutput {
 
 /// Writes `x,input,output,u,role` atomically, doubles in shortest round-trip form.
 pub fn write_series_output(path: &Path, out: &SeriesOutput) -> Result<()> {
-    write_atomic(path, |w| {
+    stage_series_output(path, out)?.commit()
+}
+
+/// Stages the file of [`write_series_output`] (see [`super::Staged`]).
+pub fn stage_series_output(path: &Path, out: &SeriesOutput) -> Result<super::Staged> {
+    super::stage(path, |w| {
         writeln!(w, "x,input,output,u,role")?;
         for i in 0..out.input.len() {
             writeln!(

@@ -130,6 +130,9 @@ pub struct ExtremumInfo {
     pub partner: Option<usize>,
     /// Whether it is also a strict extremum of the raw values (no equal neighbour).
     pub strict: bool,
+    /// Whether it is an endpoint of a series (fewer neighbours; a minimum there still has a
+    /// persistence, a maximum there is an `End`).
+    pub endpoint: bool,
 }
 
 fn finite_or_null<S: serde::Serializer>(v: &Option<f64>, s: S) -> Result<S::Ok, S::Error> {
@@ -149,6 +152,8 @@ pub fn extrema_table<D: Domain>(domain: &D, values: &[f64]) -> Vec<ExtremumInfo>
     let strict = |v: usize, lower: bool| {
         domain.neighbors(v).all(|w| if lower { values[w] > values[v] } else { values[w] < values[v] })
     };
+    let path = domain.pairing_rule() == PairingRule::Path;
+    let is_endpoint = |v: usize| path && (v == 0 || v + 1 == n);
     let mut rows = Vec::new();
     for p in sublevel_pairs(domain, values) {
         rows.push(ExtremumInfo {
@@ -158,6 +163,7 @@ pub fn extrema_table<D: Domain>(domain: &D, values: &[f64]) -> Vec<ExtremumInfo>
             persistence: Some(p.persistence),
             partner: p.partner,
             strict: strict(p.extremum, true),
+            endpoint: is_endpoint(p.extremum),
         });
     }
     match domain.pairing_rule() {
@@ -184,6 +190,7 @@ pub fn extrema_table<D: Domain>(domain: &D, values: &[f64]) -> Vec<ExtremumInfo>
                     persistence,
                     partner,
                     strict: strict(v, false),
+                    endpoint: is_endpoint(v),
                 });
             }
         }
@@ -196,6 +203,7 @@ pub fn extrema_table<D: Domain>(domain: &D, values: &[f64]) -> Vec<ExtremumInfo>
                     persistence: Some(p.persistence),
                     partner: p.partner,
                     strict: strict(p.extremum, false),
+                    endpoint: false,
                 });
             }
         }

@@ -166,9 +166,14 @@ pub fn select<D: Domain>(domain: &D, values: &[f64], selection: &Selection) -> R
                 return Err(Error::Usage(format!("the persistence threshold must be > 0, got {t}")));
             }
             let t = if matches!(selection, Selection::Relative(_)) { t * (hi - lo) } else { *t };
+            if !(t > 0.0 && t.is_finite()) {
+                return Err(Error::Usage(format!("the persistence threshold scales to {t:e}: choose a larger one")));
+            }
             threshold = Some(t);
             match domain.pairing_rule() {
-                PairingRule::Path => path_by_rank(values, &minima_pairs, |p| p.persistence >= t, usize::MAX),
+                PairingRule::Path => {
+                    path_by_rank(values, &minima_pairs, |p| p.persistence >= t && p.persistence > 0.0, usize::MAX)
+                }
                 PairingRule::Surface => {
                     let maxima_pairs = superlevel_pairs(domain, values);
                     (by_threshold(&minima_pairs, t), by_threshold(&maxima_pairs, t))
@@ -241,6 +246,8 @@ pub fn select<D: Domain>(domain: &D, values: &[f64], selection: &Selection) -> R
 /// minimum goes).
 type Kept = Vec<(usize, Option<f64>)>;
 fn path_by_rank(values: &[f64], pairs: &[Pair], keep: impl Fn(&Pair) -> bool, count: usize) -> (Kept, Kept) {
+    // a finite count includes the global maximum's own pair (SPEC: it "counts among them")
+    let counted = count != usize::MAX;
     let n = values.len();
     let gmax = (0..n).fold(0, |b, v| if sos_greater(values, v, b) { v } else { b });
     let mut ranked: Vec<&Pair> = pairs.iter().filter(|p| p.partner.is_some()).collect();
@@ -255,7 +262,17 @@ fn path_by_rank(values: &[f64], pairs: &[Pair], keep: impl Fn(&Pair) -> bool, co
     for p in pairs.iter().filter(|p| p.partner.is_none()) {
         mins.push((p.extremum, Some(p.persistence)));
     }
-    for p in ranked.into_iter().filter(|p| keep(p)).take(count) {
+    let gmax_pair = pairs.iter().position(|p| p.partner == Some(gmax) && keep(p));
+    let mut budget = count;
+    if counted && budget > 0 {
+        if let Some(k) = gmax_pair {
+            let p = &pairs[k];
+            mins.push((p.extremum, Some(p.persistence)));
+            maxs.push((gmax, Some(p.persistence)));
+            budget -= 1;
+        }
+    }
+    for p in ranked.into_iter().filter(|p| keep(p) && !(counted && p.partner == Some(gmax))).take(budget) {
         mins.push((p.extremum, Some(p.persistence)));
         maxs.push((p.partner.expect("ranked pairs have partners"), Some(p.persistence)));
     }
@@ -399,6 +416,10 @@ mod tests {
         let (mn, mx) = kept(&h, Selection::Absolute(2.5));
         assert_eq!(mn, vec![2]);
         assert_eq!(mx, vec![1]);
+        // a count includes the global maximum's pair, however small: one pair = (0, 1)
+        assert_eq!(kept(&h, Selection::Pairs(1)), (vec![0, 2], vec![1]));
+        assert_eq!(kept(&h, Selection::Pairs(0)), (vec![2], vec![1]));
+        assert_eq!(kept(&h, Selection::Pairs(2)), (vec![0, 2, 4], vec![1, 3]));
     }
 
     #[test]

@@ -127,6 +127,30 @@ pub struct EnergyReport {
     pub total: f64,
 }
 
+/// The settings of a run as the report records them.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct RunSettings {
+    /// The selection as given.
+    pub selection: String,
+    /// Absolute persistence threshold applied, if any.
+    pub threshold: Option<f64>,
+    /// Smoothness energy: orders, weights, sharp vertices.
+    pub energy: Energy,
+    /// γD.
+    pub data_weight: f64,
+    /// γ per energy term.
+    pub smooth_weights: Vec<f64>,
+    /// ℓ as a fraction of the diameter, and in the domain's units.
+    pub smooth_length: [f64; 2],
+    /// Constraint set.
+    pub edge_set: EdgeSet,
+    /// Margin ε (in the field's units) and the largest feasible one (a lower bound, twice the
+    /// cap, when that was already feasible).
+    pub margin: [f64; 2],
+    /// Solver settings as requested.
+    pub solver: QpSettings,
+}
+
 /// Everything a run measured, written by `--report`.
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]
 pub struct Report {
@@ -136,25 +160,10 @@ pub struct Report {
     pub input_minima: usize,
     /// SoS maxima of the input (series ends included).
     pub input_maxima: usize,
-    /// The selection as given.
-    pub selection: String,
-    /// Absolute persistence threshold applied, if any.
-    pub threshold: Option<f64>,
-    /// Smoothness energy.
-    pub energy_settings: Energy,
-    /// γD.
-    pub data_weight: f64,
-    /// γL per energy term.
-    pub smooth_weights: Vec<f64>,
-    /// ℓ as a fraction of the diameter, and in the domain's units.
-    pub smooth_length: [f64; 2],
-    /// Constraint set.
-    pub edge_set: EdgeSet,
+    /// The settings the run used, with the derived values.
+    pub settings: RunSettings,
     /// Number of constrained edges.
     pub constraints: usize,
-    /// Margin ε (in the field's units) and the largest feasible one (a lower bound, twice the
-    /// cap, when that was already feasible).
-    pub margin: [f64; 2],
     /// Kept extrema.
     pub kept: Vec<KeptExtremum>,
     /// Warnings.
@@ -299,15 +308,18 @@ pub fn smooth<D: Smoothable>(domain: &D, h: &[f64], settings: &SmoothSettings) -
         vertices: n,
         input_minima,
         input_maxima,
-        selection: format!("{:?}", settings.selection),
-        threshold: kept.threshold,
-        energy_settings: settings.energy.clone(),
-        data_weight: gd,
-        smooth_weights: weights,
-        smooth_length: [settings.smooth_length, ell],
-        edge_set: settings.edges,
+        settings: RunSettings {
+            selection: format!("{:?}", settings.selection),
+            threshold: kept.threshold,
+            energy: settings.energy.clone(),
+            data_weight: gd,
+            smooth_weights: weights,
+            smooth_length: [settings.smooth_length, ell],
+            edge_set: settings.edges,
+            margin: [eps * range, eps_max * range],
+            solver: settings.qp.clone(),
+        },
         constraints: edges.len(),
-        margin: [eps * range, eps_max * range],
         kept: kept.kept.clone(),
         warnings: kept.warnings.clone(),
         seconds,

@@ -122,7 +122,7 @@ pub fn smooth(args: &SmoothArgs) -> Result<String> {
         "kept {} minima and {} maxima{}\n",
         kmin,
         r.kept.len() - kmin,
-        r.threshold.map(|t| format!(" (persistence ≥ {})", sig6(t))).unwrap_or_default()
+        r.settings.threshold.map(|t| format!(" (persistence ≥ {})", sig6(t))).unwrap_or_default()
     );
     text += &format!(
         "{}; RMS deviation {}, max deviation {}\n",
@@ -137,7 +137,7 @@ pub fn smooth(args: &SmoothArgs) -> Result<String> {
         r.solver_iterations,
         r.solver_fallback.as_ref().map(|w| format!(" (structured solver gave up: {w})")).unwrap_or_default(),
         r.constraints,
-        r.margin[0],
+        r.settings.margin[0],
         r.repair.changed_vertices
     );
     text += &format!(

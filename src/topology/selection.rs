@@ -101,6 +101,7 @@ pub struct KeptExtremum {
     /// Vertex index.
     pub index: usize,
     /// `min` or `max`.
+    #[serde(rename = "type")]
     pub role: Role,
     /// Input value (kept bit for bit).
     pub value: f64,

@@ -10,9 +10,11 @@
 //! assert_eq!(s.neighbors(2).collect::<Vec<_>>(), vec![1, 3]);
 //! ```
 
+mod grid;
 mod order;
 mod series;
 
+pub use grid::Grid2d;
 pub use order::{sos_greater, sos_less, sos_sort};
 pub use series::Series;
 

@@ -16,10 +16,12 @@
 //! assert!(toposmooth::operators::quadratic_form(&q, &[1.0; 5]).abs() < 1e-12);
 //! ```
 
+mod cotan;
 mod polyharmonic;
 mod series;
 mod sparse;
 
+pub use cotan::{cotan_stiffness, grid_mass, grid_stiffness, lumped_mass};
 pub use polyharmonic::{polyharmonic, Energy};
 pub use series::{series_mass, series_stiffness};
 pub use sparse::{quadratic_form, scaled_plus_diagonal, Sparse};

@@ -246,6 +246,55 @@ mod tests {
     }
 
     #[test]
+    fn two_bumps_on_a_grid() {
+        use crate::domain::Grid2d;
+        // bumps of height 1 at (10, 8) and 0.5 at (10, 24) on a 21 × 33 grid; the saddle
+        // between them sits near (10, 16) at about exp(−64/σ²) ≈ small
+        let g = Grid2d::new(33, 21).unwrap();
+        let h: Vec<f64> = (0..g.n_vertices())
+            .map(|v| {
+                let (r, c) = g.row_col(v);
+                let d = |cr: f64, cc: f64| ((r as f64 - cr).powi(2) + (c as f64 - cc).powi(2)) / 30.0;
+                (-d(10.0, 8.0)).exp() + 0.5 * (-d(10.0, 24.0)).exp()
+            })
+            .collect();
+        let maxima = superlevel_pairs(&g, &h);
+        assert_eq!(maxima.len(), 2, "{maxima:?}");
+        let small = maxima.iter().find(|p| p.extremum == g.index(10, 24)).expect("small bump");
+        let saddle = small.partner.expect("dies");
+        assert_eq!(g.row_col(saddle).0, 10, "the saddle lies on the line between the bumps");
+        assert!((small.persistence - (h[g.index(10, 24)] - h[saddle])).abs() < 1e-15);
+        // oracle: the highest level at which both peaks lie in one component of {h ≥ level}
+        let connected = |level: f64| {
+            let mut seen = vec![false; g.n_vertices()];
+            let mut stack = vec![g.index(10, 8)];
+            seen[stack[0]] = true;
+            while let Some(v) = stack.pop() {
+                for w in g.neighbors(v) {
+                    if !seen[w] && h[w] >= level {
+                        seen[w] = true;
+                        stack.push(w);
+                    }
+                }
+            }
+            seen[g.index(10, 24)]
+        };
+        let mut levels = h.clone();
+        levels.sort_by(f64::total_cmp);
+        let merge = levels.iter().rev().find(|&&l| connected(l)).copied().unwrap();
+        assert_eq!(h[saddle], merge);
+        assert!(small.persistence > 0.3 && small.persistence < 0.4, "{}", small.persistence);
+        let big = maxima.iter().find(|p| p.extremum == g.index(10, 8)).unwrap();
+        assert_eq!(big.persistence, f64::INFINITY);
+        // minima: every corner region of the boundary is low; the global one never dies
+        let minima = sublevel_pairs(&g, &h);
+        assert_eq!(minima.iter().filter(|p| p.partner.is_none()).count(), 1);
+        let t = extrema_table(&g, &h);
+        assert_eq!(t.iter().filter(|r| r.kind == ExtremumKind::Max).count(), 2);
+        assert!(t.iter().all(|r| !r.endpoint));
+    }
+
+    #[test]
     fn table_lists_ends_and_strictness() {
         let h = [5.0, 1.0, 1.0, 3.0, 0.0, 4.0];
         let t = extrema_table(&Series::uniform(6), &h);

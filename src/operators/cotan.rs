@@ -1,0 +1,120 @@
+//! Cotangent stiffness and lumped mass on triangles (grids now, meshes later).
+
+use super::sparse::{from_triplets, Sparse};
+use crate::domain::Grid2d;
+use faer::sparse::Triplet;
+
+fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+fn cross_norm(a: [f64; 3], b: [f64; 3]) -> f64 {
+    let c = [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]];
+    dot(c, c).sqrt()
+}
+
+/// Stiffness `K = −L` (`#V × #V`) of piecewise-linear elements on triangles:
+/// `K[i][j] = −½ (cot α_ij + cot β_ij)` over the (one or two) angles opposite edge ij and
+/// `K[i][i] = −Σ_j K[i][j]`, so `fᵀKf = ∫|∇f|²` for the interpolant and `K·1 = 0`.
+/// Obtuse angles give positive off-diagonal entries (negative cotangent weights).
+///
+/// # Panics
+/// If a triangle indexes past `positions` (callers validate meshes first).
+/// Ref: Pinkall & Polthier 1993.
+pub fn cotan_stiffness(positions: &[[f64; 3]], triangles: &[[usize; 3]]) -> Sparse {
+    let n = positions.len();
+    let mut t = Vec::with_capacity(12 * triangles.len());
+    for tri in triangles {
+        for k in 0..3 {
+            let (i, j, o) = (tri[k], tri[(k + 1) % 3], tri[(k + 2) % 3]);
+            let (a, b) = (sub(positions[i], positions[o]), sub(positions[j], positions[o]));
+            let w = 0.5 * dot(a, b) / cross_norm(a, b);
+            t.push(Triplet::new(i, j, -w));
+            t.push(Triplet::new(j, i, -w));
+            t.push(Triplet::new(i, i, w));
+            t.push(Triplet::new(j, j, w));
+        }
+    }
+    from_triplets(n, n, &t)
+}
+
+/// Lumped (barycentric) mass: a third of the area of every triangle at each of its vertices.
+pub fn lumped_mass(positions: &[[f64; 3]], triangles: &[[usize; 3]]) -> Vec<f64> {
+    let mut m = vec![0.0; positions.len()];
+    for tri in triangles {
+        let area =
+            0.5 * cross_norm(sub(positions[tri[1]], positions[tri[0]]), sub(positions[tri[2]], positions[tri[0]]));
+        for &v in tri {
+            m[v] += area / 3.0;
+        }
+    }
+    m
+}
+
+fn grid_geometry(grid: &Grid2d) -> (Vec<[f64; 3]>, Vec<[usize; 3]>) {
+    let positions = (0..crate::domain::Domain::n_vertices(grid))
+        .map(|v| {
+            let p = grid.position(v);
+            [p[0], p[1], 0.0]
+        })
+        .collect();
+    (positions, grid.triangles().collect())
+}
+
+/// Cotangent stiffness of the triangulated grid with spacing |dx|, |dy|: every diagonal
+/// weight is exactly 0 (both opposite angles are right angles), so this is the 5-point
+/// stencil with weights `|dy|/|dx|` (horizontal) and `|dx|/|dy|` (vertical) (NOTES.md 4).
+pub fn grid_stiffness(grid: &Grid2d) -> Sparse {
+    let (p, t) = grid_geometry(grid);
+    cotan_stiffness(&p, &t)
+}
+
+/// Lumped mass of the triangulated grid; sums to the grid's area `(nx−1)|dx| · (ny−1)|dy|`.
+pub fn grid_mass(grid: &Grid2d) -> Vec<f64> {
+    let (p, t) = grid_geometry(grid);
+    lumped_mass(&p, &t)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::domain::Domain;
+    use crate::operators::quadratic_form;
+    use crate::operators::sparse::mul_vec;
+
+    #[test]
+    fn grid_stiffness_is_the_five_point_stencil() {
+        let g = Grid2d::with_geometry(5, 4, [0.5, -2.0], [0.0, 0.0]).unwrap();
+        let k = grid_stiffness(&g).to_dense();
+        let v = g.index(1, 2);
+        assert!((k[(v, g.index(1, 1))] + 2.0 / 0.5).abs() < 1e-12, "horizontal |dy|/|dx|");
+        assert!((k[(v, g.index(0, 2))] + 0.5 / 2.0).abs() < 1e-12, "vertical |dx|/|dy|");
+        assert!(k[(v, g.index(0, 1))].abs() < 1e-12, "diagonal weight 0");
+        assert!((k[(v, v)] - 2.0 * (4.0 + 0.25)).abs() < 1e-12);
+        for s in mul_vec(&grid_stiffness(&g), &vec![1.0; g.n_vertices()]) {
+            assert!(s.abs() < 1e-12);
+        }
+        let m = grid_mass(&g);
+        assert!((m.iter().sum::<f64>() - 4.0 * 0.5 * 3.0 * 2.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn dirichlet_energy_of_a_linear_function_is_exact() {
+        // f = 3x − y on a scaled grid: ∫|∇f|² = 10 · area
+        let g = Grid2d::with_geometry(6, 5, [0.2, 0.3], [0.0, 0.0]).unwrap();
+        let f: Vec<f64> = (0..g.n_vertices()).map(|v| 3.0 * g.position(v)[0] - g.position(v)[1]).collect();
+        let area = 5.0 * 0.2 * 4.0 * 0.3;
+        assert!((quadratic_form(&grid_stiffness(&g), &f) - 10.0 * area).abs() < 1e-10);
+    }
+
+    #[test]
+    fn obtuse_triangles_give_negative_weights() {
+        // an obtuse triangle: the edge opposite the obtuse angle gets a positive K entry
+        let p = [[0.0, 0.0, 0.0], [2.0, 0.0, 0.0], [1.0, 0.2, 0.0]];
+        let k = cotan_stiffness(&p, &[[0, 1, 2]]).to_dense();
+        assert!(k[(0, 1)] > 0.0);
+        assert!(k[(0, 2)] < 0.0);
+    }
+}

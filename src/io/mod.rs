@@ -1,6 +1,7 @@
 //! Reading and writing files. Every output goes to a temporary file in the target's directory
 //! and is renamed into place, so a failed run never leaves a half-written file.
 
+pub mod grid;
 pub mod series_csv;
 
 use crate::error::{Error, Result};

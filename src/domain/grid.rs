@@ -106,6 +106,10 @@ impl Domain for Grid2d {
         PairingRule::Surface
     }
 
+    fn triangles(&self) -> Vec<[usize; 3]> {
+        Grid2d::triangles(self).collect()
+    }
+
     fn diameter(&self) -> f64 {
         let w = (self.nx - 1) as f64 * self.spacing[0].abs();
         let h = (self.ny - 1) as f64 * self.spacing[1].abs();

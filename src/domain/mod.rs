@@ -38,6 +38,11 @@ pub trait Domain {
     /// Largest distance between two vertices (or a bound of it): the length scale of defaults.
     fn diameter(&self) -> f64;
 
+    /// The triangles of a 2D domain (none for a series).
+    fn triangles(&self) -> Vec<[usize; 3]> {
+        Vec::new()
+    }
+
     /// Every edge once, as `(i, j)` with `i < j`.
     fn edges(&self) -> Vec<(usize, usize)> {
         let mut out = Vec::new();

@@ -3,6 +3,7 @@
 //! Everything here compares vertices in SoS order (value, index) and sees the domain only
 //! through [`crate::domain::Domain`]; it never sees an operator.
 
+pub mod gradient;
 pub mod persistence;
 pub mod selection;
 

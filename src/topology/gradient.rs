@@ -1,0 +1,399 @@
+//! Forman's discrete gradient on a triangulated surface by ProcessLowerStars (Robins, Wood &
+//! Sheppard 2011), applied to simplicial lower stars, with one cone per boundary loop
+//! (NOTES.md 1).
+//!
+//! The cone vertices enter the filtration last, so the 0-dimensional structure of the real
+//! vertices is unchanged while boundary minima become interior minima of a closed surface.
+//! The *descending* structure is the gradient of the SoS order (minima are its critical
+//! vertices); the *ascending* one is the gradient of the reversed order with the cones still
+//! last (its critical vertices are the maxima, boundary maxima included).
+//!
+//! ```
+//! use toposmooth::{domain::Grid2d, topology::gradient::{Direction, DiscreteGradient}};
+//! let g = Grid2d::new(3, 3)?;
+//! let h = [0.0, 1.0, 0.0, 1.0, 2.0, 1.0, 0.0, 1.0, 0.0];
+//! let down = DiscreteGradient::new(&g, &h, Direction::Descending);
+//! assert_eq!(down.critical_vertices(), vec![0, 2, 6, 8]); // four corner minima
+//! assert_eq!(down.euler_characteristic(), 2); // the coned grid is a sphere
+//! # Ok::<(), toposmooth::Error>(())
+//! ```
+
+use crate::domain::{sos_sort, Domain};
+use std::collections::HashMap;
+
+/// Which structure to build.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Direction {
+    /// SoS order: critical vertices are minima; V-paths descend.
+    Descending,
+    /// Reversed SoS order: critical vertices are maxima; V-paths ascend.
+    Ascending,
+}
+
+/// What a cell is paired with.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Pair {
+    None,
+    Critical,
+    Cell(u32),
+}
+
+/// The coned complex and its discrete gradient.
+#[derive(Clone, Debug)]
+pub struct DiscreteGradient {
+    n_real: usize,
+    /// Filtration rank of every vertex (cones last).
+    rank: Vec<u32>,
+    edges: Vec<[u32; 2]>,
+    triangles: Vec<[u32; 3]>,
+    vertex_edges: Vec<Vec<u32>>,
+    edge_triangles: Vec<Vec<u32>>,
+    vertex_pair: Vec<Pair>,
+    edge_pair: Vec<Pair>,
+    triangle_pair: Vec<Pair>,
+}
+
+impl DiscreteGradient {
+    /// Builds the coned complex of `domain` and runs ProcessLowerStars in the given direction.
+    ///
+    /// # Panics
+    /// If `values.len() != domain.n_vertices()` or the domain has no triangles.
+    pub fn new<D: Domain>(domain: &D, values: &[f64], direction: Direction) -> Self {
+        let n = domain.n_vertices();
+        assert_eq!(values.len(), n);
+        let mut triangles: Vec<[u32; 3]> = domain.triangles().into_iter().map(|t| t.map(|v| v as u32)).collect();
+        assert!(!triangles.is_empty(), "the discrete gradient needs a triangulated domain");
+        // edges and their triangles
+        let mut edge_id: HashMap<(u32, u32), u32> = HashMap::new();
+        let mut edges: Vec<[u32; 2]> = Vec::new();
+        let mut edge_triangles: Vec<Vec<u32>> = Vec::new();
+        let mut add_triangle = |t: [u32; 3], ti: u32, edges: &mut Vec<[u32; 2]>, et: &mut Vec<Vec<u32>>| {
+            for k in 0..3 {
+                let (a, b) = (t[k].min(t[(k + 1) % 3]), t[k].max(t[(k + 1) % 3]));
+                let id = *edge_id.entry((a, b)).or_insert_with(|| {
+                    edges.push([a, b]);
+                    et.push(Vec::new());
+                    (edges.len() - 1) as u32
+                });
+                et[id as usize].push(ti);
+            }
+        };
+        for (ti, t) in triangles.clone().into_iter().enumerate() {
+            add_triangle(t, ti as u32, &mut edges, &mut edge_triangles);
+        }
+        // boundary loops: boundary edges have one triangle; walk them vertex to vertex
+        let boundary: Vec<[u32; 2]> =
+            edges.iter().zip(&edge_triangles).filter(|(_, t)| t.len() == 1).map(|(e, _)| *e).collect();
+        let mut next: HashMap<u32, Vec<u32>> = HashMap::new();
+        for e in &boundary {
+            next.entry(e[0]).or_default().push(e[1]);
+            next.entry(e[1]).or_default().push(e[0]);
+        }
+        let mut loop_of: HashMap<u32, u32> = HashMap::new();
+        let mut n_loops = 0u32;
+        for e in &boundary {
+            if loop_of.contains_key(&e[0]) {
+                continue;
+            }
+            let mut stack = vec![e[0]];
+            while let Some(v) = stack.pop() {
+                if loop_of.insert(v, n_loops).is_none() {
+                    stack.extend(next[&v].iter().copied());
+                }
+            }
+            n_loops += 1;
+        }
+        let cone = |l: u32| n as u32 + l;
+        for e in &boundary {
+            let t = [e[0], e[1], cone(loop_of[&e[0]])];
+            let ti = triangles.len() as u32;
+            triangles.push(t);
+            add_triangle(t, ti, &mut edges, &mut edge_triangles);
+        }
+        let n_all = n + n_loops as usize;
+        let mut order = sos_sort(values);
+        if direction == Direction::Ascending {
+            order.reverse();
+        }
+        let mut rank = vec![0u32; n_all];
+        for (k, &v) in order.iter().enumerate() {
+            rank[v] = k as u32;
+        }
+        for l in 0..n_loops {
+            rank[cone(l) as usize] = (n + l as usize) as u32;
+        }
+        let mut vertex_edges: Vec<Vec<u32>> = vec![Vec::new(); n_all];
+        for (ei, e) in edges.iter().enumerate() {
+            vertex_edges[e[0] as usize].push(ei as u32);
+            vertex_edges[e[1] as usize].push(ei as u32);
+        }
+        let mut g = DiscreteGradient {
+            n_real: n,
+            rank,
+            vertex_pair: vec![Pair::None; n_all],
+            edge_pair: vec![Pair::None; edges.len()],
+            triangle_pair: vec![Pair::None; triangles.len()],
+            edges,
+            triangles,
+            vertex_edges,
+            edge_triangles,
+        };
+        let mut by_rank: Vec<u32> = (0..n_all as u32).collect();
+        by_rank.sort_by_key(|&v| g.rank[v as usize]);
+        for v in by_rank {
+            g.process_lower_star(v);
+        }
+        g
+    }
+
+    fn other(&self, e: u32, v: u32) -> u32 {
+        let [a, b] = self.edges[e as usize];
+        if a == v {
+            b
+        } else {
+            a
+        }
+    }
+
+    /// Ranks of a lower-star cell's vertices other than v, descending (the comparison key).
+    fn key(&self, cell: Cell, v: u32) -> [u32; 2] {
+        match cell {
+            Cell::Edge(e) => [self.rank[self.other(e, v) as usize], 0],
+            Cell::Triangle(t) => {
+                let mut r: Vec<u32> =
+                    self.triangles[t as usize].iter().filter(|&&w| w != v).map(|&w| self.rank[w as usize]).collect();
+                r.sort_unstable_by(|a, b| b.cmp(a));
+                [r[0], r[1] + 1]
+            }
+        }
+    }
+
+    fn process_lower_star(&mut self, v: u32) {
+        let rv = self.rank[v as usize];
+        let lower_edges: Vec<u32> = self.vertex_edges[v as usize]
+            .iter()
+            .copied()
+            .filter(|&e| self.rank[self.other(e, v) as usize] < rv)
+            .collect();
+        if lower_edges.is_empty() {
+            self.vertex_pair[v as usize] = Pair::Critical;
+            return;
+        }
+        let in_star = |g: &Self, t: u32| g.triangles[t as usize].iter().all(|&w| g.rank[w as usize] <= rv);
+        let mut lower_triangles: Vec<u32> = Vec::new();
+        for &e in &lower_edges {
+            for &t in &self.edge_triangles[e as usize] {
+                if in_star(self, t) && !lower_triangles.contains(&t) {
+                    lower_triangles.push(t);
+                }
+            }
+        }
+        // faces of a lower-star triangle inside the lower star: its two edges at v
+        let faces = |g: &Self, t: u32| -> [u32; 2] {
+            let mut f = [0u32; 2];
+            let mut k = 0;
+            for &e in &lower_edges {
+                if g.edge_triangles[e as usize].contains(&t) {
+                    f[k] = e;
+                    k += 1;
+                }
+            }
+            f
+        };
+        let unpaired_faces =
+            |g: &Self, t: u32| faces(g, t).iter().filter(|&&e| g.edge_pair[e as usize] == Pair::None).count();
+        let delta = *lower_edges.iter().min_by_key(|&&e| self.key(Cell::Edge(e), v)).expect("non-empty");
+        self.vertex_pair[v as usize] = Pair::Cell(delta);
+        self.edge_pair[delta as usize] = Pair::Cell(v);
+        let mut pq_zero: Vec<Cell> = lower_edges.iter().filter(|&&e| e != delta).map(|&e| Cell::Edge(e)).collect();
+        let mut pq_one: Vec<u32> = lower_triangles
+            .iter()
+            .copied()
+            .filter(|&t| faces(self, t).contains(&delta) && unpaired_faces(self, t) == 1)
+            .collect();
+        loop {
+            while let Some(k) = (0..pq_one.len()).min_by_key(|&k| self.key(Cell::Triangle(pq_one[k]), v)) {
+                let alpha = pq_one.swap_remove(k);
+                if self.triangle_pair[alpha as usize] != Pair::None {
+                    continue;
+                }
+                if unpaired_faces(self, alpha) == 0 {
+                    pq_zero.push(Cell::Triangle(alpha));
+                    continue;
+                }
+                let lower =
+                    *faces(self, alpha).iter().find(|&&e| self.edge_pair[e as usize] == Pair::None).expect("one");
+                self.edge_pair[lower as usize] = Pair::Cell(alpha);
+                self.triangle_pair[alpha as usize] = Pair::Cell(lower);
+                pq_zero.retain(|c| *c != Cell::Edge(lower));
+                for &t in &lower_triangles {
+                    if self.triangle_pair[t as usize] == Pair::None
+                        && (faces(self, t).contains(&lower))
+                        && unpaired_faces(self, t) == 1
+                        && !pq_one.contains(&t)
+                    {
+                        pq_one.push(t);
+                    }
+                }
+            }
+            let Some(k) = (0..pq_zero.len()).min_by_key(|&k| self.key(pq_zero[k], v)) else { break };
+            let gamma = pq_zero.swap_remove(k);
+            match gamma {
+                Cell::Edge(e) => {
+                    if self.edge_pair[e as usize] != Pair::None {
+                        continue;
+                    }
+                    self.edge_pair[e as usize] = Pair::Critical;
+                    for &t in &lower_triangles {
+                        if self.triangle_pair[t as usize] == Pair::None
+                            && faces(self, t).contains(&e)
+                            && unpaired_faces(self, t) == 1
+                            && !pq_one.contains(&t)
+                        {
+                            pq_one.push(t);
+                        }
+                    }
+                }
+                Cell::Triangle(t) => {
+                    if self.triangle_pair[t as usize] == Pair::None {
+                        self.triangle_pair[t as usize] = Pair::Critical;
+                    }
+                }
+            }
+        }
+        // every lower-star triangle not reached is critical (both faces were paired elsewhere)
+        for &t in &lower_triangles {
+            if self.triangle_pair[t as usize] == Pair::None {
+                self.triangle_pair[t as usize] = Pair::Critical;
+            }
+        }
+        for &e in &lower_edges {
+            if self.edge_pair[e as usize] == Pair::None {
+                self.edge_pair[e as usize] = Pair::Critical;
+            }
+        }
+    }
+
+    /// Critical vertices among the real ones (minima when descending, maxima when ascending).
+    pub fn critical_vertices(&self) -> Vec<usize> {
+        (0..self.n_real).filter(|&v| self.vertex_pair[v] == Pair::Critical).collect()
+    }
+
+    /// Critical edges (saddles) as vertex pairs; edges at a cone name the cone as `n + loop`.
+    pub fn critical_edges(&self) -> Vec<[usize; 2]> {
+        (0..self.edges.len())
+            .filter(|&e| self.edge_pair[e] == Pair::Critical)
+            .map(|e| self.edges[e].map(|v| v as usize))
+            .collect()
+    }
+
+    /// Number of critical cells of each dimension on the coned complex (cones included).
+    pub fn critical_counts(&self) -> [usize; 3] {
+        [
+            self.vertex_pair.iter().filter(|p| **p == Pair::Critical).count(),
+            self.edge_pair.iter().filter(|p| **p == Pair::Critical).count(),
+            self.triangle_pair.iter().filter(|p| **p == Pair::Critical).count(),
+        ]
+    }
+
+    /// `#critical vertices − #critical edges + #critical triangles` (2 per closed component).
+    pub fn euler_characteristic(&self) -> i64 {
+        let [a, b, c] = self.critical_counts();
+        a as i64 - b as i64 + c as i64
+    }
+
+    /// Whether every cell is paired exactly once or critical (a valid discrete vector field).
+    pub fn is_complete(&self) -> bool {
+        self.vertex_pair.iter().chain(&self.edge_pair).chain(&self.triangle_pair).all(|p| *p != Pair::None)
+    }
+
+    /// The V-path from vertex `v` down the gradient (up, when ascending) to a critical
+    /// vertex: `v`, then the other end of the edge paired with it, and so on. Real vertices only.
+    pub fn vertex_path(&self, v: usize) -> Vec<usize> {
+        let mut path = vec![v];
+        let mut x = v as u32;
+        while let Pair::Cell(e) = self.vertex_pair[x as usize] {
+            x = self.other(e, x);
+            path.push(x as usize);
+        }
+        path.retain(|&w| w < self.n_real);
+        path
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Cell {
+    Edge(u32),
+    Triangle(u32),
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::domain::{sos_greater, sos_less, Grid2d};
+
+    fn random_field(seed: u64, n: usize, levels: u64) -> Vec<f64> {
+        let mut s = seed;
+        (0..n)
+            .map(|_| {
+                s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+                ((s >> 33) % levels) as f64
+            })
+            .collect()
+    }
+
+    #[test]
+    fn euler_relation_and_extrema_on_random_fields_with_ties() {
+        for seed in 0..300u64 {
+            let (nx, ny) = (2 + (seed % 9) as usize, 2 + (seed / 9 % 7) as usize);
+            let g = Grid2d::new(nx, ny).unwrap();
+            let h = random_field(seed, nx * ny, 1 + seed % 6);
+            for dir in [Direction::Descending, Direction::Ascending] {
+                let grad = DiscreteGradient::new(&g, &h, dir);
+                assert!(grad.is_complete(), "seed {seed}");
+                assert_eq!(grad.euler_characteristic(), 2, "seed {seed} {dir:?}: {:?}", grad.critical_counts());
+                // critical vertices are exactly the SoS extrema, boundary ones included
+                let expected: Vec<usize> = (0..g.n_vertices())
+                    .filter(|&v| {
+                        g.neighbors(v).all(|w| match dir {
+                            Direction::Descending => sos_greater(&h, w, v),
+                            Direction::Ascending => sos_less(&h, w, v),
+                        })
+                    })
+                    .collect();
+                assert_eq!(grad.critical_vertices(), expected, "seed {seed} {dir:?}");
+                // V-paths from every vertex end at a critical vertex, monotonically
+                for v in 0..g.n_vertices() {
+                    let p = grad.vertex_path(v);
+                    assert!(expected.contains(p.last().unwrap()));
+                    for w in p.windows(2) {
+                        match dir {
+                            Direction::Descending => assert!(sos_less(&h, w[1], w[0])),
+                            Direction::Ascending => assert!(sos_greater(&h, w[1], w[0])),
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn a_saddle_has_one_critical_edge_between_two_minima() {
+        // h = x² − y² on a 5 × 5 grid centred at the saddle; minima on the left/right... of −y²
+        let g = Grid2d::new(5, 5).unwrap();
+        let h: Vec<f64> = (0..25)
+            .map(|v| {
+                let (r, c) = g.row_col(v);
+                let (x, y) = (c as f64 - 2.0, r as f64 - 2.0);
+                x * x - y * y + 1e-3 * v as f64
+            })
+            .collect();
+        let down = DiscreteGradient::new(&g, &h, Direction::Descending);
+        let minima = down.critical_vertices();
+        assert_eq!(minima.len(), 2, "{minima:?}"); // top and bottom edge midpoints region
+        let saddles: Vec<[usize; 2]> = down.critical_edges().into_iter().filter(|e| e[0] < 25 && e[1] < 25).collect();
+        assert_eq!(saddles.len(), 1, "{saddles:?}");
+        let ends: Vec<usize> = saddles[0].iter().map(|&v| *down.vertex_path(v).last().unwrap()).collect();
+        assert_ne!(ends[0], ends[1], "the saddle joins the two minima");
+    }
+}

@@ -147,6 +147,9 @@ pub struct RunSettings {
     /// Margin ε (in the field's units) and the largest feasible one (a lower bound, twice the
     /// cap, when that was already feasible).
     pub margin: [f64; 2],
+    /// Smallest increment of u along a constrained edge (field units): u itself is a feasible
+    /// point of the QP when this is ≥ the margin (the QP is feasible either way).
+    pub u_margin: f64,
     /// Solver settings as requested.
     pub solver: QpSettings,
 }
@@ -268,6 +271,7 @@ pub fn smooth<D: Smoothable>(domain: &D, h: &[f64], settings: &SmoothSettings) -
 
     let t = Instant::now();
     let hint: Vec<f64> = u.iter().map(|v| (v - lo) / range).collect();
+    let u_margin = edges.iter().map(|&(i, j)| u[j] - u[i]).fold(f64::INFINITY, f64::min);
     let qp = MonotoneQp { p: &p, q: &q, fixed: &fixed, edges: &edges, margin: eps, hint: Some(&hint) };
     let sol = solve_monotone_qp(&qp, &settings.qp)?;
     seconds.solve = t.elapsed().as_secs_f64();
@@ -317,6 +321,7 @@ pub fn smooth<D: Smoothable>(domain: &D, h: &[f64], settings: &SmoothSettings) -
             smooth_length: [settings.smooth_length, ell],
             edge_set: settings.edges,
             margin: [eps * range, eps_max * range],
+            u_margin,
             solver: settings.qp.clone(),
         },
         constraints: edges.len(),

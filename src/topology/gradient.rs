@@ -307,6 +307,111 @@ impl DiscreteGradient {
         self.vertex_pair.iter().chain(&self.edge_pair).chain(&self.triangle_pair).all(|p| *p != Pair::None)
     }
 
+    /// The critical vertex a V-path from `v` ends at (cones included).
+    fn path_end(&self, v: u32) -> u32 {
+        let mut x = v;
+        while let Pair::Cell(e) = self.vertex_pair[x as usize] {
+            x = self.other(e, x);
+        }
+        x
+    }
+
+    /// Cancels every critical vertex that `keep` does not keep with a critical edge, by
+    /// reversing the unique V-path between them, taking the persistence pairs of the same
+    /// direction (sublevel pairs when descending, superlevel pairs when ascending) in order of
+    /// increasing persistence. The Euler characteristic is unchanged; afterwards the critical
+    /// real vertices are exactly the kept ones.
+    ///
+    /// # Errors
+    /// A description of the pair that could not be cancelled (no critical edge at its merge
+    /// vertex joins its basin to another one): never expected for persistence-chosen sets.
+    pub fn simplify(&mut self, pairs: &[super::Pair], keep: &[bool]) -> Result<usize, String> {
+        let mut order: Vec<&super::Pair> = pairs.iter().filter(|p| p.partner.is_some() && !keep[p.extremum]).collect();
+        order.sort_by(|a, b| {
+            a.persistence.total_cmp(&b.persistence).then(
+                self.rank[a.partner.expect("filtered") as usize].cmp(&self.rank[b.partner.expect("filtered") as usize]),
+            )
+        });
+        let mut cancelled = 0;
+        for p in order {
+            let m = p.extremum as u32;
+            let s = p.partner.expect("filtered") as u32;
+            if self.vertex_pair[m as usize] != Pair::Critical {
+                return Err(format!("vertex {m} is not critical any more"));
+            }
+            let rs = self.rank[s as usize];
+            let mut done = false;
+            for &e in &self.vertex_edges[s as usize].clone() {
+                if self.edge_pair[e as usize] != Pair::Critical || self.rank[self.other(e, s) as usize] > rs {
+                    continue;
+                }
+                let [a, b] = self.edges[e as usize];
+                let (ea, eb) = (self.path_end(a), self.path_end(b));
+                let start = match (ea == m, eb == m) {
+                    (true, false) => a,
+                    (false, true) => b,
+                    _ => continue,
+                };
+                self.reverse(e, start);
+                cancelled += 1;
+                done = true;
+                break;
+            }
+            if !done {
+                return Err(format!(
+                    "no critical edge at vertex {s} joins the basin of extremum {m} to another one (persistence {})",
+                    p.persistence
+                ));
+            }
+        }
+        Ok(cancelled)
+    }
+
+    /// Reverses the V-path from `start` (an endpoint of the critical edge `e`) to its critical
+    /// vertex: `e` pairs with `start`, every edge of the path with the vertex after it.
+    fn reverse(&mut self, e: u32, start: u32) {
+        let mut edge = e;
+        let mut x = start;
+        loop {
+            let next = self.vertex_pair[x as usize];
+            self.vertex_pair[x as usize] = Pair::Cell(edge);
+            self.edge_pair[edge as usize] = Pair::Cell(x);
+            match next {
+                Pair::Cell(f) => {
+                    edge = f;
+                    x = self.other(f, x);
+                }
+                _ => break,
+            }
+        }
+    }
+
+    /// Critical edges whose both endpoints are real vertices, with their *saddle vertex*: the
+    /// endpoint entering the filtration last (the highest when descending, the lowest when
+    /// ascending), in whose lower star the edge was made critical.
+    pub fn saddles(&self) -> Vec<Saddle> {
+        (0..self.edges.len())
+            .filter(|&e| self.edge_pair[e] == Pair::Critical)
+            .filter_map(|e| {
+                let [a, b] = self.edges[e];
+                if a as usize >= self.n_real || b as usize >= self.n_real {
+                    return None;
+                }
+                let (top, other) = if self.rank[a as usize] > self.rank[b as usize] { (a, b) } else { (b, a) };
+                Some(Saddle { vertex: top as usize, other: other as usize })
+            })
+            .collect()
+    }
+
+    /// The two separatrices of a saddle: the V-paths from the saddle vertex and from the other
+    /// endpoint of its edge, each starting at the saddle vertex (real vertices only).
+    pub fn separatrices(&self, saddle: &Saddle) -> [Vec<usize>; 2] {
+        let own = self.vertex_path(saddle.vertex);
+        let mut via = vec![saddle.vertex];
+        via.extend(self.vertex_path(saddle.other));
+        [own, via]
+    }
+
     /// The V-path from vertex `v` down the gradient (up, when ascending) to a critical
     /// vertex: `v`, then the other end of the edge paired with it, and so on. Real vertices only.
     pub fn vertex_path(&self, v: usize) -> Vec<usize> {
@@ -319,6 +424,15 @@ impl DiscreteGradient {
         path.retain(|&w| w < self.n_real);
         path
     }
+}
+
+/// A critical edge between real vertices, named by its saddle vertex and its other endpoint.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Saddle {
+    /// The endpoint entering the filtration last (the PL saddle vertex).
+    pub vertex: usize,
+    /// The other endpoint.
+    pub other: usize,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -375,6 +489,42 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    fn simplification_keeps_exactly_the_selected_extrema_on_random_fields_with_ties() {
+        use crate::topology::{select, Role, Selection};
+        let mut checked = 0;
+        for seed in 0..2000u64 {
+            let (nx, ny) = (2 + (seed % 11) as usize, 2 + (seed / 11 % 9) as usize);
+            let g = Grid2d::new(nx, ny).unwrap();
+            let h = random_field(seed * 7 + 1, nx * ny, 2 + seed % 9);
+            if h.iter().all(|&v| v == h[0]) {
+                continue;
+            }
+            let frac = [0.05, 0.2, 0.5, 0.9][(seed % 4) as usize];
+            let kept = select(&g, &h, &Selection::Relative(frac)).unwrap();
+            for (dir, role) in [(Direction::Descending, Role::Min), (Direction::Ascending, Role::Max)] {
+                let mut grad = DiscreteGradient::new(&g, &h, dir);
+                let pairs = match dir {
+                    Direction::Descending => crate::topology::sublevel_pairs(&g, &h),
+                    Direction::Ascending => crate::topology::superlevel_pairs(&g, &h),
+                };
+                let keep: Vec<bool> = kept.roles.iter().map(|&r| r == role).collect();
+                grad.simplify(&pairs, &keep).unwrap_or_else(|e| panic!("seed {seed} {dir:?}: {e}"));
+                assert!(grad.is_complete());
+                assert_eq!(grad.euler_characteristic(), 2, "seed {seed}");
+                let expected: Vec<usize> = (0..g.n_vertices()).filter(|&v| keep[v]).collect();
+                assert_eq!(grad.critical_vertices(), expected, "seed {seed} {dir:?}");
+                for s in grad.saddles() {
+                    for path in grad.separatrices(&s) {
+                        assert!(keep[*path.last().unwrap()], "separatrix ends at a kept extremum");
+                    }
+                }
+            }
+            checked += 1;
+        }
+        assert!(checked > 1900);
     }
 
     #[test]

@@ -329,7 +329,7 @@ impl DiscreteGradient {
         let mut order: Vec<&super::Pair> = pairs.iter().filter(|p| p.partner.is_some() && !keep[p.extremum]).collect();
         order.sort_by(|a, b| {
             a.persistence.total_cmp(&b.persistence).then(
-                self.rank[a.partner.expect("filtered") as usize].cmp(&self.rank[b.partner.expect("filtered") as usize]),
+                self.rank[a.partner.expect("filtered")].cmp(&self.rank[b.partner.expect("filtered")]),
             )
         });
         let mut cancelled = 0;

@@ -12,13 +12,15 @@
 //! ```
 
 use crate::constraints::{choose_margin, constraint_edges, margin_cap, max_margin, EdgeSet};
-use crate::domain::{sos_sort, Domain, Series};
+use crate::domain::{sos_sort, Domain, Grid2d, Series};
 use crate::error::{Error, Result};
 use crate::operators::{
-    polyharmonic, quadratic_form, scaled_plus_diagonal, series_mass, series_stiffness, Energy, Sparse,
+    dirichlet_solve, grid_mass, grid_stiffness, polyharmonic, quadratic_form, scaled_plus_diagonal, series_mass,
+    series_stiffness, Energy, Sparse,
 };
-use crate::representative::series_representative;
+use crate::representative::{separatrix_representative, series_representative};
 use crate::solve::{repair, solve_monotone_qp, Method, MonotoneQp, QpSettings, RepairSummary, SolveStatus};
+use crate::topology::morse_smale::MorseSmale;
 use crate::topology::{count_sos_extrema, select, KeptExtremum, KeptSet, Role, Selection};
 use crate::verify::{certify, Certificate};
 use std::time::Instant;
@@ -29,8 +31,9 @@ pub trait Smoothable: Domain {
     fn stiffness(&self) -> Sparse;
     /// Lumped mass (diagonal, > 0).
     fn mass(&self) -> Vec<f64>;
-    /// A function with exactly the kept extrema (checked by the pipeline).
-    fn representative(&self, h: &[f64], kept: &KeptSet) -> Result<Vec<f64>>;
+    /// A function with exactly the kept extrema (checked by the pipeline), and the name of
+    /// the construction that produced it.
+    fn representative(&self, h: &[f64], kept: &KeptSet) -> Result<(Vec<f64>, String)>;
 }
 
 impl Smoothable for Series {
@@ -40,8 +43,54 @@ impl Smoothable for Series {
     fn mass(&self) -> Vec<f64> {
         series_mass(self)
     }
-    fn representative(&self, h: &[f64], kept: &KeptSet) -> Result<Vec<f64>> {
-        series_representative(self, h, kept)
+    fn representative(&self, h: &[f64], kept: &KeptSet) -> Result<(Vec<f64>, String)> {
+        Ok((series_representative(self, h, kept)?, "linear".into()))
+    }
+}
+
+impl Smoothable for Grid2d {
+    fn stiffness(&self) -> Sparse {
+        grid_stiffness(self)
+    }
+    fn mass(&self) -> Vec<f64> {
+        grid_mass(self)
+    }
+    /// The separatrix representative; if it fails its check, the harmonic one (0 at kept
+    /// minima, 1 at kept maxima, rescaled to the data's range).
+    fn representative(&self, h: &[f64], kept: &KeptSet) -> Result<(Vec<f64>, String)> {
+        let k = grid_stiffness(self);
+        let mut why = Vec::new();
+        match MorseSmale::new(self, h, kept).and_then(|ms| separatrix_representative(self, h, kept, &ms, &k)) {
+            Ok(u) => {
+                let c = certify(self, &u, &kept.roles, None);
+                if c.passed {
+                    return Ok((u, "separatrix".into()));
+                }
+                why.push(format!("separatrix representative: {}", c.summary()));
+            }
+            Err(e) => why.push(format!("separatrix representative: {e}")),
+        }
+        let (lo, hi) = h.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| (a.min(v), b.max(v)));
+        let fixed: Vec<Option<f64>> = kept
+            .roles
+            .iter()
+            .map(|r| match r {
+                Role::Min => Some(lo),
+                Role::Max => Some(hi),
+                _ => None,
+            })
+            .collect();
+        match dirichlet_solve(&k, &fixed) {
+            Ok(u) => {
+                let c = certify(self, &u, &kept.roles, None);
+                if c.passed {
+                    return Ok((u, format!("harmonic (fallback: {})", why.join("; "))));
+                }
+                why.push(format!("harmonic representative: {}", c.summary()));
+            }
+            Err(e) => why.push(format!("harmonic representative: {e}")),
+        }
+        Err(Error::Representative { path: None, message: why.join("; ") })
     }
 }
 
@@ -189,6 +238,8 @@ pub struct Report {
     pub solver_fallback: Option<String>,
     /// What the repair changed.
     pub repair: RepairSummary,
+    /// Which representative was used (and why a fallback was needed).
+    pub representative: String,
     /// Certificate of u (items 1, 2, 4).
     pub representative_certificate: Certificate,
     /// Certificate of the output (items 1–4).
@@ -231,7 +282,7 @@ pub fn smooth<D: Smoothable>(domain: &D, h: &[f64], settings: &SmoothSettings) -
     seconds.persistence = t.elapsed().as_secs_f64();
 
     let t = Instant::now();
-    let u = domain.representative(h, &kept)?;
+    let (u, representative) = domain.representative(h, &kept)?;
     let representative_certificate = certify(domain, &u, &kept.roles, None);
     if !representative_certificate.passed {
         return Err(Error::Representative { path: None, message: representative_certificate.summary() });
@@ -336,6 +387,7 @@ pub fn smooth<D: Smoothable>(domain: &D, h: &[f64], settings: &SmoothSettings) -
         solver: sol.method,
         solver_fallback: sol.fallback.clone(),
         repair: repair_summary,
+        representative,
         representative_certificate,
         certificate,
     };

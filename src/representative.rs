@@ -162,6 +162,66 @@ fn strictify(u: &mut [f64], anchors: &[(usize, Role)]) {
     }
 }
 
+/// The separatrix representative on a surface (paper section 3.3, after Weinkauf, Gingold &
+/// Sorkine 2010): kept extrema and surviving saddles at their input values, every vertex on a
+/// separatrix linearly interpolated by arc length between its saddle and its extremum (the
+/// smallest such value on merged descending separatrices, the largest on ascending ones,
+/// NOTES.md 7; a vertex claimed by both stays free), harmonic elsewhere with the Laplacian
+/// `k`, whose off-diagonal weights must be ≤ 0 so that the maximum principle holds.
+///
+/// # Errors
+/// A message when the harmonic solve fails; the caller checks the result with the
+/// certificate and falls back when it does not pass.
+pub fn separatrix_representative<D: crate::domain::Domain>(
+    domain: &D,
+    h: &[f64],
+    kept: &KeptSet,
+    ms: &crate::topology::morse_smale::MorseSmale,
+    k: &crate::operators::Sparse,
+) -> std::result::Result<Vec<f64>, String> {
+    let n = h.len();
+    let mut down = vec![f64::INFINITY; n];
+    let mut up = vec![f64::NEG_INFINITY; n];
+    let dist = |a: usize, b: usize| {
+        let (p, q) = (domain.point(a), domain.point(b));
+        ((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2) + (p[2] - q[2]).powi(2)).sqrt()
+    };
+    let paint = |sep: &crate::topology::morse_smale::Separatrix, target: &mut Vec<f64>, lower: bool| {
+        let p = &sep.path;
+        let total: f64 = p.windows(2).map(|w| dist(w[0], w[1])).sum();
+        let (hs, he) = (h[sep.saddle], h[*p.last().expect("non-empty")]);
+        let mut run = 0.0;
+        for (i, &v) in p.iter().enumerate() {
+            if i > 0 {
+                run += dist(p[i - 1], v);
+            }
+            let t = if total > 0.0 { run / total } else { 1.0 };
+            let value = hs + (he - hs) * t;
+            target[v] = if lower { target[v].min(value) } else { target[v].max(value) };
+        }
+    };
+    for s in &ms.descending {
+        paint(s, &mut down, true);
+    }
+    for s in &ms.ascending {
+        paint(s, &mut up, false);
+    }
+    let fixed: Vec<Option<f64>> = (0..n)
+        .map(|v| {
+            if kept.roles[v].is_fixed() || ms.saddles.binary_search(&v).is_ok() {
+                Some(h[v])
+            } else {
+                match (down[v].is_finite(), up[v].is_finite()) {
+                    (true, false) => Some(down[v]),
+                    (false, true) => Some(up[v]),
+                    _ => None,
+                }
+            }
+        })
+        .collect();
+    crate::operators::dirichlet_solve(k, &fixed)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -106,6 +106,11 @@ impl Domain for Grid2d {
         PairingRule::Surface
     }
 
+    fn point(&self, v: usize) -> [f64; 3] {
+        let [x, y] = self.position(v);
+        [x, y, 0.0]
+    }
+
     fn triangles(&self) -> Vec<[usize; 3]> {
         Grid2d::triangles(self).collect()
     }

@@ -38,6 +38,9 @@ pub trait Domain {
     /// Largest distance between two vertices (or a bound of it): the length scale of defaults.
     fn diameter(&self) -> f64;
 
+    /// Position of vertex `v` (a series lies on the x axis; a grid in the plane z = 0).
+    fn point(&self, v: usize) -> [f64; 3];
+
     /// The triangles of a 2D domain (none for a series).
     fn triangles(&self) -> Vec<[usize; 3]> {
         Vec::new()

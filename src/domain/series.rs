@@ -69,6 +69,10 @@ impl Domain for Series {
         PairingRule::Path
     }
 
+    fn point(&self, v: usize) -> [f64; 3] {
+        [self.x[v], 0.0, 0.0]
+    }
+
     fn diameter(&self) -> f64 {
         self.x[self.x.len() - 1] - self.x[0]
     }

@@ -17,11 +17,13 @@
 //! ```
 
 mod cotan;
+mod harmonic;
 mod polyharmonic;
 mod series;
 mod sparse;
 
 pub use cotan::{cotan_stiffness, grid_mass, grid_stiffness, lumped_mass};
+pub use harmonic::dirichlet_solve;
 pub use polyharmonic::{polyharmonic, Energy};
 pub use series::{series_mass, series_stiffness};
 pub use sparse::{quadratic_form, scaled_plus_diagonal, Sparse};

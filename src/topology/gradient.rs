@@ -328,9 +328,9 @@ impl DiscreteGradient {
     pub fn simplify(&mut self, pairs: &[super::Pair], keep: &[bool]) -> Result<usize, String> {
         let mut order: Vec<&super::Pair> = pairs.iter().filter(|p| p.partner.is_some() && !keep[p.extremum]).collect();
         order.sort_by(|a, b| {
-            a.persistence.total_cmp(&b.persistence).then(
-                self.rank[a.partner.expect("filtered")].cmp(&self.rank[b.partner.expect("filtered")]),
-            )
+            a.persistence
+                .total_cmp(&b.persistence)
+                .then(self.rank[a.partner.expect("filtered")].cmp(&self.rank[b.partner.expect("filtered")]))
         });
         let mut cancelled = 0;
         for p in order {

@@ -4,6 +4,7 @@
 //! through [`crate::domain::Domain`]; it never sees an operator.
 
 pub mod gradient;
+pub mod morse_smale;
 pub mod persistence;
 pub mod selection;
 

@@ -18,7 +18,7 @@ use crate::operators::{
     dirichlet_solve, grid_mass, grid_stiffness, polyharmonic, quadratic_form, scaled_plus_diagonal, series_mass,
     series_stiffness, Energy, Sparse,
 };
-use crate::representative::{separatrix_representative, series_representative};
+use crate::representative::{flooded_representative, separatrix_representative, series_representative};
 use crate::solve::{repair, solve_monotone_qp, Method, MonotoneQp, QpSettings, RepairSummary, SolveStatus};
 use crate::topology::morse_smale::MorseSmale;
 use crate::topology::{count_sos_extrema, select, KeptExtremum, KeptSet, Role, Selection};
@@ -69,6 +69,16 @@ impl Smoothable for Grid2d {
                 why.push(format!("separatrix representative: {}", c.summary()));
             }
             Err(e) => why.push(format!("separatrix representative: {e}")),
+        }
+        match flooded_representative(self, h, kept, &k) {
+            Ok(u) => {
+                let c = certify(self, &u, &kept.roles, None);
+                if c.passed {
+                    return Ok((u, format!("flooded (fallback: {})", why.join("; "))));
+                }
+                why.push(format!("flooded representative: {}", c.summary()));
+            }
+            Err(e) => why.push(format!("flooded representative: {e}")),
         }
         let (lo, hi) = h.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| (a.min(v), b.max(v)));
         let fixed: Vec<Option<f64>> = kept

@@ -222,6 +222,75 @@ pub fn separatrix_representative<D: crate::domain::Domain>(
     crate::operators::dirichlet_solve(k, &fixed)
 }
 
+/// The data's own simplification as a representative (NOTES.md 9, after Tierny & Pascucci
+/// 2012): a flood from the kept minima raises every cancelled basin to its spill level, a flood
+/// from the kept maxima lowers every cancelled peak to its spill level, and the flooded
+/// plateaus get a harmonic fill between the values around them (Laplacian `k` with
+/// non-positive off-diagonal weights), so that no tie is left. Kept values are unchanged.
+///
+/// # Errors
+/// A message when the harmonic solve fails; the caller checks the result with the certificate.
+pub fn flooded_representative<D: crate::domain::Domain>(
+    domain: &D,
+    h: &[f64],
+    kept: &KeptSet,
+    k: &crate::operators::Sparse,
+) -> std::result::Result<Vec<f64>, String> {
+    let mut g = h.to_vec();
+    flood(domain, &mut g, kept, Role::Min);
+    flood(domain, &mut g, kept, Role::Max);
+    let fixed: Vec<Option<f64>> = (0..h.len()).map(|v| (g[v] == h[v]).then_some(h[v])).collect();
+    crate::operators::dirichlet_solve(k, &fixed)
+}
+
+/// Priority flood from the kept extrema of one type: vertices are visited in order of value
+/// (from the kept minima upwards, or from the kept maxima downwards), each taking at least
+/// (at most) the level at which the flood reached it.
+fn flood<D: crate::domain::Domain>(domain: &D, g: &mut [f64], kept: &KeptSet, role: Role) {
+    use std::cmp::Reverse;
+    use std::collections::BinaryHeap;
+    // a total order on f64 keys: the bits of a finite double, made monotone
+    let key = |x: f64| {
+        let x = if role == Role::Min { x } else { -x };
+        let b = (if x == 0.0 { 0.0 } else { x }).to_bits();
+        if b >> 63 == 1 {
+            !b
+        } else {
+            b | (1 << 63)
+        }
+    };
+    let n = g.len();
+    let mut seen = vec![false; n];
+    let mut heap = BinaryHeap::new();
+    for (v, &gv) in g.iter().enumerate() {
+        if kept.roles[v] == role {
+            heap.push(Reverse((key(gv), 0u8, v)));
+        }
+    }
+    let mut level: Option<f64> = None;
+    while let Some(Reverse((_, _, v))) = heap.pop() {
+        if seen[v] {
+            continue;
+        }
+        seen[v] = true;
+        let raise = |lv: f64, x: f64| if role == Role::Min { x.max(lv) } else { x.min(lv) };
+        if kept.roles[v] != role {
+            if let Some(lv) = level {
+                g[v] = raise(lv, g[v]);
+            }
+        }
+        level = Some(match level {
+            Some(lv) => raise(lv, g[v]),
+            None => g[v],
+        });
+        for w in domain.neighbors(v) {
+            if !seen[w] {
+                heap.push(Reverse((key(g[w]), 1u8, w)));
+            }
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

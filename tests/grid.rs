@@ -68,9 +68,9 @@ fn noisy_bumps_keep_exactly_the_persistent_extrema() {
     eprintln!("representative: {}", out.report.representative);
 }
 
-/// Work in progress (issue 4): the separatrix representative with a harmonic fallback; SPEC
-/// wants every persistence-chosen set to certify, the flooded fallback of NOTES.md 9 is still
-/// missing. Every output that is returned must certify exactly; the share of runs that do is
+/// Work in progress (issue 4): the separatrix representative with flooded and harmonic
+/// fallbacks; SPEC wants every persistence-chosen set to certify, and 6 of these 200 still fail
+/// to build a representative. Every output that is returned must certify exactly; the share of runs that do is
 /// held at its current level so that it can only go up.
 #[test]
 fn random_grids_certify_or_say_why() {
@@ -96,7 +96,7 @@ fn random_grids_certify_or_say_why() {
         }
     }
     eprintln!("{stats:?}");
-    let certified = stats.get("separatrix").unwrap_or(&0) + stats.get("harmonic").unwrap_or(&0);
-    assert!(certified >= 190, "{stats:?}");
+    let certified: i32 = stats.iter().filter(|(k, _)| !k.starts_with("exit")).map(|(_, v)| *v).sum();
+    assert!(certified >= 194, "{stats:?}");
     assert!(*stats.get("separatrix").unwrap_or(&0) >= 165, "{stats:?}");
 }

@@ -223,35 +223,35 @@ pub fn separatrix_representative<D: crate::domain::Domain>(
 }
 
 /// The data's own simplification as a representative (NOTES.md 9, after Tierny & Pascucci
-/// 2012): a flood from the kept minima raises every cancelled basin to its spill level, a flood
-/// from the kept maxima lowers every cancelled peak to its spill level, and the flooded
-/// plateaus get a harmonic fill between the values around them (Laplacian `k` with
-/// non-positive off-diagonal weights), so that no tie is left. Kept values are unchanged.
+/// 2012): a priority flood from the kept minima visits the vertices upwards and gives every
+/// vertex at least the next double above the vertex visited before it, so cancelled basins are
+/// raised to their spill level and ties are broken in visiting order; a flood from the kept
+/// maxima does the same downwards. Every vertex but a seed is reached from a visited neighbour
+/// with a strictly smaller (larger) value, so after the two floods only kept extrema remain
+/// (repeated a few times if the second flood undid the first). Kept values are unchanged; the
+/// plateaus get increments of one unit in the last place, keeping the flood order.
 ///
-/// # Errors
-/// A message when the harmonic solve fails; the caller checks the result with the certificate.
-pub fn flooded_representative<D: crate::domain::Domain>(
-    domain: &D,
-    h: &[f64],
-    kept: &KeptSet,
-    k: &crate::operators::Sparse,
-) -> std::result::Result<Vec<f64>, String> {
+/// Returns `None` if the floods do not settle (the caller's check reports it).
+pub fn flooded_representative<D: crate::domain::Domain>(domain: &D, h: &[f64], kept: &KeptSet) -> Option<Vec<f64>> {
     let mut g = h.to_vec();
-    flood(domain, &mut g, kept, Role::Min);
-    flood(domain, &mut g, kept, Role::Max);
-    let fixed: Vec<Option<f64>> = (0..h.len()).map(|v| (g[v] == h[v]).then_some(h[v])).collect();
-    crate::operators::dirichlet_solve(k, &fixed)
+    for _ in 0..8 {
+        flood(domain, &mut g, kept, Role::Min);
+        flood(domain, &mut g, kept, Role::Max);
+        if crate::verify::certify(domain, &g, &kept.roles, None).passed {
+            return Some(g);
+        }
+    }
+    None
 }
 
-/// Priority flood from the kept extrema of one type: vertices are visited in order of value
-/// (from the kept minima upwards, or from the kept maxima downwards), each taking at least
-/// (at most) the level at which the flood reached it.
+/// Priority flood from the kept extrema of one type (see [`flooded_representative`]).
 fn flood<D: crate::domain::Domain>(domain: &D, g: &mut [f64], kept: &KeptSet, role: Role) {
     use std::cmp::Reverse;
     use std::collections::BinaryHeap;
-    // a total order on f64 keys: the bits of a finite double, made monotone
+    let up = role == Role::Min;
+    // a total order on finite doubles: their bits made monotone (descending for maxima)
     let key = |x: f64| {
-        let x = if role == Role::Min { x } else { -x };
+        let x = if up { x } else { -x };
         let b = (if x == 0.0 { 0.0 } else { x }).to_bits();
         if b >> 63 == 1 {
             !b
@@ -267,22 +267,18 @@ fn flood<D: crate::domain::Domain>(domain: &D, g: &mut [f64], kept: &KeptSet, ro
             heap.push(Reverse((key(gv), 0u8, v)));
         }
     }
-    let mut level: Option<f64> = None;
+    let mut last: Option<f64> = None;
     while let Some(Reverse((_, _, v))) = heap.pop() {
         if seen[v] {
             continue;
         }
         seen[v] = true;
-        let raise = |lv: f64, x: f64| if role == Role::Min { x.max(lv) } else { x.min(lv) };
         if kept.roles[v] != role {
-            if let Some(lv) = level {
-                g[v] = raise(lv, g[v]);
+            if let Some(l) = last {
+                g[v] = if up { g[v].max(l.next_up()) } else { g[v].min(l.next_down()) };
             }
         }
-        level = Some(match level {
-            Some(lv) => raise(lv, g[v]),
-            None => g[v],
-        });
+        last = Some(g[v]);
         for w in domain.neighbors(v) {
             if !seen[w] {
                 heap.push(Reverse((key(g[w]), 1u8, w)));

@@ -68,17 +68,23 @@ fn noisy_bumps_keep_exactly_the_persistent_extrema() {
     eprintln!("representative: {}", out.report.representative);
 }
 
-/// Work in progress (issue 4): the separatrix representative with flooded and harmonic
-/// fallbacks; SPEC wants every persistence-chosen set to certify, and 6 of these 200 still fail
-/// to build a representative. Every output that is returned must certify exactly; the share of runs that do is
-/// held at its current level so that it can only go up.
+/// Every persistence-chosen set certifies (SPEC: exit 0), with the separatrix representative
+/// or, where it fails its check, the flooded one; every output is checked by the counter above.
 #[test]
 fn random_grids_certify_or_say_why() {
     let mut stats = std::collections::BTreeMap::new();
-    for seed in 0..200u64 {
+    for seed in 0..400u64 {
         let (nx, ny) = (3 + (seed % 13) as usize, 3 + (seed / 13 % 11) as usize);
         let g = Grid2d::new(nx, ny).unwrap();
-        let h = bumps(nx, ny, [0.0, 0.05, 0.3, 2.0][(seed % 4) as usize], seed);
+        // smooth bumps with noise, or few-valued random fields full of ties
+        let h = if seed % 5 == 4 {
+            uniform(seed, nx * ny).iter().map(|v| (v * 4.0).floor()).collect()
+        } else {
+            bumps(nx, ny, [0.0, 0.05, 0.3, 2.0][(seed % 4) as usize], seed)
+        };
+        if h.iter().all(|&v| v == h[0]) {
+            continue;
+        }
         let frac = [0.05, 0.2, 0.5][(seed % 3) as usize];
         match smooth(&g, &h, &SmoothSettings { selection: Selection::Relative(frac), ..Default::default() }) {
             Ok(out) => {
@@ -96,7 +102,7 @@ fn random_grids_certify_or_say_why() {
         }
     }
     eprintln!("{stats:?}");
-    let certified: i32 = stats.iter().filter(|(k, _)| !k.starts_with("exit")).map(|(_, v)| *v).sum();
-    assert!(certified >= 194, "{stats:?}");
-    assert!(*stats.get("separatrix").unwrap_or(&0) >= 165, "{stats:?}");
+    assert!(stats.keys().all(|k| !k.starts_with("exit")), "every persistence-chosen set certifies: {stats:?}");
+    // the separatrix representative does most of the work; its share can only go up
+    assert!(*stats.get("separatrix").unwrap_or(&0) >= 300, "{stats:?}");
 }

@@ -126,8 +126,7 @@ pub fn max_margin(u: &[f64], edges: &[(usize, usize)], fixed: &[Option<f64>], ca
             "the constraint graph runs from a fixed value down to the smaller fixed value at vertex {w}"
         )));
     }
-    let (fmin, fmax) =
-        fixed.iter().flatten().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| (a.min(v), b.max(v)));
+    let (fmin, fmax) = crate::domain::value_range(fixed.iter().flatten());
     let span = if fmax > fmin { fmax - fmin } else { 1.0 };
     // the usual case: the cap of `choose_margin` is feasible twice over; one pass decides
     if let Some(cap) = cap.filter(|&c| c < span) {

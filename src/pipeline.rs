@@ -74,7 +74,7 @@ impl Smoothable for Grid2d {
             Some(u) => return Ok((u, format!("flooded (fallback: {})", why.join("; ")))),
             None => why.push("flooded representative: the floods did not settle".into()),
         }
-        let (lo, hi) = h.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| (a.min(v), b.max(v)));
+        let (lo, hi) = crate::domain::value_range(h);
         let fixed: Vec<Option<f64>> = kept
             .roles
             .iter()
@@ -295,7 +295,7 @@ pub fn smooth<D: Smoothable>(domain: &D, h: &[f64], settings: &SmoothSettings) -
 
     // work in units where the field spans [0, 1]
     let t = Instant::now();
-    let (lo, hi) = h.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| (a.min(v), b.max(v)));
+    let (lo, hi) = crate::domain::value_range(h);
     let range = hi - lo;
     let z: Vec<f64> = h.iter().map(|v| (v - lo) / range).collect();
     let k = domain.stiffness();

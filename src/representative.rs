@@ -38,7 +38,7 @@ pub fn series_representative(series: &Series, h: &[f64], kept: &KeptSet) -> Resu
     if anchors.is_empty() {
         return Err(Error::Representative { path: None, message: "no kept extremum".into() });
     }
-    let (lo, hi) = h.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| (a.min(v), b.max(v)));
+    let (lo, hi) = crate::domain::value_range(h);
     let slope = (hi - lo) / series.diameter();
     // free ends: the end opposite in type to the nearest kept extremum
     let (first, first_role) = anchors[0];

@@ -15,7 +15,7 @@ mod order;
 mod series;
 
 pub use grid::Grid2d;
-pub use order::{sos_greater, sos_less, sos_sort};
+pub use order::{sos_greater, sos_less, sos_sort, value_range};
 pub use series::Series;
 
 /// How persistence pairs are formed on a domain (SPEC.md, "Persistence").

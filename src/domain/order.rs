@@ -18,6 +18,11 @@ pub fn sos_greater(values: &[f64], a: usize, b: usize) -> bool {
     a != b && !sos_less(values, a, b)
 }
 
+/// `(min, max)` of the values (`(+inf, −inf)` when there are none).
+pub fn value_range<'a>(values: impl IntoIterator<Item = &'a f64>) -> (f64, f64) {
+    values.into_iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| (a.min(v), b.max(v)))
+}
+
 /// Vertex indices sorted ascending by (value, index): a total order, hence a topological
 /// order of every edge orientation defined by it.
 pub fn sos_sort(values: &[f64]) -> Vec<usize> {

@@ -149,7 +149,7 @@ pub fn select<D: Domain>(domain: &D, values: &[f64], selection: &Selection) -> R
     if let Some(i) = values.iter().position(|v| !v.is_finite()) {
         return Err(Error::input(format!("value at vertex {i} is not finite ({})", values[i])));
     }
-    let (lo, hi) = values.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| (a.min(v), b.max(v)));
+    let (lo, hi) = crate::domain::value_range(values);
     if lo == hi {
         return Err(Error::input(format!("the field is constant ({lo}): it has no extrema to keep")));
     }

@@ -17,6 +17,7 @@ pub mod topology;
 pub use error::{Error, Result};
 pub mod commands;
 pub mod constraints;
+pub mod derive;
 pub mod io;
 pub mod pipeline;
 pub mod plot;

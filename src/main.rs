@@ -2,11 +2,12 @@
 
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use std::path::PathBuf;
+use toposmooth::commands::input::{Derive, DomainKind, GridOptions};
 use toposmooth::commands::{self, BenchArgs, ExtremaArgs, SmoothArgs, VerifyArgs};
 use toposmooth::constraints::EdgeSet;
 use toposmooth::io::series_csv::SeriesCsvOptions;
 use toposmooth::operators::Energy;
-use toposmooth::pipeline::SmoothSettings;
+use toposmooth::pipeline::{RepresentativeChoice, SmoothSettings};
 use toposmooth::solve::{Method, QpSettings};
 use toposmooth::topology::Selection;
 use toposmooth::{Error, Result};
@@ -23,10 +24,13 @@ struct Cli {
 enum Command {
     /// List the extrema with their persistence and strictness; draw the persistence diagram.
     Extrema {
-        /// Input series (CSV).
-        input: PathBuf,
+        /// Input: a series (CSV) or a grid (.vti, .vtk, .npy, CSV matrix, PNG, TIFF).
+        #[arg(required_unless_present = "u")]
+        input: Option<PathBuf>,
         #[command(flatten)]
         csv: CsvArgs,
+        #[command(flatten)]
+        grid: GridCli,
         /// Print JSON.
         #[arg(long)]
         json: bool,
@@ -38,22 +42,25 @@ enum Command {
         persistence: String,
     },
     /// Smooth a series keeping exactly the selected extrema; certify the output.
-    Smooth(SmoothCli),
+    Smooth(Box<SmoothCli>),
     /// Re-check an output file of `smooth` from what it carries.
     Verify {
-        /// Output file of `smooth` (x,input,output,u,role).
+        /// Output file of `smooth`: series CSV (x,input,output,u,role), .vti or .npz.
         file: PathBuf,
-        /// The original input: check the file's input column against it.
+        /// The original input: check the file's input array against it (read with the same
+        /// options as for `smooth`).
         #[arg(long, value_name = "FILE")]
         input: Option<PathBuf>,
         #[command(flatten)]
         csv: CsvArgs,
+        #[command(flatten)]
+        grid: GridCli,
     },
-    /// Benchmark on random-walk series: seconds per stage and peak memory.
+    /// Benchmark on random-walk series and noisy grids: seconds per stage and peak memory.
     Bench {
-        /// Series lengths.
-        #[arg(long, value_delimiter = ',', default_values_t = [1000usize, 10_000, 100_000, 1_000_000])]
-        sizes: Vec<usize>,
+        /// Series lengths `N` and grid sizes `NXxNY` (grids keep 7 minima and 6 maxima).
+        #[arg(long, value_delimiter = ',', default_value = "1000,10000,100000,1000000")]
+        sizes: Vec<String>,
         /// Energy order or blend.
         #[arg(long, default_value = "2")]
         order: String,
@@ -71,8 +78,96 @@ enum Command {
         solver: Solver,
         /// Run one size in this process and print one JSON line.
         #[arg(long, hide = true)]
-        single: Option<usize>,
+        single: Option<String>,
     },
+}
+
+#[derive(Args)]
+struct GridCli {
+    /// Read the input as a series or a grid (default: by extension; a CSV whose first line is
+    /// three or more numbers is a grid matrix).
+    #[arg(long, value_enum, default_value_t = DomainCli::Auto)]
+    domain: DomainCli,
+    /// Grid: point array of a VTK file (default: the only scalar array, or with --derive the
+    /// only vector array).
+    #[arg(long, value_name = "NAME")]
+    array: Option<String>,
+    /// Grid spacing `dx,dy` (overrides the file's; may be negative, e.g. rows running down).
+    #[arg(long, value_name = "DX,DY", allow_hyphen_values = true)]
+    spacing: Option<String>,
+    /// Grid: smooth a scalar derived from a velocity field (a 2- or 3-component array, or
+    /// --u and --v).
+    #[arg(long, value_enum)]
+    derive: Option<DeriveCli>,
+    /// Grid: x velocity component file (with --v and --derive, instead of an input file).
+    #[arg(long = "u", value_name = "FILE", requires_all = ["v", "derive"])]
+    u: Option<PathBuf>,
+    /// Grid: y velocity component file.
+    #[arg(long = "v", value_name = "FILE", requires = "u")]
+    v: Option<PathBuf>,
+    /// Grid: fill missing (NaN) samples by harmonic interpolation instead of refusing them.
+    #[arg(long)]
+    fill_missing: bool,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum DomainCli {
+    Auto,
+    Series,
+    Grid,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum DeriveCli {
+    Vorticity,
+    Magnitude,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum RepresentativeCli {
+    Separatrix,
+    Harmonic,
+}
+
+impl GridCli {
+    fn kind(&self) -> DomainKind {
+        match self.domain {
+            DomainCli::Auto => DomainKind::Auto,
+            DomainCli::Series => DomainKind::Series,
+            DomainCli::Grid => DomainKind::Grid,
+        }
+    }
+
+    fn options(&self) -> Result<GridOptions> {
+        let spacing = match &self.spacing {
+            None => None,
+            Some(text) => {
+                let parts: Vec<f64> = text
+                    .split(',')
+                    .map(|p| p.trim().parse::<f64>())
+                    .collect::<std::result::Result<_, _>>()
+                    .map_err(|_| Error::Usage(format!("--spacing `{text}` is not two numbers dx,dy")))?;
+                match parts.as_slice() {
+                    [dx, dy] if dx.is_finite() && dy.is_finite() && *dx != 0.0 && *dy != 0.0 => Some([*dx, *dy]),
+                    _ => {
+                        return Err(Error::Usage(format!(
+                            "--spacing `{text}` must be two finite non-zero numbers dx,dy"
+                        )))
+                    }
+                }
+            }
+        };
+        Ok(GridOptions {
+            array: self.array.clone(),
+            spacing,
+            derive: self.derive.map(|d| match d {
+                DeriveCli::Vorticity => Derive::Vorticity,
+                DeriveCli::Magnitude => Derive::Magnitude,
+            }),
+            uv: self.u.clone().zip(self.v.clone()),
+            fill_missing: self.fill_missing,
+        })
+    }
 }
 
 #[derive(Args)]
@@ -106,23 +201,43 @@ enum Edges {
 
 #[derive(Args)]
 struct SmoothCli {
-    /// Input series (CSV).
-    input: PathBuf,
-    /// Output CSV: x,input,output,u,role.
+    /// Input: a series (CSV) or a grid (.vti, .vtk, .npy, CSV matrix, PNG, TIFF).
+    #[arg(required_unless_present = "u")]
+    input: Option<PathBuf>,
+    /// Output: a series CSV (x,input,output,u,role); for grids .vti or .npz (verifiable:
+    /// input, smoothed, representative, role) or .npy / CSV (the smoothed array only).
     #[arg(short, long)]
     output: PathBuf,
     #[command(flatten)]
     csv: CsvArgs,
+    #[command(flatten)]
+    grid: GridCli,
+    /// Grid: kept extrema, saddles and separatrices as VTK PolyData (.vtp).
+    #[arg(long, value_name = "VTP")]
+    complex: Option<PathBuf>,
+    /// Grid: representative function.
+    #[arg(long, value_enum, default_value_t = RepresentativeCli::Separatrix)]
+    representative: RepresentativeCli,
+    /// Grid plot: number of isolines (0: none).
+    #[arg(long, default_value_t = 0)]
+    isolines: usize,
     /// Keep extrema of persistence ≥ T: `5%` of the range or an absolute value. [default: 5%]
-    #[arg(long, value_name = "T", conflicts_with_all = ["pairs", "keep_min", "keep_max"])]
+    #[arg(long, value_name = "T", conflicts_with_all = ["pairs", "minima", "keep_min", "keep_max"])]
     persistence: Option<String>,
-    /// Keep the N most persistent (minimum, maximum) pairs besides the global minimum.
-    #[arg(long, value_name = "N", conflicts_with_all = ["keep_min", "keep_max"])]
+    /// Series: keep the N most persistent (minimum, maximum) pairs besides the global minimum.
+    #[arg(long, value_name = "N", conflicts_with_all = ["minima", "keep_min", "keep_max"])]
     pairs: Option<usize>,
-    /// Keep exactly these minima (sample indices, comma-separated); needs --keep-max.
+    /// Grids: keep the N most persistent minima (with --maxima).
+    #[arg(long, value_name = "N", requires = "maxima", conflicts_with_all = ["keep_min", "keep_max"])]
+    minima: Option<usize>,
+    /// Grids: keep the M most persistent maxima (with --minima).
+    #[arg(long, value_name = "M", requires = "minima")]
+    maxima: Option<usize>,
+    /// Keep exactly these minima (vertex indices, comma-separated; grids: row·nx + column);
+    /// needs --keep-max.
     #[arg(long, value_name = "I,J", requires = "keep_max")]
     keep_min: Option<String>,
-    /// Keep exactly these maxima (sample indices); needs --keep-min.
+    /// Keep exactly these maxima (vertex indices); needs --keep-min.
     #[arg(long, value_name = "K", requires = "keep_min")]
     keep_max: Option<String>,
     /// Polyharmonic order 1..4, or a blend like `1:0.2,2:1`.
@@ -150,7 +265,7 @@ struct SmoothCli {
     /// Clarabel alone.
     #[arg(long, value_enum, default_value_t = Solver::Structured)]
     solver: Solver,
-    /// Figure: input (grey), output, kept extrema.
+    /// Figure: series input (grey), output and kept extrema; grids as heat maps side by side.
     #[arg(long, value_name = "PNG")]
     plot: Option<PathBuf>,
     /// JSON report: settings, kept extrema, seconds per stage, energy, deviations, certificate.
@@ -176,6 +291,9 @@ fn smooth_args(c: SmoothCli) -> Result<SmoothArgs> {
     let selection = match (&c.persistence, c.pairs, &c.keep_min, &c.keep_max) {
         (Some(p), _, _, _) => commands::parse_persistence(p)?,
         (None, Some(n), _, _) => Selection::Pairs(n),
+        (None, None, _, _) if c.minima.is_some() => {
+            Selection::Count { minima: c.minima.unwrap_or(1), maxima: c.maxima.unwrap_or(1) }
+        }
         (None, None, Some(mn), Some(mx)) => {
             Selection::Explicit { minima: commands::parse_indices(mn)?, maxima: commands::parse_indices(mx)? }
         }
@@ -193,28 +311,47 @@ fn smooth_args(c: SmoothCli) -> Result<SmoothArgs> {
         smooth_length: c.smooth_length,
         edges: edge_set(c.edges),
         qp: QpSettings { max_iter: c.max_iter, method: method(c.solver), ..Default::default() },
+        representative: match c.representative {
+            RepresentativeCli::Separatrix => RepresentativeChoice::Separatrix,
+            RepresentativeCli::Harmonic => RepresentativeChoice::Harmonic,
+        },
     };
-    Ok(SmoothArgs { input: c.input, csv: c.csv.options(), output: c.output, settings, plot: c.plot, report: c.report })
+    Ok(SmoothArgs {
+        input: c.input,
+        kind: c.grid.kind(),
+        csv: c.csv.options(),
+        grid: c.grid.options()?,
+        complex: c.complex,
+        isolines: c.isolines,
+        output: c.output,
+        settings,
+        plot: c.plot,
+        report: c.report,
+    })
 }
 
 fn run(cli: Cli) -> Result<String> {
     match cli.command {
-        Command::Extrema { input, csv, json, plot, persistence } => commands::extrema(&ExtremaArgs {
+        Command::Extrema { input, csv, grid, json, plot, persistence } => commands::extrema(&ExtremaArgs {
             input,
+            kind: grid.kind(),
             csv: csv.options(),
+            grid: grid.options()?,
             json,
             plot,
             selection: commands::parse_persistence(&persistence)?,
         }),
-        Command::Smooth(c) => commands::smooth(&smooth_args(c)?),
-        Command::Verify { file, input, csv } => commands::verify(&VerifyArgs { file, input, csv: csv.options() }),
+        Command::Smooth(c) => commands::smooth(&smooth_args(*c)?),
+        Command::Verify { file, input, csv, grid } => {
+            commands::verify(&VerifyArgs { file, input, csv: csv.options(), grid: grid.options()? })
+        }
         Command::Bench { sizes, order, persistence, edges, seed, single, solver } => {
             let persistence = match commands::parse_persistence(&persistence)? {
                 Selection::Relative(r) => r,
                 _ => return Err(Error::Usage("bench takes --persistence as a percentage".into())),
             };
             commands::bench(&BenchArgs {
-                sizes,
+                cases: sizes.iter().map(|s| commands::BenchCase::parse(s)).collect::<Result<_>>()?,
                 energy: Energy::parse(&order)?,
                 persistence,
                 edges: edge_set(edges),

@@ -25,15 +25,47 @@ use crate::topology::{count_sos_extrema, select, KeptExtremum, KeptSet, Role, Se
 use crate::verify::{certify, Certificate};
 use std::time::Instant;
 
+/// Which representative function to build on surfaces (series always use the linear one).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum RepresentativeChoice {
+    /// Separatrices interpolated, harmonic elsewhere (paper section 3.3).
+    #[default]
+    Separatrix,
+    /// Harmonic: kept minima at the data's minimum, kept maxima at its maximum.
+    Harmonic,
+}
+
+/// A representative function, the construction that produced it and the complex it used.
+#[derive(Clone, Debug)]
+pub struct Representative {
+    /// Values per vertex.
+    pub u: Vec<f64>,
+    /// Construction used: `linear`, `separatrix`, `harmonic` or `flooded`.
+    pub kind: &'static str,
+    /// Construction used, with the reasons for any fallback.
+    pub name: String,
+    /// The simplified Morse–Smale complex (surfaces).
+    pub complex: Option<MorseSmale>,
+}
+
 /// A domain the pipeline can smooth on: it supplies its operators and its representative.
 pub trait Smoothable: Domain {
     /// Stiffness `K = −L`.
     fn stiffness(&self) -> Sparse;
     /// Lumped mass (diagonal, > 0).
     fn mass(&self) -> Vec<f64>;
-    /// A function with exactly the kept extrema (checked by the pipeline), and the name of
-    /// the construction that produced it.
-    fn representative(&self, h: &[f64], kept: &KeptSet) -> Result<(Vec<f64>, String)>;
+    /// A function with exactly the kept extrema (checked by the pipeline), built by the
+    /// first construction in the order `choice` prefers that is not `excluded` (kind and
+    /// why: the pipeline excludes one whose order makes the constraints infeasible).
+    fn representative(
+        &self,
+        h: &[f64],
+        kept: &KeptSet,
+        choice: RepresentativeChoice,
+        k: &Sparse,
+        excluded: &[(&'static str, String)],
+    ) -> Result<Representative>;
 }
 
 impl Smoothable for Series {
@@ -43,9 +75,33 @@ impl Smoothable for Series {
     fn mass(&self) -> Vec<f64> {
         series_mass(self)
     }
-    fn representative(&self, h: &[f64], kept: &KeptSet) -> Result<(Vec<f64>, String)> {
-        Ok((series_representative(self, h, kept)?, "linear".into()))
+    fn representative(
+        &self,
+        h: &[f64],
+        kept: &KeptSet,
+        _: RepresentativeChoice,
+        _: &Sparse,
+        _: &[(&'static str, String)],
+    ) -> Result<Representative> {
+        let u = series_representative(self, h, kept)?;
+        Ok(Representative { u, kind: "linear", name: "linear".into(), complex: None })
     }
+}
+
+/// The harmonic representative: kept minima at the data's minimum, kept maxima at its
+/// maximum, harmonic elsewhere with `k` (non-negative weights: the maximum principle holds).
+fn harmonic_representative(h: &[f64], kept: &KeptSet, k: &Sparse) -> std::result::Result<Vec<f64>, String> {
+    let (lo, hi) = crate::domain::value_range(h);
+    let fixed: Vec<Option<f64>> = kept
+        .roles
+        .iter()
+        .map(|r| match r {
+            Role::Min => Some(lo),
+            Role::Max => Some(hi),
+            _ => None,
+        })
+        .collect();
+    dirichlet_solve(k, &fixed)
 }
 
 impl Smoothable for Grid2d {
@@ -55,44 +111,88 @@ impl Smoothable for Grid2d {
     fn mass(&self) -> Vec<f64> {
         grid_mass(self)
     }
-    /// The separatrix representative; if it fails its check, the harmonic one (0 at kept
-    /// minima, 1 at kept maxima, rescaled to the data's range).
-    fn representative(&self, h: &[f64], kept: &KeptSet) -> Result<(Vec<f64>, String)> {
-        let k = grid_stiffness(self);
-        let mut why = Vec::new();
-        match MorseSmale::new(self, h, kept).and_then(|ms| separatrix_representative(self, h, kept, &ms, &k)) {
-            Ok(u) => {
-                let c = certify(self, &u, &kept.roles, None);
-                if c.passed {
-                    return Ok((u, "separatrix".into()));
-                }
-                why.push(format!("separatrix representative: {}", c.summary()));
+    /// The chosen representative (the complex is built either way, for `--complex`); if it
+    /// fails its check, the other one, then the flooded one (NOTES.md 9).
+    fn representative(
+        &self,
+        h: &[f64],
+        kept: &KeptSet,
+        choice: RepresentativeChoice,
+        k: &Sparse,
+        excluded: &[(&'static str, String)],
+    ) -> Result<Representative> {
+        let mut why: Vec<String> = excluded.iter().map(|(kind, e)| format!("{kind} representative: {e}")).collect();
+        let skip = |kind: &str| excluded.iter().any(|(x, _)| *x == kind);
+        let complex = match MorseSmale::new(self, h, kept) {
+            Ok(ms) => Some(ms),
+            Err(e) => {
+                why.push(format!("Morse-Smale complex: {e}"));
+                None
             }
-            Err(e) => why.push(format!("separatrix representative: {e}")),
-        }
-        match flooded_representative(self, h, kept) {
-            Some(u) => return Ok((u, format!("flooded (fallback: {})", why.join("; ")))),
-            None => why.push("flooded representative: the floods did not settle".into()),
-        }
-        let (lo, hi) = crate::domain::value_range(h);
-        let fixed: Vec<Option<f64>> = kept
-            .roles
-            .iter()
-            .map(|r| match r {
-                Role::Min => Some(lo),
-                Role::Max => Some(hi),
-                _ => None,
-            })
-            .collect();
-        match dirichlet_solve(&k, &fixed) {
-            Ok(u) => {
-                let c = certify(self, &u, &kept.roles, None);
-                if c.passed {
-                    return Ok((u, format!("harmonic (fallback: {})", why.join("; "))));
+        };
+        let released = std::cell::Cell::new(0);
+        let separatrix = |why: &mut Vec<String>| -> Option<Vec<f64>> {
+            let ms = complex.as_ref()?;
+            match separatrix_representative(self, h, kept, ms, k) {
+                Ok((u, r)) => {
+                    let c = certify(self, &u, &kept.roles, None);
+                    released.set(r);
+                    if c.passed {
+                        return Some(u);
+                    }
+                    why.push(format!("separatrix representative: {}", c.summary()));
                 }
-                why.push(format!("harmonic representative: {}", c.summary()));
+                Err(e) => why.push(format!("separatrix representative: {e}")),
             }
-            Err(e) => why.push(format!("harmonic representative: {e}")),
+            None
+        };
+        let harmonic = |why: &mut Vec<String>| -> Option<Vec<f64>> {
+            match harmonic_representative(h, kept, k) {
+                Ok(u) => {
+                    let c = certify(self, &u, &kept.roles, None);
+                    if c.passed {
+                        return Some(u);
+                    }
+                    why.push(format!("harmonic representative: {}", c.summary()));
+                }
+                Err(e) => why.push(format!("harmonic representative: {e}")),
+            }
+            None
+        };
+        let (first, second): (&'static str, &'static str) = match choice {
+            RepresentativeChoice::Separatrix => ("separatrix", "harmonic"),
+            RepresentativeChoice::Harmonic => ("harmonic", "separatrix"),
+        };
+        let build =
+            |name: &str, why: &mut Vec<String>| if name == "separatrix" { separatrix(why) } else { harmonic(why) };
+        let named = |name: &str, why: &[String]| {
+            let name = if name == "separatrix" && released.get() > 0 {
+                format!(
+                    "separatrix ({} contradicting separatrix vertices released to the harmonic fill)",
+                    released.get()
+                )
+            } else {
+                name.to_string()
+            };
+            if why.is_empty() {
+                name
+            } else {
+                format!("{name} (fallback: {})", why.join("; "))
+            }
+        };
+        for kind in [first, second] {
+            if skip(kind) {
+                continue;
+            }
+            if let Some(u) = build(kind, &mut why) {
+                return Ok(Representative { u, kind, name: named(kind, &why), complex });
+            }
+        }
+        if !skip("flooded") {
+            match flooded_representative(self, h, kept) {
+                Some(u) => return Ok(Representative { u, kind: "flooded", name: named("flooded", &why), complex }),
+                None => why.push("flooded representative: the floods did not settle".into()),
+            }
         }
         Err(Error::Representative { path: None, message: why.join("; ") })
     }
@@ -115,6 +215,8 @@ pub struct SmoothSettings {
     pub edges: EdgeSet,
     /// Solver settings.
     pub qp: QpSettings,
+    /// Representative function on surfaces. {separatrix}
+    pub representative: RepresentativeChoice,
 }
 
 impl Default for SmoothSettings {
@@ -127,6 +229,7 @@ impl Default for SmoothSettings {
             smooth_length: 0.01,
             edges: EdgeSet::Minimal,
             qp: QpSettings::default(),
+            representative: RepresentativeChoice::Separatrix,
         }
     }
 }
@@ -155,7 +258,11 @@ impl SmoothSettings {
 pub struct StageSeconds {
     /// Persistence and selection of the kept set.
     pub persistence: f64,
-    /// Representative function and its check.
+    /// Discrete gradients of the input (surfaces).
+    pub complex: f64,
+    /// Their simplification to the kept set (surfaces).
+    pub simplify: f64,
+    /// Representative function and its check (complex excluded).
     pub representative: f64,
     /// Stiffness, mass and energy matrices.
     pub operators: f64,
@@ -205,6 +312,8 @@ pub struct RunSettings {
     pub u_margin: f64,
     /// Solver settings as requested.
     pub solver: QpSettings,
+    /// Representative requested (surfaces).
+    pub representative: RepresentativeChoice,
 }
 
 /// Everything a run measured, written by `--report`.
@@ -261,6 +370,8 @@ pub struct Smoothed {
     pub roles: Vec<Role>,
     /// What was measured.
     pub report: Report,
+    /// The simplified Morse–Smale complex the representative was built from (surfaces).
+    pub complex: Option<MorseSmale>,
 }
 
 /// Smooths `h` on `domain` keeping exactly the selected extrema; returns only certified output.
@@ -285,20 +396,49 @@ pub fn smooth<D: Smoothable>(domain: &D, h: &[f64], settings: &SmoothSettings) -
     let (input_minima, input_maxima) = count_sos_extrema(domain, h);
     seconds.persistence = t.elapsed().as_secs_f64();
 
-    let t = Instant::now();
-    let (u, representative) = domain.representative(h, &kept)?;
-    let representative_certificate = certify(domain, &u, &kept.roles, None);
-    if !representative_certificate.passed {
-        return Err(Error::Representative { path: None, message: representative_certificate.summary() });
-    }
-    seconds.representative = t.elapsed().as_secs_f64();
-
-    // work in units where the field spans [0, 1]
-    let t = Instant::now();
+    let k = domain.stiffness();
     let (lo, hi) = crate::domain::value_range(h);
     let range = hi - lo;
     let z: Vec<f64> = h.iter().map(|v| (v - lo) / range).collect();
-    let k = domain.stiffness();
+    let fixed: Vec<Option<f64>> = (0..n).map(|i| kept.roles[i].is_fixed().then_some(z[i])).collect();
+    check_fixed_neighbours(domain, h, &kept.roles)?;
+    let magnitude = h.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+    let resolution = (magnitude.next_up() - magnitude) / range;
+    // A representative whose order makes the constraints infeasible (the harmonic one can
+    // order a high kept minimum below a low kept maximum) gives way to the next construction;
+    // for a kept set chosen by persistence the flooded one always fits the data's order.
+    let mut excluded: Vec<(&'static str, String)> = Vec::new();
+    let (u, representative, complex, representative_certificate, edges, eps_max, eps) = loop {
+        let t = Instant::now();
+        let rep = domain.representative(h, &kept, settings.representative, &k, &excluded)?;
+        if let Some(ms) = &rep.complex {
+            seconds.complex = ms.seconds[0];
+            seconds.simplify = ms.seconds[1];
+        }
+        let representative_certificate = certify(domain, &rep.u, &kept.roles, None);
+        if !representative_certificate.passed {
+            return Err(Error::Representative { path: None, message: representative_certificate.summary() });
+        }
+        seconds.representative += t.elapsed().as_secs_f64() - seconds.complex - seconds.simplify;
+        let t = Instant::now();
+        let edges = constraint_edges(domain, &rep.u, &fixed, settings.edges);
+        let margins = max_margin(&rep.u, &edges, &fixed, Some(margin_cap(1.0, resolution)))
+            .and_then(|eps_max| Ok((eps_max, choose_margin(eps_max, 1.0, resolution)?)));
+        seconds.constraints += t.elapsed().as_secs_f64();
+        match margins {
+            Ok((eps_max, eps)) => {
+                break (rep.u, rep.name, rep.complex, representative_certificate, edges, eps_max, eps);
+            }
+            Err(e @ Error::Infeasible { .. })
+                if settings.selection.by_persistence() && rep.kind != "linear" && rep.kind != "flooded" =>
+            {
+                excluded.push((rep.kind, e.to_string()));
+            }
+            Err(e) => return Err(e),
+        }
+    };
+
+    let t = Instant::now();
     let m = domain.mass();
     let ell = settings.smooth_length * domain.diameter();
     let weights: Vec<f64> = settings
@@ -313,16 +453,6 @@ pub fn smooth<D: Smoothable>(domain: &D, h: &[f64], settings: &SmoothSettings) -
     let p = scaled_plus_diagonal(&q_energy, 1.0, &data_diag);
     let q: Vec<f64> = (0..n).map(|i| -gd * m[i] * z[i]).collect();
     seconds.operators = t.elapsed().as_secs_f64();
-
-    let t = Instant::now();
-    let fixed: Vec<Option<f64>> = (0..n).map(|i| kept.roles[i].is_fixed().then_some(z[i])).collect();
-    let edges = constraint_edges(domain, &u, &fixed, settings.edges);
-    check_fixed_neighbours(domain, h, &kept.roles)?;
-    let magnitude = h.iter().fold(0.0f64, |a, v| a.max(v.abs()));
-    let resolution = (magnitude.next_up() - magnitude) / range;
-    let eps_max = max_margin(&u, &edges, &fixed, Some(margin_cap(1.0, resolution)))?;
-    let eps = choose_margin(eps_max, 1.0, resolution)?;
-    seconds.constraints = t.elapsed().as_secs_f64();
 
     let t = Instant::now();
     let hint: Vec<f64> = u.iter().map(|v| (v - lo) / range).collect();
@@ -378,6 +508,7 @@ pub fn smooth<D: Smoothable>(domain: &D, h: &[f64], settings: &SmoothSettings) -
             margin: [eps * range, eps_max * range],
             u_margin,
             solver: settings.qp.clone(),
+            representative: settings.representative,
         },
         constraints: edges.len(),
         kept: kept.kept.clone(),
@@ -395,7 +526,7 @@ pub fn smooth<D: Smoothable>(domain: &D, h: &[f64], settings: &SmoothSettings) -
         representative_certificate,
         certificate,
     };
-    Ok(Smoothed { output: f, u, roles: kept.roles, report })
+    Ok(Smoothed { output: f, u, roles: kept.roles, report, complex })
 }
 
 /// Two adjacent fixed vertices of different roles must differ in value (SPEC.md).

@@ -169,6 +169,10 @@ fn strictify(u: &mut [f64], anchors: &[(usize, Role)]) {
 /// NOTES.md 7; a vertex claimed by both stays free), harmonic elsewhere with the Laplacian
 /// `k`, whose off-diagonal weights must be ≤ 0 so that the maximum principle holds.
 ///
+/// Where separatrix values contradict each other (a prescribed vertex becomes a spurious
+/// extremum or a free one flat), those vertices and their prescribed neighbours are released
+/// to the harmonic fill and the solve repeated; returns u and how many vertices were released.
+///
 /// # Errors
 /// A message when the harmonic solve fails; the caller checks the result with the
 /// certificate and falls back when it does not pass.
@@ -178,7 +182,7 @@ pub fn separatrix_representative<D: crate::domain::Domain>(
     kept: &KeptSet,
     ms: &crate::topology::morse_smale::MorseSmale,
     k: &crate::operators::Sparse,
-) -> std::result::Result<Vec<f64>, String> {
+) -> std::result::Result<(Vec<f64>, usize), String> {
     let n = h.len();
     let mut down = vec![f64::INFINITY; n];
     let mut up = vec![f64::NEG_INFINITY; n];
@@ -206,7 +210,7 @@ pub fn separatrix_representative<D: crate::domain::Domain>(
     for s in &ms.ascending {
         paint(s, &mut up, false);
     }
-    let fixed: Vec<Option<f64>> = (0..n)
+    let prescribed: Vec<Option<f64>> = (0..n)
         .map(|v| {
             if kept.roles[v].is_fixed() || ms.saddles.binary_search(&v).is_ok() {
                 Some(h[v])
@@ -219,7 +223,69 @@ pub fn separatrix_representative<D: crate::domain::Domain>(
             }
         })
         .collect();
-    crate::operators::dirichlet_solve(k, &fixed)
+    // Where the interpolated separatrices contradict each other (a separatrix vertex or a
+    // saddle ends up below or above all its neighbours, or a free vertex between them is
+    // flat), release the separatrices through those vertices (and through their prescribed
+    // neighbours) to the harmonic fill and solve again.
+    let separatrices: Vec<&[usize]> = ms.descending.iter().chain(&ms.ascending).map(|s| &s.path[..]).collect();
+    let mut through: Vec<Vec<usize>> = vec![Vec::new(); n];
+    for (i, p) in separatrices.iter().enumerate() {
+        for &v in p.iter() {
+            through[v].push(i);
+        }
+    }
+    let mut released = vec![false; n];
+    let mut gone = vec![false; separatrices.len()];
+    let mut count = 0;
+    for _ in 0..64 {
+        let fixed: Vec<Option<f64>> = (0..n).map(|v| if released[v] { None } else { prescribed[v] }).collect();
+        let u = crate::operators::dirichlet_solve(k, &fixed)?;
+        let bad: Vec<usize> = (0..n).filter(|&v| kept.roles[v] == Role::Other && !is_regular(domain, &u, v)).collect();
+        let mut progress = false;
+        let release = |w: usize, released: &mut Vec<bool>, count: &mut usize| {
+            if fixed[w].is_some() && !kept.roles[w].is_fixed() && !released[w] {
+                released[w] = true;
+                *count += 1;
+                true
+            } else {
+                false
+            }
+        };
+        for &v in &bad {
+            for w in std::iter::once(v).chain(domain.neighbors(v)) {
+                if fixed[w].is_none() {
+                    continue;
+                }
+                progress |= release(w, &mut released, &mut count);
+                // a saddle stays while it has separatrices; a separatrix vertex takes its
+                // whole separatrix with it
+                if ms.saddles.binary_search(&w).is_err() {
+                    for &s in &through[w] {
+                        if !std::mem::replace(&mut gone[s], true) {
+                            for &x in separatrices[s] {
+                                if ms.saddles.binary_search(&x).is_err() {
+                                    progress |= release(x, &mut released, &mut count);
+                                }
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        if bad.is_empty() || !progress {
+            return Ok((u, count));
+        }
+    }
+    Err("separatrix vertices still contradict each other after 64 rounds of releasing them".into())
+}
+
+fn is_regular<D: crate::domain::Domain>(domain: &D, u: &[f64], v: usize) -> bool {
+    let (mut lower, mut higher) = (false, false);
+    for w in domain.neighbors(v) {
+        lower |= u[w] < u[v];
+        higher |= u[w] > u[v];
+    }
+    lower && higher
 }
 
 /// The data's own simplification as a representative (NOTES.md 9, after Tierny & Pascucci

@@ -1,38 +1,11 @@
-//! The pipeline on grids (issue 4, in progress): library level.
+//! The pipeline on grids at library level: known small fields and random fields with ties.
 
 mod common;
 
-use common::uniform;
+use common::{grid_extrema, uniform};
 use toposmooth::domain::Grid2d;
 use toposmooth::pipeline::{smooth, SmoothSettings};
 use toposmooth::topology::{Role, Selection};
-
-/// Strict extrema and flat vertices of a grid field, from SPEC's 6-neighbour rule written out
-/// here independently of the crate.
-fn grid_extrema(nx: usize, ny: usize, f: &[f64]) -> (Vec<usize>, Vec<usize>, Vec<usize>) {
-    let (mut mins, mut maxs, mut flat) = (vec![], vec![], vec![]);
-    for r in 0..ny as isize {
-        for c in 0..nx as isize {
-            let v = (r as usize) * nx + c as usize;
-            let nb: Vec<f64> = [(0, -1), (0, 1), (-1, 0), (1, 0), (-1, -1), (1, 1)]
-                .iter()
-                .map(|(dr, dc)| (r + dr, c + dc))
-                .filter(|&(rr, cc)| rr >= 0 && rr < ny as isize && cc >= 0 && cc < nx as isize)
-                .map(|(rr, cc)| f[rr as usize * nx + cc as usize])
-                .collect();
-            let lower = nb.iter().filter(|&&w| w < f[v]).count();
-            let higher = nb.iter().filter(|&&w| w > f[v]).count();
-            if higher == nb.len() {
-                mins.push(v);
-            } else if lower == nb.len() {
-                maxs.push(v);
-            } else if lower == 0 || higher == 0 {
-                flat.push(v);
-            }
-        }
-    }
-    (mins, maxs, flat)
-}
 
 fn bumps(nx: usize, ny: usize, noise: f64, seed: u64) -> Vec<f64> {
     let r = uniform(seed, nx * ny);
@@ -105,4 +78,91 @@ fn random_grids_certify_or_say_why() {
     assert!(stats.keys().all(|k| !k.starts_with("exit")), "every persistence-chosen set certifies: {stats:?}");
     // the separatrix representative does most of the work; its share can only go up
     assert!(*stats.get("separatrix").unwrap_or(&0) >= 300, "{stats:?}");
+}
+
+/// Smooths `h` and checks the output with the independent counter: exactly the kept extrema,
+/// no flat vertex, kept values bit for bit. Returns the kept minima and maxima.
+fn smooth_and_check(nx: usize, ny: usize, h: &[f64], selection: Selection) -> (Vec<usize>, Vec<usize>) {
+    let g = Grid2d::new(nx, ny).unwrap();
+    let out = smooth(&g, h, &SmoothSettings { selection, ..Default::default() }).unwrap();
+    let (mins, maxs, flat) = grid_extrema(nx, ny, &out.output);
+    assert!(flat.is_empty(), "flat vertices {flat:?}");
+    assert_eq!(mins, (0..nx * ny).filter(|&v| out.roles[v] == Role::Min).collect::<Vec<_>>());
+    assert_eq!(maxs, (0..nx * ny).filter(|&v| out.roles[v] == Role::Max).collect::<Vec<_>>());
+    for &v in mins.iter().chain(&maxs) {
+        assert_eq!(out.output[v].to_bits(), h[v].to_bits());
+    }
+    (mins, maxs)
+}
+
+fn gauss(x: f64, y: f64, cx: f64, cy: f64, s: f64) -> f64 {
+    (-((x - cx).powi(2) + (y - cy).powi(2)) / (s * s)).exp()
+}
+
+#[test]
+fn two_gaussian_bumps_keep_both_peaks() {
+    let (nx, ny) = (30, 20);
+    let noise = uniform(11, nx * ny);
+    let h: Vec<f64> = (0..nx * ny)
+        .map(|v| {
+            let (x, y) = ((v % nx) as f64, (v / nx) as f64);
+            gauss(x, y, 8.0, 10.0, 4.0) + 0.7 * gauss(x, y, 21.0, 9.0, 4.0) + 0.02 * noise[v]
+        })
+        .collect();
+    let (mins, maxs) = smooth_and_check(nx, ny, &h, Selection::Relative(0.2));
+    // the two peaks survive at their places; of the flat noisy floor only the global minimum
+    let peak = |cx: usize, cy: usize| maxs.iter().any(|&v| (v % nx).abs_diff(cx) <= 2 && (v / nx).abs_diff(cy) <= 2);
+    assert!(peak(8, 10) && peak(21, 9), "maxima {maxs:?}");
+    assert_eq!((mins.len(), maxs.len()), (1, 2), "minima {mins:?} maxima {maxs:?}");
+}
+
+#[test]
+fn a_saddle_keeps_its_boundary_extrema_and_nothing_inside() {
+    // h = x² − y² on [−1, 1]²: maxima on the left and right edges, minima on the top and bottom
+    let n = 21;
+    let noise = uniform(3, n * n);
+    let h: Vec<f64> = (0..n * n)
+        .map(|v| {
+            let (x, y) = ((v % n) as f64 / 10.0 - 1.0, (v / n) as f64 / 10.0 - 1.0);
+            x * x - y * y + 0.01 * noise[v]
+        })
+        .collect();
+    let (mins, maxs) = smooth_and_check(n, n, &h, Selection::Relative(0.3));
+    let on_edge = |v: usize| v % n == 0 || v % n == n - 1 || v / n == 0 || v / n == n - 1;
+    assert!(mins.iter().chain(&maxs).all(|&v| on_edge(v)), "{mins:?} {maxs:?}");
+    assert!(maxs.iter().all(|&v| v % n == 0 || v % n == n - 1), "maxima on the left/right edges: {maxs:?}");
+    assert!(mins.iter().all(|&v| v / n == 0 || v / n == n - 1), "minima on the top/bottom edges: {mins:?}");
+    assert_eq!((mins.len(), maxs.len()), (2, 2));
+}
+
+#[test]
+fn a_noisy_ramp_becomes_monotone_between_two_corners() {
+    let (nx, ny) = (25, 15);
+    let noise = uniform(8, nx * ny);
+    let h: Vec<f64> = (0..nx * ny).map(|v| (v % nx) as f64 + 0.5 * (v / nx) as f64 + 3.0 * (noise[v] - 0.5)).collect();
+    let before = grid_extrema(nx, ny, &h);
+    assert!(before.0.len() + before.1.len() > 20, "noisy input");
+    let (mins, maxs) = smooth_and_check(nx, ny, &h, Selection::Relative(0.5));
+    assert_eq!((mins.len(), maxs.len()), (1, 1));
+    let (gmin, gmax) =
+        (0..nx * ny).fold((0, 0), |(a, b), v| (if h[v] < h[a] { v } else { a }, if h[v] > h[b] { v } else { b }));
+    assert_eq!((mins[0], maxs[0]), (gmin, gmax));
+}
+
+#[test]
+fn a_global_maximum_on_the_boundary_is_kept_there() {
+    // a bump centred outside the grid: the highest point is on the right edge, plus an inner pit
+    let (nx, ny) = (20, 16);
+    let noise = uniform(21, nx * ny);
+    let h: Vec<f64> = (0..nx * ny)
+        .map(|v| {
+            let (x, y) = ((v % nx) as f64, (v / nx) as f64);
+            gauss(x, y, 22.0, 7.0, 6.0) - 0.6 * gauss(x, y, 7.0, 8.0, 3.0) + 0.01 * noise[v]
+        })
+        .collect();
+    let gmax = (0..nx * ny).fold(0, |b, v| if h[v] > h[b] { v } else { b });
+    assert_eq!(gmax % nx, nx - 1, "the global maximum lies on the right edge");
+    let (mins, maxs) = smooth_and_check(nx, ny, &h, Selection::Relative(0.2));
+    assert_eq!(maxs, vec![gmax]);
+    assert!(mins.iter().any(|&v| (v % nx).abs_diff(7) <= 1 && (v / nx).abs_diff(8) <= 1), "the pit: {mins:?}");
 }

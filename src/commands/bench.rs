@@ -1,10 +1,10 @@
-//! `toposmooth bench`: time per stage and peak memory on random-walk series.
+//! `toposmooth bench`: time per stage and peak memory on random-walk series and noisy grids.
 //!
-//! Each size runs in a child process (`bench --single N`) so that its peak resident memory
+//! Each size runs in a child process (`bench --single N` or `NXxNY`) so that its peak resident memory
 //! (VmHWM) is its own.
 
 use crate::constraints::EdgeSet;
-use crate::domain::Series;
+use crate::domain::{Grid2d, Series};
 use crate::error::{Error, Result};
 use crate::operators::Energy;
 use crate::pipeline::{smooth, SmoothSettings};
@@ -15,8 +15,8 @@ use std::time::Instant;
 /// Options of `bench`.
 #[derive(Clone, Debug)]
 pub struct BenchArgs {
-    /// Series lengths.
-    pub sizes: Vec<usize>,
+    /// The cases, run one per child process.
+    pub cases: Vec<BenchCase>,
     /// Energy.
     pub energy: Energy,
     /// Persistence threshold as a fraction of the range.
@@ -25,8 +25,8 @@ pub struct BenchArgs {
     pub edges: EdgeSet,
     /// RNG seed.
     pub seed: u64,
-    /// Run one size in this process and print one JSON line.
-    pub single: Option<usize>,
+    /// Run one case (`N` or `NXxNY`) in this process and print one JSON line.
+    pub single: Option<String>,
     /// QP solver.
     pub method: Method,
 }
@@ -51,6 +51,45 @@ pub fn random_walk(n: usize, seed: u64) -> Vec<f64> {
         .collect()
 }
 
+/// A grid field with smooth structure (a few Gaussian bumps and pits, a gentle tilt) plus
+/// uniform noise of 5 % of its range: many noise extrema, a handful of persistent ones.
+pub fn noisy_bumps(nx: usize, ny: usize, seed: u64) -> Vec<f64> {
+    let mut state = seed;
+    let mut next = move || {
+        state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = state;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
+    };
+    // (x, y, sign·height, width) in unit coordinates
+    let bumps = [
+        (0.2, 0.3, 1.0, 0.08),
+        (0.7, 0.25, 0.8, 0.1),
+        (0.45, 0.7, 0.9, 0.09),
+        (0.85, 0.75, 0.6, 0.07),
+        (0.15, 0.8, 0.7, 0.06),
+        (0.5, 0.35, 0.75, 0.07),
+        (0.35, 0.5, -0.8, 0.08),
+        (0.65, 0.55, -0.9, 0.09),
+        (0.9, 0.4, -0.6, 0.06),
+        (0.25, 0.1, -0.7, 0.07),
+        (0.75, 0.9, -0.6, 0.07),
+        (0.55, 0.1, -0.5, 0.06),
+    ];
+    (0..nx * ny)
+        .map(|v| {
+            let (x, y) = ((v % nx) as f64 / (nx - 1) as f64, (v / nx) as f64 / (ny - 1) as f64);
+            let smooth: f64 = bumps
+                .iter()
+                .map(|&(cx, cy, a, w)| a * (-((x - cx).powi(2) + (y - cy).powi(2)) / (w * w)).exp())
+                .sum::<f64>()
+                + 0.1 * x;
+            smooth + 0.1 * (next() - 0.5)
+        })
+        .collect()
+}
+
 fn peak_rss_mib() -> f64 {
     std::fs::read_to_string("/proc/self/status")
         .ok()
@@ -61,48 +100,94 @@ fn peak_rss_mib() -> f64 {
         .unwrap_or(f64::NAN)
 }
 
+/// One benchmark case: a series of n samples or an nx × ny grid.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum BenchCase {
+    /// Random-walk series.
+    Series(usize),
+    /// Noisy bumps on a grid (columns, rows).
+    Grid(usize, usize),
+}
+
+impl BenchCase {
+    /// Parses `N` or `NXxNY`.
+    pub fn parse(s: &str) -> Result<BenchCase> {
+        let bad = || Error::Usage(format!("bench size `{s}` is not N (series) or NXxNY (grid)"));
+        let case = match s.split_once(['x', 'X', '×']) {
+            Some((a, b)) => BenchCase::Grid(a.trim().parse().map_err(|_| bad())?, b.trim().parse().map_err(|_| bad())?),
+            None => BenchCase::Series(s.trim().parse().map_err(|_| bad())?),
+        };
+        match case {
+            BenchCase::Series(n) if n < 2 => {
+                Err(Error::Usage(format!("bench series need at least 2 samples, got {n}")))
+            }
+            BenchCase::Grid(a, b) if a < 2 || b < 2 => {
+                Err(Error::Usage(format!("bench grids need at least 2 × 2 vertices, got {a} × {b}")))
+            }
+            c => Ok(c),
+        }
+    }
+
+    fn label(&self) -> String {
+        match self {
+            BenchCase::Series(n) => n.to_string(),
+            BenchCase::Grid(a, b) => format!("{a}x{b}"),
+        }
+    }
+}
+
+fn run_single(case: BenchCase, args: &BenchArgs) -> Result<String> {
+    let mut settings = SmoothSettings {
+        selection: Selection::Relative(args.persistence),
+        energy: args.energy.clone(),
+        edges: args.edges,
+        qp: QpSettings { method: args.method, ..Default::default() },
+        ..Default::default()
+    };
+    let t = Instant::now();
+    let (r, n) = match case {
+        BenchCase::Series(n) => (smooth(&Series::uniform(n), &random_walk(n, args.seed), &settings)?, n),
+        BenchCase::Grid(nx, ny) => {
+            // the benchmark: 13 kept extrema
+            settings.selection = Selection::Count { minima: 7, maxima: 6 };
+            let grid = Grid2d::new(nx, ny)?;
+            (smooth(&grid, &noisy_bumps(nx, ny, args.seed), &settings)?, nx * ny)
+        }
+    };
+    let total = t.elapsed().as_secs_f64();
+    let rep = &r.report;
+    let line = serde_json::json!({
+        "case": case.label(),
+        "n": n,
+        "input_extrema": rep.input_minima + rep.input_maxima,
+        "kept": rep.kept.len(),
+        "constraints": rep.constraints,
+        "iterations": rep.solver_iterations,
+        "solver": rep.solver,
+        "fallback": rep.solver_fallback,
+        "representative": rep.representative,
+        "status": format!("{:?}", rep.solver_status),
+        "certified": rep.certificate.passed,
+        "seconds": rep.seconds,
+        "total": total,
+        "peak_rss_mib": peak_rss_mib(),
+    });
+    Ok(format!("{line}\n"))
+}
+
 /// Runs the benchmark; returns the table (or one JSON line with `single`).
 pub fn bench(args: &BenchArgs) -> Result<String> {
-    if let Some(&n) = args.single.iter().chain(&args.sizes).find(|&&n| n < 2) {
-        return Err(Error::Usage(format!("bench sizes must be at least 2 samples, got {n}")));
-    }
-    if let Some(n) = args.single {
-        let h = random_walk(n, args.seed);
-        let settings = SmoothSettings {
-            selection: Selection::Relative(args.persistence),
-            energy: args.energy.clone(),
-            edges: args.edges,
-            qp: QpSettings { method: args.method, ..Default::default() },
-            ..Default::default()
-        };
-        let t = Instant::now();
-        let r = smooth(&Series::uniform(n), &h, &settings)?;
-        let total = t.elapsed().as_secs_f64();
-        let rep = &r.report;
-        let line = serde_json::json!({
-            "n": n,
-            "input_extrema": rep.input_minima + rep.input_maxima,
-            "kept": rep.kept.len(),
-            "constraints": rep.constraints,
-            "iterations": rep.solver_iterations,
-            "solver": rep.solver,
-            "fallback": rep.solver_fallback,
-            "status": format!("{:?}", rep.solver_status),
-            "certified": rep.certificate.passed,
-            "seconds": rep.seconds,
-            "total": total,
-            "peak_rss_mib": peak_rss_mib(),
-        });
-        return Ok(format!("{line}\n"));
+    if let Some(s) = &args.single {
+        return run_single(BenchCase::parse(s)?, args);
     }
     let exe = std::env::current_exe().map_err(|source| Error::Io { path: "current executable".into(), source })?;
     let order = args.energy.terms.iter().map(|(k, w)| format!("{k}:{w}")).collect::<Vec<_>>().join(",");
     let mut out = String::from(
-        "| samples | input extrema | kept | constraints | iterations | persistence s | representative s | operators s | constraints s | solve s | repair s | verify s | total s | peak MiB |\n|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n",
+        "| size | input extrema | kept | constraints | iterations | persistence s | complex s | simplify s | representative s | operators s | constraints s | solve s | repair s | verify s | total s | peak MiB |\n|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n",
     );
-    for &n in &args.sizes {
+    for case in &args.cases {
         let child = std::process::Command::new(&exe)
-            .args(["bench", "--single", &n.to_string(), "--order", &order, "--seed", &args.seed.to_string()])
+            .args(["bench", "--single", &case.label(), "--order", &order, "--seed", &args.seed.to_string()])
             .args(["--persistence", &format!("{}%", args.persistence * 100.0)])
             .args(["--edges", if args.edges == EdgeSet::All { "all" } else { "minimal" }])
             .args(["--solver", if args.method == Method::Clarabel { "clarabel" } else { "structured" }])
@@ -110,7 +195,8 @@ pub fn bench(args: &BenchArgs) -> Result<String> {
             .map_err(|source| Error::Io { path: exe.clone(), source })?;
         if !child.status.success() {
             return Err(Error::input(format!(
-                "bench of {n} samples failed: {}",
+                "bench of {} failed: {}",
+                case.label(),
                 String::from_utf8_lossy(&child.stderr).trim()
             )));
         }
@@ -119,13 +205,15 @@ pub fn bench(args: &BenchArgs) -> Result<String> {
         let s = &v["seconds"];
         let f = |x: &serde_json::Value| x.as_f64().unwrap_or(f64::NAN);
         out += &format!(
-            "| {} | {} | {} | {} | {} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} | {:.0} |\n",
-            n,
+            "| {} | {} | {} | {} | {} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} | {:.0} |\n",
+            case.label(),
             v["input_extrema"],
             v["kept"],
             v["constraints"],
             v["iterations"],
             f(&s["persistence"]),
+            f(&s["complex"]),
+            f(&s["simplify"]),
             f(&s["representative"]),
             f(&s["operators"]),
             f(&s["constraints"]),

@@ -1,20 +1,25 @@
 //! `toposmooth extrema`: list the extrema with persistence and strictness; draw the diagram.
 
+use super::input::{read_field, DomainKind, FieldInput, GridOptions};
 use super::{check_png_name, sig6, stage_plot};
-use crate::domain::Series;
+use crate::domain::{Domain, Series};
 use crate::error::{Error, Result};
-use crate::io::series_csv::{read_series, SeriesCsvOptions};
+use crate::io::series_csv::SeriesCsvOptions;
 use crate::plot::{plot_persistence_diagram, DiagramPoint};
 use crate::topology::{extrema_table, select, ExtremumKind, Role, Selection};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// Options of `extrema`.
 #[derive(Clone, Debug)]
 pub struct ExtremaArgs {
-    /// Input file.
-    pub input: PathBuf,
-    /// Column choice.
+    /// Input file (none when a grid comes from `--u`/`--v`).
+    pub input: Option<PathBuf>,
+    /// Series or grid.
+    pub kind: DomainKind,
+    /// Column choice (series).
     pub csv: SeriesCsvOptions,
+    /// Grid options.
+    pub grid: GridOptions,
     /// Print JSON instead of a table.
     pub json: bool,
     /// Persistence diagram PNG.
@@ -27,6 +32,8 @@ pub struct ExtremaArgs {
 struct Listing<'a> {
     file: String,
     column: &'a str,
+    /// `[columns, rows]` for a grid.
+    grid: Option<[usize; 2]>,
     samples: usize,
     sos_minima: usize,
     sos_maxima: usize,
@@ -41,22 +48,47 @@ struct Listing<'a> {
 struct Row<'a> {
     #[serde(flatten)]
     info: &'a crate::topology::ExtremumInfo,
-    x: &'a str,
+    x: String,
     kept: bool,
 }
 
 /// Runs `extrema`; returns the text printed on standard output.
 pub fn extrema(args: &ExtremaArgs) -> Result<String> {
     check_png_name(args.plot.as_deref())?;
-    let data = read_series(&args.input, &args.csv)?;
-    let series = Series::with_coordinates(data.x.clone()).map_err(|e| e.in_file(&args.input))?;
-    let h = &data.values;
-    let table = extrema_table(&series, h);
-    let kept = select(&series, h, &args.selection).map_err(|e| e.in_file(&args.input))?;
+    match read_field(args.input.as_deref(), args.kind, &args.csv, &args.grid)? {
+        FieldInput::Series(data) => {
+            let path = args.input.clone().unwrap_or_default();
+            let series = Series::with_coordinates(data.x.clone()).map_err(|e| e.in_file(&path))?;
+            let label = |i: usize| data.x_text[i].clone();
+            list(args, &path, &series, &data.values, &data.column, None, &label)
+        }
+        FieldInput::Grid(data) => {
+            let g = &data.grid;
+            let label = |i: usize| {
+                let (r, c) = g.row_col(i);
+                format!("({r},{c})")
+            };
+            list(args, &data.path, g, &data.values, &data.description, Some([g.nx(), g.ny()]), &label)
+        }
+    }
+}
+
+fn list<D: Domain>(
+    args: &ExtremaArgs,
+    path: &Path,
+    domain: &D,
+    h: &[f64],
+    column: &str,
+    grid: Option<[usize; 2]>,
+    label: &dyn Fn(usize) -> String,
+) -> Result<String> {
+    let table = extrema_table(domain, h);
+    let kept = select(domain, h, &args.selection).map_err(|e| e.in_file(path))?;
     let count = |k: ExtremumKind, strict: bool| table.iter().filter(|r| r.kind == k && (!strict || r.strict)).count();
     let listing = Listing {
-        file: args.input.display().to_string(),
-        column: &data.column,
+        file: path.display().to_string(),
+        column,
+        grid,
         samples: h.len(),
         sos_minima: count(ExtremumKind::Min, false),
         sos_maxima: count(ExtremumKind::Max, false) + count(ExtremumKind::End, false),
@@ -66,11 +98,7 @@ pub fn extrema(args: &ExtremaArgs) -> Result<String> {
         threshold: kept.threshold,
         extrema: table
             .iter()
-            .map(|r| Row {
-                info: r,
-                x: &data.x_text[r.index],
-                kept: matches!(kept.roles[r.index], Role::Min | Role::Max),
-            })
+            .map(|r| Row { info: r, x: label(r.index), kept: matches!(kept.roles[r.index], Role::Min | Role::Max) })
             .collect(),
     };
     if let Some(path) = &args.plot {
@@ -82,12 +110,8 @@ pub fn extrema(args: &ExtremaArgs) -> Result<String> {
             let death = r.partner.map(|p| h[p]).unwrap_or(f64::INFINITY);
             points.push(DiagramPoint { birth: r.value, death, is_max: false, kept: kept.roles[r.index] == Role::Min });
         }
-        let title = format!(
-            "{} — {} ({} pairs)",
-            args.input.file_name().unwrap_or_default().to_string_lossy(),
-            data.column,
-            points.len()
-        );
+        let title =
+            format!("{} — {} ({} pairs)", path.file_name().unwrap_or_default().to_string_lossy(), column, points.len());
         stage_plot(path, |p| plot_persistence_diagram(p, &points, kept.threshold, &title, (900, 800)))?.commit()?;
     }
     if args.json {
@@ -96,7 +120,13 @@ pub fn extrema(args: &ExtremaArgs) -> Result<String> {
     let mut out = String::new();
     out += &format!(
         "{:>8} {:>12} {:>9} {:>14} {:>14} {:>6} {:>4}\n",
-        "index", "x", "type", "value", "persistence", "strict", "kept"
+        "index",
+        if grid.is_some() { "(row,col)" } else { "x" },
+        "type",
+        "value",
+        "persistence",
+        "strict",
+        "kept"
     );
     for row in &listing.extrema {
         let r = row.info;
@@ -122,9 +152,13 @@ pub fn extrema(args: &ExtremaArgs) -> Result<String> {
             if row.kept { "yes" } else { "" }
         );
     }
+    let what = match grid {
+        Some([nx, ny]) => format!("{nx} × {ny} grid"),
+        None => format!("{} samples", listing.samples),
+    };
     out += &format!(
-        "{}: {} samples of `{}`; SoS extrema: {} minima, {} maxima (incl. {} ends); strict in the raw values: {} minima, {} maxima\n",
-        listing.file, listing.samples, listing.column, listing.sos_minima, listing.sos_maxima, listing.ends, listing.strict_minima, listing.strict_maxima
+        "{}: {what} of `{}`; SoS extrema: {} minima, {} maxima (incl. {} ends); strict in the raw values: {} minima, {} maxima\n",
+        listing.file, listing.column, listing.sos_minima, listing.sos_maxima, listing.ends, listing.strict_minima, listing.strict_maxima
     );
     if let Some(t) = kept.threshold {
         out += &format!(

@@ -3,10 +3,12 @@
 
 mod bench;
 mod extrema;
+pub mod input;
 mod smooth;
+mod smooth_grid;
 mod verify;
 
-pub use bench::{bench, BenchArgs};
+pub use bench::{bench, BenchArgs, BenchCase};
 pub use extrema::{extrema, ExtremaArgs};
 pub use smooth::{smooth, SmoothArgs};
 pub use verify::{verify, VerifyArgs};

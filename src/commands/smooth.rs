@@ -1,23 +1,32 @@
 //! `toposmooth smooth`: the whole pipeline on a file, with output, plot and report.
 
+use super::input::{read_field, DomainKind, FieldInput, GridOptions};
 use super::{check_distinct, check_png_name, sig6, stage_plot, x_axis};
 use crate::domain::Series;
-use crate::error::Result;
-use crate::io::series_csv::{read_series, stage_series_output, SeriesCsvOptions, SeriesOutput};
+use crate::error::{Error, Result};
+use crate::io::series_csv::{stage_series_output, SeriesCsv, SeriesCsvOptions, SeriesOutput};
 use crate::io::stage_json;
 use crate::pipeline::{smooth as run_pipeline, Report, SmoothSettings};
 use crate::plot::{plot_series, Marker};
 use crate::topology::Role;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 /// Options of `smooth`.
 #[derive(Clone, Debug)]
 pub struct SmoothArgs {
-    /// Input file.
-    pub input: PathBuf,
-    /// Column choice.
+    /// Input file (none when a grid comes from `--u`/`--v`).
+    pub input: Option<PathBuf>,
+    /// Series or grid.
+    pub kind: DomainKind,
+    /// Column choice (series).
     pub csv: SeriesCsvOptions,
+    /// Array, spacing, derivation and NaN policy (grids).
+    pub grid: GridOptions,
+    /// Kept critical points and separatrices as VTK PolyData (grids).
+    pub complex: Option<PathBuf>,
+    /// Isolines in the grid plot.
+    pub isolines: usize,
     /// Output CSV.
     pub output: PathBuf,
     /// Pipeline settings.
@@ -43,15 +52,53 @@ struct RunReport<'a> {
 /// Runs `smooth`; returns the summary printed on standard output.
 pub fn smooth(args: &SmoothArgs) -> Result<String> {
     check_png_name(args.plot.as_deref())?;
+    let input_path = args.input.clone().or_else(|| args.grid.uv.as_ref().map(|(u, _)| u.clone())).unwrap_or_default();
     check_distinct(
-        &args.input,
-        &[("-o", Some(&args.output)), ("--plot", args.plot.as_deref()), ("--report", args.report.as_deref())],
+        &input_path,
+        &[
+            ("-o", Some(&args.output)),
+            ("--plot", args.plot.as_deref()),
+            ("--report", args.report.as_deref()),
+            ("--complex", args.complex.as_deref()),
+        ],
     )?;
     let start = Instant::now();
-    let data = read_series(&args.input, &args.csv)?;
-    let series = Series::with_coordinates(data.x.clone()).map_err(|e| e.in_file(&args.input))?;
+    let field = read_field(args.input.as_deref(), args.kind, &args.csv, &args.grid)?;
+    match field {
+        FieldInput::Series(data) => {
+            if args.complex.is_some() {
+                return Err(Error::Usage("--complex is for grids (a series has no separatrices)".into()));
+            }
+            check_output_extension(&args.output, &["csv"], "a series")?;
+            smooth_series(args, &input_path, data, start)
+        }
+        FieldInput::Grid(data) => {
+            check_output_extension(&args.output, &["vti", "npz", "npy", "csv"], "a grid")?;
+            if let Some(c) = &args.complex {
+                check_output_extension(c, &["vtp"], "--complex")?;
+            }
+            super::smooth_grid::smooth_grid(args, data, start)
+        }
+    }
+}
+
+fn check_output_extension(path: &Path, allowed: &[&str], what: &str) -> Result<()> {
+    let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
+    if allowed.contains(&ext.as_str()) {
+        Ok(())
+    } else {
+        Err(Error::Usage(format!(
+            "{}: the output of {what} is written as {}",
+            path.display(),
+            allowed.iter().map(|e| format!(".{e}")).collect::<Vec<_>>().join(", ")
+        )))
+    }
+}
+
+fn smooth_series(args: &SmoothArgs, input: &Path, data: SeriesCsv, start: Instant) -> Result<String> {
+    let series = Series::with_coordinates(data.x.clone()).map_err(|e| e.in_file(input))?;
     let read_seconds = start.elapsed().as_secs_f64();
-    let result = run_pipeline(&series, &data.values, &args.settings).map_err(|e| e.in_file(&args.input))?;
+    let result = run_pipeline(&series, &data.values, &args.settings).map_err(|e| e.in_file(input))?;
     let t = Instant::now();
     let out = SeriesOutput {
         x_text: data.x_text.clone(),
@@ -77,7 +124,7 @@ pub fn smooth(args: &SmoothArgs) -> Result<String> {
         let r = &result.report;
         let title = format!(
             "{} — {}: {} of {} extrema kept, certified (RMS change {:.3e})",
-            args.input.file_name().unwrap_or_default().to_string_lossy(),
+            input.file_name().unwrap_or_default().to_string_lossy(),
             data.column,
             r.kept.len(),
             r.input_minima + r.input_maxima,
@@ -91,7 +138,7 @@ pub fn smooth(args: &SmoothArgs) -> Result<String> {
     let r = &result.report;
     if let Some(path) = &args.report {
         let run = RunReport {
-            input_file: args.input.display().to_string(),
+            input_file: input.display().to_string(),
             column: &data.column,
             output_file: args.output.display().to_string(),
             read_seconds,
@@ -112,7 +159,7 @@ pub fn smooth(args: &SmoothArgs) -> Result<String> {
     let kmin = r.kept.iter().filter(|k| k.role == Role::Min).count();
     text += &format!(
         "{}: {} samples of `{}`, {} minima and {} maxima in the input (SoS, ends included)\n",
-        args.input.display(),
+        input.display(),
         r.vertices,
         data.column,
         r.input_minima,

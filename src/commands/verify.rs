@@ -1,11 +1,14 @@
 //! `toposmooth verify`: re-check an output file from what it carries, independently of `smooth`.
 
-use crate::domain::Series;
+use super::input::{read_grid, GridOptions};
+use crate::domain::{Grid2d, Series};
 use crate::error::{Error, Result};
+use crate::io::npz::read_npz;
 use crate::io::series_csv::{read_series, read_series_output, SeriesCsvOptions};
+use crate::io::vtk::read_image;
 use crate::topology::Role;
 use crate::verify::certify;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// Options of `verify`.
 #[derive(Clone, Debug)]
@@ -16,10 +19,135 @@ pub struct VerifyArgs {
     pub input: Option<PathBuf>,
     /// Column choice for the original input.
     pub csv: SeriesCsvOptions,
+    /// How to read the original input when it is a grid.
+    pub grid: GridOptions,
 }
 
 /// Runs `verify`: `Ok(text)` when the file is certified, [`Error::Uncertified`] (exit 1) when not.
 pub fn verify(args: &VerifyArgs) -> Result<String> {
+    let ext = args.file.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
+    match ext.as_str() {
+        "vti" | "npz" => verify_grid(args, &ext),
+        "npy" => Err(Error::Usage(format!(
+            "{}: a .npy export holds the smoothed array only and cannot be verified alone; verify the .vti or .npz output",
+            args.file.display()
+        ))),
+        _ => verify_series(args),
+    }
+}
+
+/// The arrays a verifiable grid output carries.
+struct GridOutput {
+    grid: Grid2d,
+    input: Vec<f64>,
+    smoothed: Vec<f64>,
+    representative: Vec<f64>,
+    roles: Vec<Role>,
+}
+
+fn read_grid_output(path: &Path, ext: &str) -> Result<GridOutput> {
+    let (grid, mut arrays): (Grid2d, Vec<(String, Vec<f64>)>) = if ext == "vti" {
+        let img = read_image(path)?;
+        let grid = Grid2d::with_geometry(img.nx, img.ny, img.spacing, img.origin).map_err(|e| e.in_file(path))?;
+        (grid, img.arrays.into_iter().filter(|a| a.components == 1).map(|a| (a.name, a.values)).collect())
+    } else {
+        let arrays = read_npz(path)?;
+        let Some((_, [ny, nx], _)) = arrays.first() else {
+            return Err(Error::input("the archive holds no arrays").in_file(path));
+        };
+        let grid = Grid2d::new(*nx, *ny).map_err(|e| e.in_file(path))?;
+        if let Some((name, shape, _)) = arrays.iter().find(|(_, s, _)| *s != [*ny, *nx]) {
+            return Err(
+                Error::input(format!("array `{name}` has shape {shape:?}, the first {:?}", [*ny, *nx])).in_file(path)
+            );
+        }
+        (grid, arrays.into_iter().map(|(n, _, v)| (n, v)).collect())
+    };
+    let mut take = |name: &str| -> Result<Vec<f64>> {
+        let names: Vec<String> = arrays.iter().map(|(n, _)| n.clone()).collect();
+        match arrays.iter().position(|(n, _)| n == name) {
+            Some(i) => Ok(arrays.swap_remove(i).1),
+            None => Err(Error::input(format!(
+                "no array `{name}` (a verifiable output holds input, smoothed, representative, role; found {})",
+                names.join(", ")
+            ))
+            .in_file(path)),
+        }
+    };
+    let (input, smoothed, representative, role) =
+        (take("input")?, take("smoothed")?, take("representative")?, take("role")?);
+    let roles = role
+        .iter()
+        .enumerate()
+        .map(|(i, &c)| {
+            Role::from_code(c).ok_or_else(|| {
+                let (r, col) = grid.row_col(i);
+                Error::input(format!("role {c} at (row {r}, column {col}) is not one of −1, 0, 1, 2, 3")).in_file(path)
+            })
+        })
+        .collect::<Result<Vec<Role>>>()?;
+    Ok(GridOutput { grid, input, smoothed, representative, roles })
+}
+
+fn verify_grid(args: &VerifyArgs, ext: &str) -> Result<String> {
+    let out = read_grid_output(&args.file, ext)?;
+    let g = &out.grid;
+    let n = g.nx() * g.ny();
+    let mut problems = Vec::new();
+    if let Some(orig) = &args.input {
+        let data = read_grid(orig, &args.grid)?;
+        if (data.grid.nx(), data.grid.ny()) != (g.nx(), g.ny()) {
+            problems.push(format!(
+                "{} is {} × {}, {} is {} × {}",
+                orig.display(),
+                data.grid.nx(),
+                data.grid.ny(),
+                args.file.display(),
+                g.nx(),
+                g.ny()
+            ));
+        } else if let Some(i) = (0..n).find(|&i| data.values[i].to_bits() != out.input[i].to_bits()) {
+            let (r, c) = g.row_col(i);
+            problems.push(format!(
+                "input array differs from {} at (row {r}, column {c}): {} vs {}",
+                orig.display(),
+                out.input[i],
+                data.values[i]
+            ));
+        }
+    }
+    if let Some(i) = out.roles.iter().position(|&r| r == Role::End || r == Role::Fixed) {
+        let (r, c) = g.row_col(i);
+        problems
+            .push(format!("(row {r}, column {c}) has role {}: grid outputs keep extrema only", out.roles[i].code()));
+    }
+    if !out.roles.contains(&Role::Min) || !out.roles.contains(&Role::Max) {
+        problems.push("the role array keeps no minimum or no maximum".into());
+    }
+    let cert = certify(g, &out.smoothed, &out.roles, Some(&out.input));
+    if !cert.passed {
+        problems.push(format!("smoothed: {}", cert.summary()));
+    }
+    let ucert = certify(g, &out.representative, &out.roles, None);
+    if !ucert.passed {
+        problems.push(format!("representative: {}", ucert.summary()));
+    }
+    if !problems.is_empty() {
+        return Err(Error::Uncertified { path: Some(args.file.clone()), message: problems.join("; ") });
+    }
+    let kmin = out.roles.iter().filter(|&&r| r == Role::Min).count();
+    let kmax = out.roles.iter().filter(|&&r| r == Role::Max).count();
+    Ok(format!(
+        "{}: {} ({} × {} grid, {kmin} minima and {kmax} maxima kept at their input values, representative consistent{})\n",
+        args.file.display(),
+        cert.summary(),
+        g.nx(),
+        g.ny(),
+        if args.input.is_some() { ", input array matches" } else { "" }
+    ))
+}
+
+fn verify_series(args: &VerifyArgs) -> Result<String> {
     let out = read_series_output(&args.file)?;
     let n = out.input.len();
     let series = Series::uniform(n);

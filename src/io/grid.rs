@@ -174,6 +174,21 @@ fn read_tiff(path: &Path) -> Result<GridField> {
     finish(path, nx, ny, values, "gray".into())
 }
 
+/// Stages a CSV matrix: one grid row per line, shortest round-trip numbers (a single-array
+/// export for scripts; not verifiable alone, SPEC.md).
+///
+/// # Errors
+/// The temporary file cannot be written.
+pub fn stage_grid_csv(path: &Path, nx: usize, values: &[f64]) -> Result<super::Staged> {
+    super::stage(path, |w| {
+        for row in values.chunks(nx) {
+            let line: Vec<String> = row.iter().map(|&v| super::format_f64(v)).collect();
+            writeln!(w, "{}", line.join(","))?;
+        }
+        Ok(())
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -2,7 +2,9 @@
 //! and is renamed into place, so a failed run never leaves a half-written file.
 
 pub mod grid;
+pub mod npz;
 pub mod series_csv;
+pub mod vtk;
 
 use crate::error::{Error, Result};
 use std::io::Write;

@@ -24,6 +24,8 @@ pub struct MorseSmale {
     pub descending: Vec<Separatrix>,
     /// Separatrices ascending to kept maxima.
     pub ascending: Vec<Separatrix>,
+    /// Seconds spent building the two discrete gradients and simplifying them.
+    pub seconds: [f64; 2],
 }
 
 impl MorseSmale {
@@ -33,10 +35,13 @@ impl MorseSmale {
     /// # Errors
     /// A description of a cancellation that failed (never expected for persistence sets).
     pub fn new<D: Domain>(domain: &D, values: &[f64], kept: &KeptSet) -> Result<Self, String> {
+        let t = std::time::Instant::now();
         let mut down = DiscreteGradient::new(domain, values, Direction::Descending);
+        let mut up = DiscreteGradient::new(domain, values, Direction::Ascending);
+        let built = t.elapsed().as_secs_f64();
+        let t = std::time::Instant::now();
         let keep_min: Vec<bool> = kept.roles.iter().map(|&r| r == Role::Min).collect();
         down.simplify(&sublevel_pairs(domain, values), &keep_min)?;
-        let mut up = DiscreteGradient::new(domain, values, Direction::Ascending);
         let keep_max: Vec<bool> = kept.roles.iter().map(|&r| r == Role::Max).collect();
         up.simplify(&superlevel_pairs(domain, values), &keep_max)?;
         let (ds, us) = (down.saddles(), up.saddles());
@@ -53,6 +58,7 @@ impl MorseSmale {
                 .flat_map(|s| g.separatrices(s).map(|path| Separatrix { saddle: s.vertex, path }))
                 .collect()
         };
-        Ok(MorseSmale { descending: trace(&down, &ds), ascending: trace(&up, &us), saddles })
+        let (descending, ascending) = (trace(&down, &ds), trace(&up, &us));
+        Ok(MorseSmale { descending, ascending, saddles, seconds: [built, t.elapsed().as_secs_f64()] })
     }
 }

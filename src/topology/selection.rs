@@ -66,6 +66,11 @@ impl Role {
         }
     }
 
+    /// The role of an array code; `None` for any other number.
+    pub fn from_code(c: f64) -> Option<Role> {
+        [Role::Min, Role::Max, Role::Fixed, Role::End, Role::Other].into_iter().find(|r| f64::from(r.code()) == c)
+    }
+
     /// Text used in series CSV files.
     pub fn label(self) -> &'static str {
         match self {

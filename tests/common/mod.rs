@@ -49,3 +49,30 @@ pub fn scratch(name: &str) -> std::path::PathBuf {
     std::fs::create_dir_all(&d).unwrap();
     d
 }
+
+/// Strict extrema and flat vertices of a grid field, from SPEC's 6-neighbour rule written out
+/// here independently of the crate.
+pub fn grid_extrema(nx: usize, ny: usize, f: &[f64]) -> (Vec<usize>, Vec<usize>, Vec<usize>) {
+    let (mut mins, mut maxs, mut flat) = (vec![], vec![], vec![]);
+    for r in 0..ny as isize {
+        for c in 0..nx as isize {
+            let v = (r as usize) * nx + c as usize;
+            let nb: Vec<f64> = [(0, -1), (0, 1), (-1, 0), (1, 0), (-1, -1), (1, 1)]
+                .iter()
+                .map(|(dr, dc)| (r + dr, c + dc))
+                .filter(|&(rr, cc)| rr >= 0 && rr < ny as isize && cc >= 0 && cc < nx as isize)
+                .map(|(rr, cc)| f[rr as usize * nx + cc as usize])
+                .collect();
+            let lower = nb.iter().filter(|&&w| w < f[v]).count();
+            let higher = nb.iter().filter(|&&w| w > f[v]).count();
+            if higher == nb.len() {
+                mins.push(v);
+            } else if lower == nb.len() {
+                maxs.push(v);
+            } else if lower == 0 || higher == 0 {
+                flat.push(v);
+            }
+        }
+    }
+    (mins, maxs, flat)
+}

@@ -1,8 +1,7 @@
-//! PNG plots of smoothed series and persistence diagrams.
+//! PNG plots: smoothed series, persistence diagrams and grid heat maps ([`grid`]).
 //!
-//! Drawing uses plotters' bitmap backend into an in-memory RGB buffer; since plotters is built
-//! without its image encoder, the buffer is written by a small built-in PNG encoder (fixed-Huffman
-//! deflate with run matching, which compresses flat plot backgrounds well).
+//! Drawing uses plotters' bitmap backend into an in-memory RGB buffer, written as PNG by the
+//! `image` crate.
 
 use chrono::{Datelike, NaiveDate, TimeDelta};
 use plotters::coord::ranged1d::{KeyPointHint, NoDefaultFormatting, ValueFormatter};
@@ -13,6 +12,9 @@ use plotters::style::text_anchor::{HPos, Pos, VPos};
 use std::error::Error;
 use std::path::Path;
 use std::sync::OnceLock;
+
+mod grid;
+pub use grid::{plot_grid_fields, GridMarker, GridPanel, GridPlotOptions};
 
 /// Error of a plot: carries a message.
 #[derive(Debug, thiserror::Error)]

@@ -1,0 +1,262 @@
+//! Reading the field a command works on: a series (CSV) or a grid (.vti, legacy .vtk, .npy,
+//! CSV matrix, PNG, TIFF, or two velocity components), with the grid options `--array`,
+//! `--spacing`, `--derive` and `--fill-missing` applied.
+
+use crate::derive::{describe_missing, fill_missing, magnitude, vorticity};
+use crate::domain::Grid2d;
+use crate::error::{Error, Result};
+use crate::io::grid::{read_grid_csv, read_npy, read_raster, GridField};
+use crate::io::series_csv::{read_series, SeriesCsv, SeriesCsvOptions};
+use crate::io::vtk::read_image;
+use std::path::{Path, PathBuf};
+
+/// What kind of domain a file holds.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum DomainKind {
+    /// Decide from the extension; a CSV is a grid when its first line is three or more
+    /// numbers (a matrix without header), else a series.
+    #[default]
+    Auto,
+    /// A series (CSV).
+    Series,
+    /// A grid.
+    Grid,
+}
+
+/// A scalar to derive from a velocity field.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Derive {
+    /// ω = ∂v/∂x − ∂u/∂y.
+    Vorticity,
+    /// |(u, v)|.
+    Magnitude,
+}
+
+/// How to read a grid.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct GridOptions {
+    /// Point array to read from a VTK file (default: the only scalar array, or with
+    /// `derive` the only vector array).
+    pub array: Option<String>,
+    /// Spacing `(dx, dy)`, overriding the file's.
+    pub spacing: Option<[f64; 2]>,
+    /// Derive a scalar from a velocity field.
+    pub derive: Option<Derive>,
+    /// Velocity components from two grid files (with `derive`).
+    pub uv: Option<(PathBuf, PathBuf)>,
+    /// Fill NaN samples harmonically instead of refusing them.
+    pub fill_missing: bool,
+}
+
+/// A grid field ready to smooth.
+#[derive(Clone, Debug)]
+pub struct GridInput {
+    /// The grid with its spacing and origin.
+    pub grid: Grid2d,
+    /// The values to smooth (after deriving and filling).
+    pub values: Vec<f64>,
+    /// What the values are: the array read or the derivation.
+    pub description: String,
+    /// Samples filled by `--fill-missing` (1) or not (0), when any were.
+    pub filled: Option<Vec<bool>>,
+    /// The file the grid came from (the first velocity file with `--u/--v`).
+    pub path: PathBuf,
+}
+
+/// A field read by a command.
+#[derive(Clone, Debug)]
+pub enum FieldInput {
+    /// A series.
+    Series(SeriesCsv),
+    /// A grid.
+    Grid(GridInput),
+}
+
+fn extension(path: &Path) -> String {
+    path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase()
+}
+
+/// Whether a file is read as a grid.
+pub fn is_grid_file(path: &Path, kind: DomainKind) -> Result<bool> {
+    Ok(match kind {
+        DomainKind::Series => false,
+        DomainKind::Grid => true,
+        DomainKind::Auto => match extension(path).as_str() {
+            "vti" | "vtk" | "npy" | "png" | "tif" | "tiff" => true,
+            _ => {
+                let text = std::fs::read_to_string(path).map_err(|source| Error::Io { path: path.into(), source })?;
+                let first = text.lines().map(str::trim).find(|l| !l.is_empty()).unwrap_or("");
+                let cells: Vec<&str> = first.trim_start_matches('\u{feff}').split(',').collect();
+                cells.len() >= 3 && cells.iter().all(|c| c.trim().parse::<f64>().is_ok())
+            }
+        },
+    })
+}
+
+/// Reads the field of a command: a series or a grid, by [`is_grid_file`].
+pub fn read_field(
+    path: Option<&Path>,
+    kind: DomainKind,
+    csv: &SeriesCsvOptions,
+    grid: &GridOptions,
+) -> Result<FieldInput> {
+    let grid_wanted = grid.uv.is_some() || grid.derive.is_some() || grid.fill_missing || grid.array.is_some();
+    match path {
+        Some(p) if !is_grid_file(p, kind)? => {
+            if grid_wanted || grid.spacing.is_some() {
+                return Err(Error::Usage(format!(
+                    "{} is read as a series; --array, --spacing, --derive, --u/--v and --fill-missing are for grids (use --domain grid for a CSV matrix)",
+                    p.display()
+                )));
+            }
+            Ok(FieldInput::Series(read_series(p, csv)?))
+        }
+        Some(p) if grid.uv.is_some() => {
+            Err(Error::Usage(format!("give either an input file ({}) or --u and --v, not both", p.display())))
+        }
+        Some(p) => Ok(FieldInput::Grid(read_grid(p, grid)?)),
+        None => match &grid.uv {
+            Some(_) => Ok(FieldInput::Grid(read_grid(Path::new(""), grid)?)),
+            None => Err(Error::Usage("no input file".into())),
+        },
+    }
+}
+
+/// One array of a raw read: name, components, values.
+struct Raw {
+    grid: Grid2d,
+    arrays: Vec<(String, usize, Vec<f64>)>,
+}
+
+fn read_raw(path: &Path) -> Result<Raw> {
+    let from_field = |f: GridField| Raw { arrays: vec![(f.array, 1, f.values)], grid: f.grid };
+    match extension(path).as_str() {
+        "vti" | "vtk" => {
+            let img = read_image(path)?;
+            let grid = Grid2d::with_geometry(img.nx, img.ny, img.spacing, img.origin).map_err(|e| e.in_file(path))?;
+            let arrays = img.arrays.into_iter().map(|a| (a.name, a.components, a.values)).collect();
+            Ok(Raw { grid, arrays })
+        }
+        "npy" => read_npy(path).map(from_field),
+        "png" | "tif" | "tiff" => read_raster(path).map(from_field),
+        _ => read_grid_csv(path).map(from_field),
+    }
+}
+
+fn with_spacing(path: &Path, grid: &Grid2d, spacing: Option<[f64; 2]>) -> Result<Grid2d> {
+    match spacing {
+        Some(s) => Grid2d::with_geometry(grid.nx(), grid.ny(), s, grid.origin()).map_err(|e| e.in_file(path)),
+        None => Ok(grid.clone()),
+    }
+}
+
+fn pick<'a>(path: &Path, raw: &'a Raw, name: Option<&str>, vector: bool) -> Result<&'a (String, usize, Vec<f64>)> {
+    let listing = || {
+        raw.arrays
+            .iter()
+            .map(|(n, c, _)| format!("`{n}` ({c} component{})", if *c == 1 { "" } else { "s" }))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    if let Some(name) = name {
+        return raw.arrays.iter().find(|(n, _, _)| n == name).ok_or_else(|| {
+            Error::input(format!("no point array named `{name}`; the file has {}", listing())).in_file(path)
+        });
+    }
+    let fits: Vec<&(String, usize, Vec<f64>)> =
+        raw.arrays.iter().filter(|(_, c, _)| if vector { *c == 2 || *c == 3 } else { *c == 1 }).collect();
+    match fits.as_slice() {
+        [one] => Ok(one),
+        [] => Err(Error::input(format!(
+            "no {} point array; the file has {}",
+            if vector { "vector (2 or 3 components)" } else { "scalar" },
+            if raw.arrays.is_empty() { "none".to_string() } else { listing() }
+        ))
+        .in_file(path)),
+        _ => {
+            Err(Error::Usage(format!("{}: several arrays fit, choose one with --array: {}", path.display(), listing())))
+        }
+    }
+}
+
+/// Reads a grid with its options applied: array choice, spacing, derivation, NaN policy.
+///
+/// # Errors
+/// Input errors naming the file (unreadable, missing array, different grid sizes of `--u`
+/// and `--v`, NaN without `--fill-missing`), usage errors for contradictory options.
+pub fn read_grid(path: &Path, opts: &GridOptions) -> Result<GridInput> {
+    let (grid, mut values, description, source) = match (&opts.uv, opts.derive) {
+        (Some(_), None) => return Err(Error::Usage("--u and --v need --derive vorticity|magnitude".into())),
+        (Some((pu, pv)), Some(d)) => {
+            let (ru, rv) = (read_raw(pu)?, read_raw(pv)?);
+            if (ru.grid.nx(), ru.grid.ny()) != (rv.grid.nx(), rv.grid.ny()) {
+                return Err(Error::input(format!(
+                    "{} is {} × {} but {} is {} × {}",
+                    pu.display(),
+                    ru.grid.nx(),
+                    ru.grid.ny(),
+                    pv.display(),
+                    rv.grid.nx(),
+                    rv.grid.ny()
+                )));
+            }
+            let a = pick(pu, &ru, opts.array.as_deref(), false)?;
+            let b = pick(pv, &rv, opts.array.as_deref(), false)?;
+            let grid = with_spacing(pu, &ru.grid, opts.spacing)?;
+            let values = derive(&grid, d, &a.2, &b.2);
+            (grid, values, format!("{d:?} of ({}, {})", pu.display(), pv.display()).to_lowercase(), pu.clone())
+        }
+        (None, Some(d)) => {
+            let raw = read_raw(path)?;
+            let a = pick(path, &raw, opts.array.as_deref(), true)?;
+            if a.1 != 2 && a.1 != 3 {
+                return Err(Error::input(format!(
+                    "--derive needs a vector array (2 or 3 components); `{}` has {}",
+                    a.0, a.1
+                ))
+                .in_file(path));
+            }
+            let u: Vec<f64> = a.2.iter().step_by(a.1).copied().collect();
+            let v: Vec<f64> = a.2.iter().skip(1).step_by(a.1).copied().collect();
+            let grid = with_spacing(path, &raw.grid, opts.spacing)?;
+            let values = derive(&grid, d, &u, &v);
+            (
+                grid,
+                values,
+                format!("{} of {}", if d == Derive::Vorticity { "vorticity" } else { "magnitude" }, a.0),
+                path.to_path_buf(),
+            )
+        }
+        (None, None) => {
+            let raw = read_raw(path)?;
+            let a = pick(path, &raw, opts.array.as_deref(), false)?;
+            if a.1 != 1 {
+                return Err(Error::input(format!(
+                    "`{}` has {} components; smooth a scalar array, or use --derive vorticity|magnitude",
+                    a.0, a.1
+                ))
+                .in_file(path));
+            }
+            let grid = with_spacing(path, &raw.grid, opts.spacing)?;
+            (grid, a.2.clone(), a.0.clone(), path.to_path_buf())
+        }
+    };
+    let mut filled = None;
+    if let Some(what) = describe_missing(&grid, &values, 5) {
+        if !opts.fill_missing {
+            return Err(Error::input(format!("{what}; pass --fill-missing to fill them harmonically")).in_file(&source));
+        }
+        let mask: Vec<bool> = values.iter().map(|v| v.is_nan()).collect();
+        fill_missing(&grid, &mut values).map_err(|e| e.in_file(&source))?;
+        filled = Some(mask);
+    }
+    Ok(GridInput { grid, values, description, filled, path: source })
+}
+
+fn derive(grid: &Grid2d, d: Derive, u: &[f64], v: &[f64]) -> Vec<f64> {
+    match d {
+        Derive::Vorticity => vorticity(grid, u, v),
+        Derive::Magnitude => magnitude(u, v),
+    }
+}

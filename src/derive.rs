@@ -1,0 +1,171 @@
+//! Scalar fields derived from measured grid data before smoothing: vorticity and speed of a
+//! velocity field, and harmonic filling of missing (NaN) samples.
+//!
+//! Derivatives use the signed spacing (SPEC.md: PIV rows often run downwards, dy < 0, and
+//! vorticity keeps its physical sign): second-order central differences inside, first-order
+//! one-sided differences at the boundary, as `numpy.gradient` does. A missing sample makes
+//! every derivative whose stencil touches it missing, and a rejected vector has no vorticity
+//! of its own: a NaN velocity makes the vorticity NaN there and at its left, right, upper and
+//! lower neighbours (the bundled PIV vorticity was made the same way: 774 missing cells from
+//! 353 rejected vectors).
+//!
+//! ```
+//! use toposmooth::{derive::vorticity, domain::Grid2d};
+//! // solid-body rotation u = −y, v = x has vorticity 2 everywhere
+//! let g = Grid2d::with_geometry(4, 3, [0.5, 0.5], [0.0, 0.0])?;
+//! let (u, v): (Vec<f64>, Vec<f64>) = (0..12).map(|i| {
+//!     let (x, y) = ((i % 4) as f64 * 0.5, (i / 4) as f64 * 0.5);
+//!     (-y, x)
+//! }).unzip();
+//! assert!(vorticity(&g, &u, &v).iter().all(|w| (w - 2.0).abs() < 1e-12));
+//! # Ok::<(), toposmooth::Error>(())
+//! ```
+
+use crate::domain::Grid2d;
+use crate::error::{Error, Result};
+use crate::operators::{dirichlet_solve, grid_stiffness};
+
+/// ∂f/∂x (along columns, spacing dx) and ∂f/∂y (along rows, spacing dy) at every vertex.
+pub fn gradient(grid: &Grid2d, f: &[f64]) -> (Vec<f64>, Vec<f64>) {
+    let (nx, ny) = (grid.nx(), grid.ny());
+    let [dx, dy] = grid.spacing();
+    let d = |a: f64, b: f64, h: f64| (b - a) / h;
+    let mut fx = vec![0.0; nx * ny];
+    let mut fy = vec![0.0; nx * ny];
+    for r in 0..ny {
+        for c in 0..nx {
+            let i = r * nx + c;
+            fx[i] = match c {
+                0 => d(f[i], f[i + 1], dx),
+                _ if c == nx - 1 => d(f[i - 1], f[i], dx),
+                _ => d(f[i - 1], f[i + 1], 2.0 * dx),
+            };
+            fy[i] = match r {
+                0 => d(f[i], f[i + nx], dy),
+                _ if r == ny - 1 => d(f[i - nx], f[i], dy),
+                _ => d(f[i - nx], f[i + nx], 2.0 * dy),
+            };
+        }
+    }
+    (fx, fy)
+}
+
+/// Vorticity ω = ∂v/∂x − ∂u/∂y of the velocity (u, v); missing where the vector itself or
+/// one its stencil uses is missing.
+pub fn vorticity(grid: &Grid2d, u: &[f64], v: &[f64]) -> Vec<f64> {
+    let (vx, _) = gradient(grid, v);
+    let (_, uy) = gradient(grid, u);
+    (0..u.len()).map(|i| if u[i].is_nan() || v[i].is_nan() { f64::NAN } else { vx[i] - uy[i] }).collect()
+}
+
+/// Speed |(u, v)|.
+pub fn magnitude(u: &[f64], v: &[f64]) -> Vec<f64> {
+    u.iter().zip(v).map(|(a, b)| a.hypot(*b)).collect()
+}
+
+/// The first few missing samples as `(row r, column c)` text.
+pub fn describe_missing(grid: &Grid2d, values: &[f64], limit: usize) -> Option<String> {
+    let missing: Vec<usize> = values.iter().enumerate().filter(|(_, v)| v.is_nan()).map(|(i, _)| i).collect();
+    if missing.is_empty() {
+        return None;
+    }
+    let first: Vec<String> = missing
+        .iter()
+        .take(limit)
+        .map(|&i| {
+            let (r, c) = grid.row_col(i);
+            format!("(row {r}, column {c})")
+        })
+        .collect();
+    Some(format!(
+        "{} missing (NaN) samples, first {}{}",
+        missing.len(),
+        first.join(", "),
+        if missing.len() > limit { ", …" } else { "" }
+    ))
+}
+
+/// Fills missing (NaN) samples by harmonic interpolation from the others (5-point Laplacian
+/// with the grid's spacing: every filled value lies between known values around its hole);
+/// returns how many were filled.
+///
+/// # Errors
+/// Every sample is missing.
+pub fn fill_missing(grid: &Grid2d, values: &mut [f64]) -> Result<usize> {
+    let fixed: Vec<Option<f64>> = values.iter().map(|&v| (!v.is_nan()).then_some(v)).collect();
+    let count = fixed.iter().filter(|f| f.is_none()).count();
+    if count == 0 {
+        return Ok(0);
+    }
+    if count == values.len() {
+        return Err(Error::input("every sample is missing (NaN): nothing to fill from"));
+    }
+    let filled = dirichlet_solve(&grid_stiffness(grid), &fixed).map_err(|e| Error::input(format!("fill: {e}")))?;
+    values.copy_from_slice(&filled);
+    Ok(count)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn derivatives_are_exact_for_quadratics_inside_and_linears_everywhere() {
+        let g = Grid2d::with_geometry(6, 5, [0.5, -2.0], [0.0, 0.0]).unwrap();
+        let pos = |i: usize| ((i % 6) as f64 * 0.5, (i / 6) as f64 * -2.0);
+        let lin: Vec<f64> = (0..30).map(|i| 3.0 * pos(i).0 - 0.5 * pos(i).1).collect();
+        let (fx, fy) = gradient(&g, &lin);
+        assert!(fx.iter().all(|d| (d - 3.0).abs() < 1e-12));
+        assert!(fy.iter().all(|d| (d + 0.5).abs() < 1e-12), "negative dy keeps the physical sign");
+        let quad: Vec<f64> = (0..30).map(|i| pos(i).0 * pos(i).0).collect();
+        let (fx, _) = gradient(&g, &quad);
+        for r in 0..5 {
+            for c in 1..5 {
+                let i = r * 6 + c;
+                assert!((fx[i] - 2.0 * pos(i).0).abs() < 1e-12);
+            }
+        }
+    }
+
+    #[test]
+    fn nan_spreads_through_the_stencil_only() {
+        let g = Grid2d::new(5, 5).unwrap();
+        let mut u = vec![1.0; 25];
+        let v = vec![0.0; 25];
+        u[12] = f64::NAN; // centre
+        let w = vorticity(&g, &u, &v);
+        let bad: Vec<usize> = (0..25).filter(|&i| w[i].is_nan()).collect();
+        // ∂u/∂y at rows 1 and 3 of column 2 use u[12]; the centre has no vector
+        assert_eq!(bad, vec![7, 12, 17]);
+        assert!(magnitude(&u, &v)[12].is_nan());
+    }
+
+    #[test]
+    fn harmonic_fill_stays_within_the_known_values() {
+        let g = Grid2d::new(7, 6).unwrap();
+        let mut f: Vec<f64> = (0..42).map(|i| (i % 7) as f64 + 0.1 * (i / 7) as f64).collect();
+        let truth = f.clone();
+        for i in [8, 9, 15, 16, 0, 1, 7] {
+            f[i] = f64::NAN;
+        }
+        assert!(describe_missing(&g, &f, 2).unwrap().starts_with("7 missing (NaN) samples, first (row 0, column 0)"));
+        assert_eq!(fill_missing(&g, &mut f).unwrap(), 7);
+        // the hole touches the boundary (Neumann there): every filled value lies within the
+        // known values around it
+        let (lo, hi) = (truth[2].min(truth[14]), truth[23].max(truth[17]));
+        for i in [8, 9, 15, 16, 0, 1, 7] {
+            assert!(f[i] > lo - 1e-12 && f[i] < hi + 1e-12, "{i}: {}", f[i]);
+        }
+        // an interior hole in a linear field is filled exactly (5-point stencil)
+        let mut f = truth.clone();
+        for i in [8, 9, 15, 16, 24] {
+            f[i] = f64::NAN;
+        }
+        assert_eq!(fill_missing(&g, &mut f).unwrap(), 5);
+        for i in 0..42 {
+            assert!((f[i] - truth[i]).abs() < 1e-9, "{i}: {} vs {}", f[i], truth[i]);
+        }
+        let mut all = vec![f64::NAN; 42];
+        assert!(fill_missing(&g, &mut all).is_err());
+    }
+}

@@ -1,0 +1,314 @@
+//! NumPy files: 2D float64 arrays as `.npy`, several of them as an `.npz` archive (what
+//! `numpy.savez` writes: a zip of `NAME.npy` members, here deflate-compressed), and reading
+//! any `.npz` of 2D numeric arrays back.
+//!
+//! Arrays have shape `(ny, nx)` in C order: element `(r, c)` is grid vertex `r · nx + c`, so
+//! `numpy.load(f)["smoothed"][r, c]` is the value at row `r`, column `c` of the grid.
+
+use super::{stage, stage_with, Staged};
+use crate::error::{Error, Result};
+use std::io::{Read, Write};
+use std::path::Path;
+
+fn input(path: &Path, msg: impl Into<String>) -> Error {
+    Error::input(msg).in_file(path)
+}
+
+fn check_shape(path: &Path, what: &str, ny: usize, nx: usize, len: usize) -> Result<()> {
+    if ny.checked_mul(nx) != Some(len) {
+        return Err(input(path, format!("{what} has {len} values for shape ({ny}, {nx})")));
+    }
+    Ok(())
+}
+
+fn write_npy(w: &mut dyn Write, ny: usize, nx: usize, values: &[f64]) -> std::io::Result<()> {
+    use npyz::WriterBuilder;
+    let mut writer =
+        npyz::WriteOptions::<f64>::new().default_dtype().shape(&[ny as u64, nx as u64]).writer(w).begin_nd()?;
+    writer.extend(values.iter().copied())?;
+    writer.finish()
+}
+
+/// Stages a `.npy` file: a little-endian float64 array of shape `(ny, nx)`, C order.
+///
+/// # Errors
+/// An input error when `values.len() != ny · nx`; I/O errors while writing.
+pub fn stage_npy(path: &Path, ny: usize, nx: usize, values: &[f64]) -> Result<Staged> {
+    check_shape(path, "the array", ny, nx, values.len())?;
+    stage(path, |w| write_npy(w, ny, nx, values))
+}
+
+/// Stages a `.npz` archive with one little-endian float64 array of shape `(ny, nx)` (C order)
+/// per entry of `arrays`, stored as member `NAME.npy` (deflate-compressed), so that
+/// `numpy.load(path)[NAME]` returns it.
+///
+/// # Errors
+/// Input errors: an array whose length is not `ny · nx`, an empty, duplicate or path-like
+/// name. I/O errors while writing.
+pub fn stage_npz(path: &Path, ny: usize, nx: usize, arrays: &[(&str, &[f64])]) -> Result<Staged> {
+    let mut seen: Vec<&str> = Vec::new();
+    for (name, values) in arrays {
+        if name.is_empty() || name.contains(['/', '\\', '\0']) {
+            return Err(input(path, format!("array name {name:?} cannot be a member name of an .npz archive")));
+        }
+        if seen.contains(name) {
+            return Err(input(path, format!("two arrays are named `{name}`")));
+        }
+        seen.push(name);
+        check_shape(path, &format!("array `{name}`"), ny, nx, values.len())?;
+    }
+    stage_with(path, |tmp| {
+        use zip::write::SimpleFileOptions;
+        let file = std::fs::File::create(tmp)?;
+        let mut zip = zip::ZipWriter::new(std::io::BufWriter::new(file));
+        for (name, values) in arrays {
+            let options = SimpleFileOptions::default()
+                .compression_method(zip::CompressionMethod::Deflated)
+                .large_file(values.len() as u64 * 8 + 4096 >= u64::from(u32::MAX));
+            zip.start_file(npyz::npz::file_name_from_array_name(name), options)?;
+            write_npy(&mut zip, ny, nx, values)?;
+        }
+        let buffered = zip.finish()?;
+        let file = buffered.into_inner().map_err(|e| e.into_error())?;
+        file.sync_all()
+    })
+}
+
+/// One array of an `.npz` archive: its name, shape `[ny, nx]` and values in C order.
+pub type NpzArray = (String, [usize; 2], Vec<f64>);
+
+/// Reads every array of an `.npz` archive: `(name, [ny, nx], values)` in archive order, with
+/// values converted to f64 and Fortran-ordered arrays rearranged to C order (row by row).
+/// Members whose names do not end in `.npy` are skipped, as `numpy.load` does.
+///
+/// # Errors
+/// Input errors naming the file (and the array): not a zip archive, a truncated or corrupt
+/// member, an array that is not 2D, an unsupported dtype, an archive with no arrays. I/O
+/// errors for an unreadable file.
+pub fn read_npz(path: &Path) -> Result<Vec<NpzArray>> {
+    let file = std::fs::File::open(path).map_err(|source| Error::Io { path: path.to_path_buf(), source })?;
+    let mut archive = zip::ZipArchive::new(std::io::BufReader::new(file))
+        .map_err(|e| input(path, format!("not a readable .npz (zip) archive: {e}")))?;
+    let mut out = Vec::new();
+    for i in 0..archive.len() {
+        let mut member = archive
+            .by_index(i)
+            .map_err(|e| input(path, format!("cannot read member {} of the archive: {e}", i + 1)))?;
+        let Some(name) = npyz::npz::array_name_from_file_name(member.name()).map(str::to_string) else {
+            continue;
+        };
+        let mut bytes = Vec::with_capacity(member.size().min(1 << 30) as usize);
+        member.read_to_end(&mut bytes).map_err(|e| input(path, format!("array `{name}`: cannot read it: {e}")))?;
+        let (shape, values) = decode_npy(&bytes).map_err(|m| input(path, format!("array `{name}`: {m}")))?;
+        out.push((name, shape, values));
+    }
+    if out.is_empty() {
+        return Err(input(path, "the archive holds no .npy arrays"));
+    }
+    Ok(out)
+}
+
+/// Decodes a whole `.npy` file held in memory: a 2D numeric or boolean array as
+/// `([ny, nx], values in C order)`.
+pub fn decode_npy(bytes: &[u8]) -> std::result::Result<([usize; 2], Vec<f64>), String> {
+    use npyz::{DType, Order, TypeChar};
+    let npy = npyz::NpyFile::new(bytes).map_err(|e| format!("not a readable .npy array: {e}"))?;
+    let shape = npy.shape().to_vec();
+    if shape.len() != 2 {
+        return Err(format!("expected a 2D array (rows, columns), found shape {shape:?}"));
+    }
+    let (ny, nx) = (shape[0] as usize, shape[1] as usize);
+    let order = npy.order();
+    let dtype = npy.dtype();
+    let DType::Plain(ts) = &dtype else {
+        return Err(format!("unsupported dtype {}", dtype.descr()));
+    };
+    let bad = |e: std::io::Error| format!("cannot read the data (truncated?): {e}");
+    let values: Vec<f64> = match (ts.type_char(), ts.size_field()) {
+        (TypeChar::Float, 8) => npy.into_vec::<f64>().map_err(bad)?,
+        (TypeChar::Float, 4) => npy.into_vec::<f32>().map_err(bad)?.into_iter().map(f64::from).collect(),
+        (TypeChar::Int, 1) => npy.into_vec::<i8>().map_err(bad)?.into_iter().map(f64::from).collect(),
+        (TypeChar::Int, 2) => npy.into_vec::<i16>().map_err(bad)?.into_iter().map(f64::from).collect(),
+        (TypeChar::Int, 4) => npy.into_vec::<i32>().map_err(bad)?.into_iter().map(f64::from).collect(),
+        (TypeChar::Int, 8) => npy.into_vec::<i64>().map_err(bad)?.into_iter().map(|v| v as f64).collect(),
+        (TypeChar::Uint, 1) => npy.into_vec::<u8>().map_err(bad)?.into_iter().map(f64::from).collect(),
+        (TypeChar::Uint, 2) => npy.into_vec::<u16>().map_err(bad)?.into_iter().map(f64::from).collect(),
+        (TypeChar::Uint, 4) => npy.into_vec::<u32>().map_err(bad)?.into_iter().map(f64::from).collect(),
+        (TypeChar::Uint, 8) => npy.into_vec::<u64>().map_err(bad)?.into_iter().map(|v| v as f64).collect(),
+        (TypeChar::Bool, 1) => npy.into_vec::<bool>().map_err(bad)?.into_iter().map(|b| b as u8 as f64).collect(),
+        _ => return Err(format!("unsupported dtype {}", dtype.descr())),
+    };
+    if Some(values.len()) != ny.checked_mul(nx) {
+        return Err(format!("{} values for shape ({ny}, {nx})", values.len()));
+    }
+    let values = match order {
+        Order::C => values,
+        // Fortran order stores column by column: element (r, c) sits at c·ny + r
+        Order::Fortran => (0..ny * nx).map(|k| values[(k % nx) * ny + k / nx]).collect(),
+    };
+    Ok(([ny, nx], values))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn dir() -> std::path::PathBuf {
+        let d = std::env::temp_dir().join(format!("toposmooth-npz-{}", std::process::id()));
+        std::fs::create_dir_all(&d).unwrap();
+        d
+    }
+
+    /// Deterministic values covering awkward doubles (no NaN: NaN != NaN is checked by bits).
+    fn values(n: usize, seed: u64) -> Vec<f64> {
+        let mut s = seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1;
+        (0..n)
+            .map(|i| {
+                s ^= s << 13;
+                s ^= s >> 7;
+                s ^= s << 17;
+                match i % 7 {
+                    0 => -0.0,
+                    1 => f64::MIN_POSITIVE / 3.0,
+                    _ => (s >> 11) as f64 / (1u64 << 53) as f64 * 2e3 - 1e3,
+                }
+            })
+            .collect()
+    }
+
+    fn bits(v: &[f64]) -> Vec<u64> {
+        v.iter().map(|x| x.to_bits()).collect()
+    }
+
+    #[test]
+    fn npy_round_trip_bits() {
+        let p = dir().join("a.npy");
+        let v = values(5 * 3, 1);
+        stage_npy(&p, 5, 3, &v).unwrap().commit().unwrap();
+        let bytes = std::fs::read(&p).unwrap();
+        let (shape, back) = decode_npy(&bytes).unwrap();
+        assert_eq!(shape, [5, 3]);
+        assert_eq!(bits(&back), bits(&v));
+        // the crate's own .npy reader agrees (nx = 3 columns, ny = 5 rows)
+        let f = crate::io::grid::read_npy(&p).unwrap();
+        assert_eq!((f.grid.nx(), f.grid.ny()), (3, 5));
+        assert_eq!(bits(&f.values), bits(&v));
+        let e = stage_npy(&p, 4, 3, &v).err().unwrap().to_string();
+        assert!(e.contains("a.npy") && e.contains("15 values"), "{e}");
+    }
+
+    #[test]
+    fn npz_round_trip_bits() {
+        let p = dir().join("out.npz");
+        let (ny, nx) = (7, 4);
+        let names = ["input", "smoothed", "representative", "role"];
+        let data: Vec<Vec<f64>> = (0..4).map(|k| values(ny * nx, k + 10)).collect();
+        let arrays: Vec<(&str, &[f64])> = names.iter().zip(&data).map(|(n, v)| (*n, v.as_slice())).collect();
+        let staged = stage_npz(&p, ny, nx, &arrays).unwrap();
+        assert!(!p.exists(), "nothing at the final path before commit");
+        staged.commit().unwrap();
+        let back = read_npz(&p).unwrap();
+        assert_eq!(back.len(), 4);
+        for ((name, shape, vals), (want_name, want)) in back.iter().zip(&arrays) {
+            assert_eq!(name, want_name);
+            assert_eq!(*shape, [ny, nx]);
+            assert_eq!(bits(vals), bits(want));
+        }
+        // bad arguments
+        let short = vec![0.0; 3];
+        let e = stage_npz(&p, ny, nx, &[("a", &short)]).err().unwrap().to_string();
+        assert!(e.contains("out.npz") && e.contains("`a`"), "{e}");
+        let e = stage_npz(&p, ny, nx, &[("a", &data[0]), ("a", &data[1])]).err().unwrap().to_string();
+        assert!(e.contains("two arrays"), "{e}");
+    }
+
+    /// A version-1.0 .npy file built by hand from its documented layout.
+    fn npy_bytes(descr: &str, fortran: bool, shape: &str, data: &[u8]) -> Vec<u8> {
+        let mut header = format!(
+            "{{'descr': '{descr}', 'fortran_order': {}, 'shape': {shape}, }}",
+            if fortran { "True" } else { "False" }
+        );
+        while (10 + header.len() + 1) % 64 != 0 {
+            header.push(' ');
+        }
+        header.push('\n');
+        let mut out = b"\x93NUMPY\x01\x00".to_vec();
+        out.extend((header.len() as u16).to_le_bytes());
+        out.extend(header.as_bytes());
+        out.extend(data);
+        out
+    }
+
+    fn zip_of(path: &Path, members: &[(&str, Vec<u8>)], method: zip::CompressionMethod) {
+        let mut z = zip::ZipWriter::new(std::fs::File::create(path).unwrap());
+        for (name, bytes) in members {
+            z.start_file(*name, zip::write::SimpleFileOptions::default().compression_method(method)).unwrap();
+            z.write_all(bytes).unwrap();
+        }
+        z.finish().unwrap();
+    }
+
+    #[test]
+    fn npz_dtypes_and_fortran_order() {
+        let p = dir().join("mixed.npz");
+        let f32s: Vec<u8> = [1.5f32, -2.0, 3.25, 4.0, 5.0, 6.0].iter().flat_map(|v| v.to_le_bytes()).collect();
+        // (2, 3) matrix [[1, 2, 3], [4, 5, 6]] stored column by column, big-endian int32
+        let fort: Vec<u8> = [1i32, 4, 2, 5, 3, 6].iter().flat_map(|v| v.to_be_bytes()).collect();
+        let u8s = vec![0u8, 255, 7, 9];
+        zip_of(
+            &p,
+            &[
+                ("f.npy", npy_bytes("<f4", false, "(2, 3)", &f32s)),
+                ("notes.txt", b"skipped".to_vec()),
+                ("i.npy", npy_bytes(">i4", true, "(2, 3)", &fort)),
+                ("u.npy", npy_bytes("|u1", false, "(2, 2)", &u8s)),
+            ],
+            zip::CompressionMethod::Stored,
+        );
+        let back = read_npz(&p).unwrap();
+        let names: Vec<&str> = back.iter().map(|(n, _, _)| n.as_str()).collect();
+        assert_eq!(names, ["f", "i", "u"]);
+        assert_eq!(back[0].2, vec![1.5, -2.0, 3.25, 4.0, 5.0, 6.0]);
+        assert_eq!((back[1].1, back[1].2.clone()), ([2, 3], vec![1.0, 2.0, 3.0, 4.0, 5.0, 6.0]));
+        assert_eq!(back[2].2, vec![0.0, 255.0, 7.0, 9.0]);
+    }
+
+    #[test]
+    fn npz_errors_name_file_and_problem() {
+        let d = dir();
+        // truncated archive: cut a valid one in half
+        let good = d.join("good.npz");
+        let v = values(40 * 30, 3);
+        stage_npz(&good, 40, 30, &[("x", &v)]).unwrap().commit().unwrap();
+        let bytes = std::fs::read(&good).unwrap();
+        let cut = d.join("cut.npz");
+        std::fs::write(&cut, &bytes[..bytes.len() / 2]).unwrap();
+        let e = read_npz(&cut).unwrap_err().to_string();
+        assert!(e.contains("cut.npz") && e.contains("zip"), "{e}");
+        // a member whose .npy data is short
+        let data: Vec<u8> = [1.0f64, 2.0, 3.0].iter().flat_map(|v| v.to_le_bytes()).collect();
+        let short = d.join("short.npz");
+        zip_of(&short, &[("s.npy", npy_bytes("<f8", false, "(2, 3)", &data))], zip::CompressionMethod::Deflated);
+        let e = read_npz(&short).unwrap_err().to_string();
+        assert!(e.contains("short.npz") && e.contains("`s`"), "{e}");
+        // not 2D
+        let one = d.join("one.npz");
+        zip_of(&one, &[("v.npy", npy_bytes("<f8", false, "(3,)", &data))], zip::CompressionMethod::Stored);
+        let e = read_npz(&one).unwrap_err().to_string();
+        assert!(e.contains("2D") && e.contains("`v`"), "{e}");
+        // unsupported dtype
+        let c = d.join("complex.npz");
+        zip_of(&c, &[("z.npy", npy_bytes("<c16", false, "(1, 1)", &[0; 16]))], zip::CompressionMethod::Stored);
+        let e = read_npz(&c).unwrap_err().to_string();
+        assert!(e.contains("dtype"), "{e}");
+        // no arrays, not a zip, missing file
+        let none = d.join("none.npz");
+        zip_of(&none, &[("a.txt", b"x".to_vec())], zip::CompressionMethod::Stored);
+        assert!(read_npz(&none).unwrap_err().to_string().contains("no .npy arrays"));
+        let junk = d.join("junk.npz");
+        std::fs::write(&junk, b"not a zip at all").unwrap();
+        assert!(read_npz(&junk).unwrap_err().to_string().contains("junk.npz"));
+        let e = read_npz(&d.join("missing.npz")).unwrap_err();
+        assert!(matches!(e, Error::Io { .. }) && e.to_string().contains("missing.npz"), "{e}");
+    }
+}

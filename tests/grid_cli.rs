@@ -1,0 +1,311 @@
+//! The command-line tool on grids: the bundled measured and simulated fields, every output
+//! format, `verify`, and the input errors of the grid readers.
+
+mod common;
+
+use common::{grid_extrema, scratch};
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+use toposmooth::io::npz::read_npz;
+
+fn toposmooth(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_toposmooth")).args(args).output().expect("runs")
+}
+
+fn dataset(name: &str) -> String {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("datasets").join(name).display().to_string()
+}
+
+fn text(o: &Output) -> String {
+    format!("{}{}", String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr))
+}
+
+fn path(dir: &Path, name: &str) -> String {
+    dir.join(name).display().to_string()
+}
+
+/// A CSV matrix as numbers (NaN kept).
+fn read_matrix(p: &str) -> (usize, Vec<f64>) {
+    let text = std::fs::read_to_string(p).unwrap();
+    let rows: Vec<Vec<f64>> = text
+        .lines()
+        .filter(|l| !l.trim().is_empty())
+        .map(|l| l.split(',').map(|c| c.trim().parse().unwrap()).collect())
+        .collect();
+    (rows[0].len(), rows.concat())
+}
+
+/// The arrays of an .npz output by name.
+fn npz(p: &str) -> std::collections::HashMap<String, ([usize; 2], Vec<f64>)> {
+    read_npz(Path::new(p)).unwrap().into_iter().map(|(n, s, v)| (n, (s, v))).collect()
+}
+
+/// Checks an .npz output with the independent counter: exactly the kept extrema, no flat
+/// vertex, kept values equal to the input. Returns (kept minima, kept maxima).
+fn check_output(p: &str) -> (usize, usize) {
+    let a = npz(p);
+    let ([ny, nx], f) = &a["smoothed"];
+    let (input, role) = (&a["input"].1, &a["role"].1);
+    let (mins, maxs, flat) = grid_extrema(*nx, *ny, f);
+    assert!(flat.is_empty(), "flat vertices {flat:?}");
+    assert_eq!(mins, (0..nx * ny).filter(|&v| role[v] == -1.0).collect::<Vec<_>>());
+    assert_eq!(maxs, (0..nx * ny).filter(|&v| role[v] == 1.0).collect::<Vec<_>>());
+    for &v in mins.iter().chain(&maxs) {
+        assert_eq!(f[v].to_bits(), input[v].to_bits());
+    }
+    (mins.len(), maxs.len())
+}
+
+#[test]
+fn piv_vorticity_with_holes_keeps_nine_minima_and_four_maxima() {
+    let dir = scratch("piv");
+    let piv = dataset("soapfilm_piv_vorticity_63x63.csv");
+    // holes are refused by default, naming the file and the first cells
+    let o = toposmooth(&["smooth", &piv, "-o", &path(&dir, "refused.vti"), "--minima", "9", "--maxima", "4"]);
+    assert_eq!(o.status.code(), Some(3), "{}", text(&o));
+    assert!(
+        text(&o).contains("soapfilm_piv_vorticity_63x63.csv") && text(&o).contains("774 missing (NaN)"),
+        "{}",
+        text(&o)
+    );
+    assert!(!dir.join("refused.vti").exists());
+
+    let (vti, npz_out, vtp, png, json) = (
+        path(&dir, "piv.vti"),
+        path(&dir, "piv.npz"),
+        path(&dir, "piv.vtp"),
+        path(&dir, "piv.png"),
+        path(&dir, "run.json"),
+    );
+    let common = ["--fill-missing", "--minima", "9", "--maxima", "4", "--spacing", "0.31248,-0.31248"];
+    let mut args =
+        vec!["smooth", piv.as_str(), "-o", vti.as_str(), "--complex", &vtp, "--plot", &png, "--report", &json];
+    args.extend(common);
+    let o = toposmooth(&args);
+    assert!(o.status.success(), "{}", text(&o));
+    assert!(text(&o).contains("774 missing samples filled"), "{}", text(&o));
+    let v = toposmooth(&["verify", &vti]);
+    assert_eq!(v.status.code(), Some(0), "{}", text(&v));
+    for f in [&vtp, &png] {
+        assert!(std::fs::metadata(f).unwrap().len() > 1000, "{f}");
+    }
+    let r: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    assert_eq!(r["filled_missing"], 774);
+    assert_eq!(r["certificate"]["passed"], true);
+    assert!(r["saddles"].as_u64().unwrap() >= 1);
+
+    let mut args = vec!["smooth", piv.as_str(), "-o", npz_out.as_str()];
+    args.extend(common);
+    assert!(toposmooth(&args).status.success());
+    assert_eq!(check_output(&npz_out), (9, 4));
+    // the filled input keeps every measured value bit for bit
+    let (_, raw) = read_matrix(&piv);
+    let input = &npz(&npz_out)["input"].1;
+    assert!(raw.iter().zip(input).all(|(a, b)| a.is_nan() || a.to_bits() == b.to_bits()));
+    let v = toposmooth(&["verify", &npz_out, "--input", &piv, "--fill-missing", "--spacing", "0.31248,-0.31248"]);
+    assert_eq!(v.status.code(), Some(0), "{}", text(&v));
+}
+
+#[test]
+fn derived_vorticity_matches_the_bundled_fields() {
+    // PIV: u and v on a grid whose rows run downwards
+    let dir = scratch("derive");
+    let out = path(&dir, "w.npz");
+    let (u, v) = (dataset("soapfilm_piv_u_63x63.csv"), dataset("soapfilm_piv_v_63x63.csv"));
+    let o = toposmooth(&[
+        "smooth",
+        "--u",
+        &u,
+        "--v",
+        &v,
+        "--derive",
+        "vorticity",
+        "--spacing",
+        "0.31248,-0.31248",
+        "--fill-missing",
+        "-o",
+        &out,
+        "--minima",
+        "9",
+        "--maxima",
+        "4",
+    ]);
+    assert!(o.status.success(), "{}", text(&o));
+    let (_, reference) = read_matrix(&dataset("soapfilm_piv_vorticity_63x63.csv"));
+    let a = npz(&out);
+    let (input, filled) = (&a["input"].1, &a["filled"].1);
+    let mut compared = 0;
+    for i in 0..reference.len() {
+        assert_eq!(reference[i].is_nan(), filled[i] == 1.0, "NaN spreads through the stencil as numpy's does: {i}");
+        if reference[i].is_finite() {
+            // u and v carry 6 decimals (±5e-7 m/s): a central difference over 0.625 mm
+            // carries ±1.6e-6 (m/s)/mm; the vorticity itself reaches about 0.1
+            assert!((input[i] - reference[i]).abs() <= 2e-6, "{i}: {} vs {}", input[i], reference[i]);
+            compared += 1;
+        }
+    }
+    assert_eq!(compared, 3195);
+
+    // the Kármán vortex street: a 3-component vector array in an appended, zlib-compressed .vti
+    let out = path(&dir, "karman.npz");
+    let vti = dataset("karman_vortex_street_ttk_example1.vti");
+    let o = toposmooth(&["smooth", &vti, "--derive", "vorticity", "--persistence", "5%", "-o", &out]);
+    assert!(o.status.success(), "{}", text(&o));
+    let (nx, reference) = read_matrix(&dataset("karman_vortex_street_vorticity_65x513.csv"));
+    assert_eq!(nx, 513);
+    let a = npz(&out);
+    assert_eq!(a["input"].0, [65, 513]);
+    // the reference went through a text round trip with 6 significant digits
+    let worst = a["input"].1.iter().zip(&reference).map(|(w, r)| (w - r).abs()).fold(0.0, f64::max);
+    assert!(worst < 1e-6, "largest difference {worst} (vorticity range about 1.6)");
+    let (kmin, kmax) = check_output(&out);
+    assert!(kmin >= 5 && kmax >= 5, "the vortices survive: {kmin} minima, {kmax} maxima");
+}
+
+#[test]
+fn elevation_formats_and_representatives() {
+    let dir = scratch("volcano");
+    let volcano = dataset("volcano_maunga_whau_61x87.csv");
+    let (nx, h) = read_matrix(&volcano);
+    let ny = h.len() / nx;
+    let mut rms = Vec::new();
+    for rep in ["separatrix", "harmonic"] {
+        let (npz_out, json) = (path(&dir, &format!("{rep}.npz")), path(&dir, &format!("{rep}.json")));
+        let o = toposmooth(&[
+            "smooth",
+            &volcano,
+            "-o",
+            &npz_out,
+            "--persistence",
+            "3%",
+            "--representative",
+            rep,
+            "--report",
+            &json,
+            "--spacing",
+            "10,10",
+        ]);
+        assert!(o.status.success(), "{}", text(&o));
+        check_output(&npz_out);
+        let r: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+        assert!(r["representative"].as_str().unwrap().starts_with(rep), "{}", r["representative"]);
+        rms.push(r["rms_deviation"].as_f64().unwrap());
+    }
+    assert!(rms.iter().all(|r| *r > 0.0 && *r < 5.0), "{rms:?}");
+    // single-array exports hold the same smoothed values
+    let (npy, csv) = (path(&dir, "s.npy"), path(&dir, "s.csv"));
+    for out in [&npy, &csv] {
+        let o = toposmooth(&["smooth", &volcano, "-o", out, "--persistence", "3%", "--spacing", "10,10"]);
+        assert!(o.status.success(), "{}", text(&o));
+    }
+    let smoothed = &npz(&path(&dir, "separatrix.npz"))["smoothed"].1;
+    let (cnx, from_csv) = read_matrix(&csv);
+    assert_eq!((cnx, from_csv.len()), (nx, nx * ny));
+    assert!(from_csv.iter().zip(smoothed).all(|(a, b)| a.to_bits() == b.to_bits()));
+    let bytes = std::fs::read(&npy).unwrap();
+    let arr = npyz::NpyFile::new(&bytes[..]).unwrap();
+    assert_eq!(arr.shape(), &[ny as u64, nx as u64]);
+    assert!(arr.into_vec::<f64>().unwrap().iter().zip(smoothed).all(|(a, b)| a.to_bits() == b.to_bits()));
+    // .npy exports are not verifiable alone
+    assert_eq!(toposmooth(&["verify", &npy]).status.code(), Some(2));
+}
+
+#[test]
+fn verify_catches_a_tampered_grid_output() {
+    let dir = scratch("tamper");
+    let retina = dataset("retina_microaneurysms_102x102.csv");
+    let out = path(&dir, "r.npz");
+    let o = toposmooth(&["smooth", &retina, "-o", &out, "--persistence", "10%"]);
+    assert!(o.status.success(), "{}", text(&o));
+    assert_eq!(toposmooth(&["verify", &out, "--input", &retina]).status.code(), Some(0));
+    let a = npz(&out);
+    let ([ny, nx], f) = a["smoothed"].clone();
+    let role = &a["role"].1;
+    // raise one free interior vertex above all its neighbours: a spurious maximum
+    let v = (nx + 1..nx * ny - nx - 1).find(|&v| role[v] == 0.0 && v % nx != 0 && v % nx != nx - 1).unwrap();
+    let mut g = f.clone();
+    g[v] = f.iter().cloned().fold(f64::MIN, f64::max) + 1.0;
+    let names = ["input", "smoothed", "representative", "role"];
+    let arrays: Vec<(&str, &[f64])> =
+        names.iter().map(|&n| (n, if n == "smoothed" { &g[..] } else { &a[n].1[..] })).collect();
+    let bad = path(&dir, "bad.npz");
+    toposmooth::io::npz::stage_npz(Path::new(&bad), ny, nx, &arrays).unwrap().commit().unwrap();
+    let o = toposmooth(&["verify", &bad]);
+    assert_eq!(o.status.code(), Some(1), "{}", text(&o));
+    assert!(text(&o).contains("NOT certified"), "{}", text(&o));
+}
+
+#[test]
+fn extrema_lists_grid_extrema_from_every_reader() {
+    let dir = scratch("extrema");
+    let volcano = dataset("volcano_maunga_whau_61x87.csv");
+    let o = toposmooth(&["extrema", &volcano, "--json", "--plot", &path(&dir, "d.png")]);
+    assert!(o.status.success(), "{}", text(&o));
+    let j: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let (nx, h) = read_matrix(&volcano);
+    let (mins, maxs, _) = grid_extrema(nx, h.len() / nx, &h);
+    assert_eq!(j["grid"], serde_json::json!([87, 61]));
+    assert_eq!(j["strict_minima"].as_u64().unwrap() as usize, mins.len());
+    assert_eq!(j["strict_maxima"].as_u64().unwrap() as usize, maxs.len());
+    // the same field as .npy (written by the tool) lists the same extrema
+    let npy = path(&dir, "v.npy");
+    let npz_out = path(&dir, "v.npz");
+    assert!(toposmooth(&["smooth", &volcano, "-o", &npz_out]).status.success());
+    let input = npz(&npz_out)["input"].1.clone();
+    toposmooth::io::npz::stage_npy(Path::new(&npy), h.len() / nx, nx, &input).unwrap().commit().unwrap();
+    let o2 = toposmooth(&["extrema", &npy, "--json"]);
+    let j2: serde_json::Value = serde_json::from_slice(&o2.stdout).unwrap();
+    assert_eq!(j2["extrema"], j["extrema"]);
+}
+
+fn write(dir: &Path, name: &str, content: &[u8]) -> PathBuf {
+    let p = dir.join(name);
+    std::fs::write(&p, content).unwrap();
+    p
+}
+
+#[test]
+fn grid_reader_errors_name_the_file_and_the_problem() {
+    let dir = scratch("readers");
+    let vti = std::fs::read(dataset("karman_vortex_street_ttk_example1.vti")).unwrap();
+    let cases: Vec<(PathBuf, Vec<&str>, &str)> = vec![
+        (write(&dir, "truncated.vti", &vti[..vti.len() / 2]), vec!["--derive", "vorticity"], "truncated.vti"),
+        (write(&dir, "ragged.csv", b"1,2,3\n4,5\n"), vec![], "line 2"),
+        (write(&dir, "text.csv", b"1,2,3\n4,x,6\n"), vec![], "not a number"),
+        (write(&dir, "nan.csv", b"1,2,3\n4,NaN,6\n7,8,9\n"), vec![], "1 missing (NaN)"),
+        (write(&dir, "one-row.csv", b"1,2,3\n"), vec![], "at least 2"),
+        (write(&dir, "empty.npy", b""), vec![], "empty.npy"),
+    ];
+    for (file, extra, needle) in cases {
+        let f = file.display().to_string();
+        let mut args = vec!["extrema", f.as_str()];
+        args.extend(extra);
+        let o = toposmooth(&args);
+        assert_eq!(o.status.code(), Some(3), "{f}: {}", text(&o));
+        assert!(
+            text(&o).contains(needle) && text(&o).contains(file.file_name().unwrap().to_str().unwrap()),
+            "{f}: {}",
+            text(&o)
+        );
+    }
+    // a wrong array name lists the arrays there are
+    let karman = dataset("karman_vortex_street_ttk_example1.vti");
+    let o = toposmooth(&["extrema", &karman, "--array", "pressure"]);
+    assert_eq!(o.status.code(), Some(3), "{}", text(&o));
+    assert!(text(&o).contains("Vectors_"), "{}", text(&o));
+    // a vector array without --derive
+    let o = toposmooth(&["extrema", &karman]);
+    assert_eq!(o.status.code(), Some(3), "{}", text(&o));
+    // an unknown compressor
+    let s = String::from_utf8_lossy(&vti).replace("vtkZLibDataCompressor", "vtkMadeUpCompressor");
+    let f = write(&dir, "compressor.vti", s.as_bytes()).display().to_string();
+    let o = toposmooth(&["extrema", &f, "--derive", "vorticity"]);
+    assert_eq!(o.status.code(), Some(3), "{}", text(&o));
+    assert!(text(&o).contains("compressor.vti") && text(&o).contains("vtkMadeUpCompressor"), "{}", text(&o));
+    // wrong sizes: the extent says more points than the data holds
+    let s = String::from_utf8_lossy(&vti).replace("0 512 0 64 0 0", "0 600 0 64 0 0");
+    let f = write(&dir, "extent.vti", s.as_bytes()).display().to_string();
+    let o = toposmooth(&["extrema", &f, "--derive", "vorticity"]);
+    assert_eq!(o.status.code(), Some(3), "{}", text(&o));
+    assert!(text(&o).contains("extent.vti"), "{}", text(&o));
+}

@@ -191,6 +191,7 @@ impl CsvArgs {
 enum Solver {
     Structured,
     Clarabel,
+    ClarabelAuxiliary,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -284,6 +285,7 @@ fn method(s: Solver) -> Method {
     match s {
         Solver::Structured => Method::Structured,
         Solver::Clarabel => Method::Clarabel,
+        Solver::ClarabelAuxiliary => Method::ClarabelAuxiliary,
     }
 }
 

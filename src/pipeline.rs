@@ -457,7 +457,19 @@ pub fn smooth<D: Smoothable>(domain: &D, h: &[f64], settings: &SmoothSettings) -
     let t = Instant::now();
     let hint: Vec<f64> = u.iter().map(|v| (v - lo) / range).collect();
     let u_margin = edges.iter().map(|&(i, j)| u[j] - u[i]).fold(f64::INFINITY, f64::min);
-    let qp = MonotoneQp { p: &p, q: &q, fixed: &fixed, edges: &edges, margin: eps, hint: Some(&hint) };
+    let factor = match settings.qp.method {
+        Method::ClarabelAuxiliary => Some(energy_factor(&k, &m, &settings.energy, &weights, &q_energy)?),
+        _ => None,
+    };
+    let qp = MonotoneQp {
+        p: &p,
+        q: &q,
+        fixed: &fixed,
+        edges: &edges,
+        margin: eps,
+        hint: Some(&hint),
+        factored: factor.as_ref().map(|f| (f, &data_diag[..])),
+    };
     let sol = solve_monotone_qp(&qp, &settings.qp)?;
     seconds.solve = t.elapsed().as_secs_f64();
 
@@ -527,6 +539,45 @@ pub fn smooth<D: Smoothable>(domain: &D, h: &[f64], settings: &SmoothSettings) -
         certificate,
     };
     Ok(Smoothed { output: f, u, roles: kept.roles, report, complex })
+}
+
+/// `F` with `FᵀF` equal to the energy matrix, for the appendix formulation: order 2 only,
+/// `F = √γ M^{−1/2} K` (checked against `q_energy` on a test vector).
+fn energy_factor(k: &Sparse, m: &[f64], energy: &Energy, weights: &[f64], q_energy: &Sparse) -> Result<Sparse> {
+    if energy.terms.len() != 1 || energy.terms[0].0 != 2 || !energy.sharp.is_empty() {
+        return Err(Error::Usage(
+            "--solver clarabel-auxiliary supports a single order-2 energy without --sharp".into(),
+        ));
+    }
+    let w = weights[0] * energy.terms[0].1;
+    let mut triplets = Vec::new();
+    let (cp, ri, val) = (k.symbolic().col_ptr(), k.symbolic().row_idx(), k.val());
+    for j in 0..k.ncols() {
+        for p in cp[j]..cp[j + 1] {
+            triplets.push(faer::sparse::Triplet::new(ri[p], j, (w / m[ri[p]]).sqrt() * val[p]));
+        }
+    }
+    let f = Sparse::try_new_from_triplets(k.nrows(), k.ncols(), &triplets)
+        .map_err(|e| Error::input(format!("energy factor: {e:?}")))?;
+    let x: Vec<f64> = (0..k.ncols()).map(|i| ((i * 7919) % 101) as f64 / 101.0).collect();
+    let fx: Vec<f64> = {
+        let mut y = vec![0.0; f.nrows()];
+        let (cp, ri, val) = (f.symbolic().col_ptr(), f.symbolic().row_idx(), f.val());
+        for j in 0..f.ncols() {
+            for p in cp[j]..cp[j + 1] {
+                y[ri[p]] += val[p] * x[j];
+            }
+        }
+        y
+    };
+    let (a, b) = (fx.iter().map(|v| v * v).sum::<f64>(), quadratic_form(q_energy, &x));
+    if (a - b).abs() > 1e-8 * b.abs().max(1e-300) {
+        return Err(Error::Representative {
+            path: None,
+            message: format!("internal error: FᵀF differs from the energy matrix ({a} vs {b})"),
+        });
+    }
+    Ok(f)
 }
 
 /// Two adjacent fixed vertices of different roles must differ in value (SPEC.md).

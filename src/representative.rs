@@ -237,10 +237,17 @@ pub fn separatrix_representative<D: crate::domain::Domain>(
     let mut released = vec![false; n];
     let mut gone = vec![false; separatrices.len()];
     let mut count = 0;
-    for _ in 0..64 {
+    for _ in 0..MAX_RELEASE_ROUNDS {
         let fixed: Vec<Option<f64>> = (0..n).map(|v| if released[v] { None } else { prescribed[v] }).collect();
         let u = crate::operators::dirichlet_solve(k, &fixed)?;
-        let bad: Vec<usize> = (0..n).filter(|&v| kept.roles[v] == Role::Other && !is_regular(domain, &u, v)).collect();
+        let bad: Vec<usize> = (0..n)
+            .filter(|&v| match kept.roles[v] {
+                Role::Other => !is_regular(domain, &u, v),
+                Role::Min => domain.neighbors(v).any(|w| u[w] <= u[v]),
+                Role::Max => domain.neighbors(v).any(|w| u[w] >= u[v]),
+                _ => false,
+            })
+            .collect();
         let mut progress = false;
         let release = |w: usize, released: &mut Vec<bool>, count: &mut usize| {
             if fixed[w].is_some() && !kept.roles[w].is_fixed() && !released[w] {
@@ -276,8 +283,12 @@ pub fn separatrix_representative<D: crate::domain::Domain>(
             return Ok((u, count));
         }
     }
-    Err("separatrix vertices still contradict each other after 64 rounds of releasing them".into())
+    Err(format!("separatrix vertices still contradict each other after {MAX_RELEASE_ROUNDS} rounds of releasing them"))
 }
+
+/// Rounds of releasing contradicting separatrices (each one harmonic solve) before the
+/// caller falls back to another representative.
+const MAX_RELEASE_ROUNDS: usize = 6;
 
 fn is_regular<D: crate::domain::Domain>(domain: &D, u: &[f64], v: usize) -> bool {
     let (mut lower, mut higher) = (false, false);

@@ -166,3 +166,36 @@ fn a_global_maximum_on_the_boundary_is_kept_there() {
     assert_eq!(maxs, vec![gmax]);
     assert!(mins.iter().any(|&v| (v % nx).abs_diff(7) <= 1 && (v / nx).abs_diff(8) <= 1), "the pit: {mins:?}");
 }
+
+/// The paper's appendix formulation (auxiliary variables t = F f, Clarabel) reaches the same
+/// optimum as the plain P = FᵀF (the default solver and Clarabel).
+#[test]
+fn appendix_formulation_reaches_the_same_optimum() {
+    use toposmooth::solve::{Method, QpSettings};
+    let (nx, ny) = (14, 11);
+    let g = Grid2d::new(nx, ny).unwrap();
+    let h = bumps(nx, ny, 0.1, 17);
+    let run = |method| {
+        let settings = SmoothSettings {
+            selection: Selection::Relative(0.2),
+            qp: QpSettings { method, ..Default::default() },
+            ..Default::default()
+        };
+        smooth(&g, &h, &settings).unwrap()
+    };
+    let (a, b, c) = (run(Method::Structured), run(Method::Clarabel), run(Method::ClarabelAuxiliary));
+    assert_eq!(c.report.solver, Method::ClarabelAuxiliary);
+    for (x, y) in [(&a, &c), (&b, &c)] {
+        let rel = (x.report.energy.total - y.report.energy.total).abs() / x.report.energy.total;
+        assert!(rel < 1e-5, "objectives {} vs {}", x.report.energy.total, y.report.energy.total);
+        let worst = x.output.iter().zip(&y.output).map(|(p, q)| (p - q).abs()).fold(0.0, f64::max);
+        assert!(worst < 1e-4, "outputs differ by {worst}");
+    }
+    // blends are not factored: a usage error, not a silent switch
+    let settings = SmoothSettings {
+        energy: toposmooth::operators::Energy::parse("1:1,2:1").unwrap(),
+        qp: QpSettings { method: Method::ClarabelAuxiliary, ..Default::default() },
+        ..Default::default()
+    };
+    assert_eq!(smooth(&g, &h, &settings).unwrap_err().exit_code(), 2);
+}

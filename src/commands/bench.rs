@@ -190,7 +190,14 @@ pub fn bench(args: &BenchArgs) -> Result<String> {
             .args(["bench", "--single", &case.label(), "--order", &order, "--seed", &args.seed.to_string()])
             .args(["--persistence", &format!("{}%", args.persistence * 100.0)])
             .args(["--edges", if args.edges == EdgeSet::All { "all" } else { "minimal" }])
-            .args(["--solver", if args.method == Method::Clarabel { "clarabel" } else { "structured" }])
+            .args([
+                "--solver",
+                match args.method {
+                    Method::Clarabel => "clarabel",
+                    Method::ClarabelAuxiliary => "clarabel-auxiliary",
+                    Method::Structured => "structured",
+                },
+            ])
             .output()
             .map_err(|source| Error::Io { path: exe.clone(), source })?;
         if !child.status.success() {

@@ -68,7 +68,7 @@ pub fn read_grid_csv(path: &Path) -> Result<GridField> {
         return Err(err(path, "the file holds no grid rows".into()));
     }
     let ny = rows.len();
-    finish(path, nx, ny, rows.concat(), "csv".into())
+    finish(path, nx, ny, rows.concat(), "values".into())
 }
 
 /// Reads a 2D NumPy array of shape `(ny, nx)` (C or Fortran order; float, integer or bool).
@@ -112,7 +112,7 @@ pub fn read_npy(path: &Path) -> Result<GridField> {
         // Fortran order stores column by column: element (r, c) sits at c·ny + r
         Order::Fortran => (0..ny * nx).map(|k| values[(k % nx) * ny + k / nx]).collect(),
     };
-    finish(path, nx, ny, values, "npy".into())
+    finish(path, nx, ny, values, "values".into())
 }
 
 /// Reads a grayscale raster: PNG (8/16-bit, via `image`) or TIFF (8/16/32-bit integers and

@@ -19,6 +19,9 @@ pub struct MonotoneQp<'a> {
     /// A point that satisfies every constraint (the representative u), `#V`, if known: the
     /// structured solver starts there.
     pub hint: Option<&'a [f64]>,
+    /// `P = FᵀF + diag(d)` as `(F, d)`, for [`Method::ClarabelAuxiliary`] (the paper's
+    /// appendix: auxiliary variables `t = F f` make the quadratic part the identity).
+    pub factored: Option<(&'a Sparse, &'a [f64])>,
 }
 
 /// Which interior-point solver runs.
@@ -30,6 +33,10 @@ pub enum Method {
     Structured,
     /// Clarabel on the full KKT system.
     Clarabel,
+    /// Clarabel on the paper's appendix formulation: variables `(f, t)` with `t = F f` as
+    /// equality constraints and `P = diag(d) ⊕ I` (needs [`MonotoneQp::factored`]).
+    #[serde(rename = "clarabel-auxiliary")]
+    ClarabelAuxiliary,
 }
 
 /// Solver settings.
@@ -96,6 +103,8 @@ pub struct ReducedQp {
     pub a_val: Vec<f64>,
     /// Right-hand side, one per row.
     pub b: Vec<f64>,
+    /// The factor the objective was divided by.
+    pub scale: f64,
 }
 
 impl ReducedQp {
@@ -140,6 +149,13 @@ pub fn solve_monotone_qp(qp: &MonotoneQp<'_>, settings: &QpSettings) -> Result<Q
             let (xf, status, it) = super::clarabel::solve(&reduced, settings)?;
             (xf, status, it, Method::Clarabel)
         }
+        Method::ClarabelAuxiliary => {
+            let Some((f, d)) = qp.factored else {
+                return Err(crate::Error::Usage("the auxiliary formulation needs P given as FᵀF + diag(d)".into()));
+            };
+            let (xf, status, it) = super::clarabel::solve_auxiliary(&reduced, f, d, qp, &free, settings)?;
+            (xf, status, it, Method::ClarabelAuxiliary)
+        }
     };
     for (k, &i) in free.iter().enumerate() {
         x[i] = xf[k];
@@ -175,7 +191,7 @@ fn reduce(qp: &MonotoneQp<'_>, free: &[usize]) -> ReducedQp {
     p.iter_mut().for_each(|t| t.2 /= scale);
     q.iter_mut().for_each(|v| *v /= scale);
     // f_j − f_i ≥ ε  ⇔  f_i − f_j ≤ −ε
-    let mut r = ReducedQp { n: nf, p, q, a_row: vec![], a_col: vec![], a_val: vec![], b: vec![] };
+    let mut r = ReducedQp { n: nf, p, q, a_row: vec![], a_col: vec![], a_val: vec![], b: vec![], scale };
     for &(i, j) in qp.edges {
         let row = r.b.len();
         let mut push = |col: usize, v: f64| {
@@ -218,7 +234,7 @@ mod tests {
         let edges = [(0, 1), (1, 2), (2, 3)];
         for method in [Method::Structured, Method::Clarabel] {
             for hint in [None, Some(&[0.0, 1.0, 2.0, 3.0][..])] {
-                let qp = MonotoneQp { p: &p, q: &q, fixed: &fixed, edges: &edges, margin: 1e-6, hint };
+                let qp = MonotoneQp { p: &p, q: &q, fixed: &fixed, edges: &edges, margin: 1e-6, hint, factored: None };
                 let sol = solve_monotone_qp(&qp, &QpSettings { method, ..Default::default() }).unwrap();
                 assert_eq!(sol.method, method, "{:?}", sol.fallback);
                 assert!(matches!(sol.status, SolveStatus::Solved | SolveStatus::AlmostSolved));

@@ -160,15 +160,22 @@ impl DiscreteGradient {
         match cell {
             Cell::Edge(e) => [self.rank[self.other(e, v) as usize], 0],
             Cell::Triangle(t) => {
-                let mut r: Vec<u32> =
-                    self.triangles[t as usize].iter().filter(|&&w| w != v).map(|&w| self.rank[w as usize]).collect();
-                r.sort_unstable_by(|a, b| b.cmp(a));
-                [r[0], r[1] + 1]
+                let mut r = [0u32; 2];
+                let mut k = 0;
+                for &w in &self.triangles[t as usize] {
+                    if w != v && k < 2 {
+                        r[k] = self.rank[w as usize];
+                        k += 1;
+                    }
+                }
+                [r[0].max(r[1]), r[0].min(r[1]) + 1]
             }
         }
     }
 
     fn process_lower_star(&mut self, v: u32) {
+        use std::cmp::Reverse;
+        use std::collections::BinaryHeap;
         let rv = self.rank[v as usize];
         let lower_edges: Vec<u32> = self.vertex_edges[v as usize]
             .iter()
@@ -179,22 +186,23 @@ impl DiscreteGradient {
             self.vertex_pair[v as usize] = Pair::Critical;
             return;
         }
-        let in_star = |g: &Self, t: u32| g.triangles[t as usize].iter().all(|&w| g.rank[w as usize] <= rv);
-        let mut lower_triangles: Vec<u32> = Vec::new();
-        for &e in &lower_edges {
-            for &t in &self.edge_triangles[e as usize] {
-                if in_star(self, t) && !lower_triangles.contains(&t) {
-                    lower_triangles.push(t);
-                }
+        // the edge from v to w (a cone's star is a whole boundary loop: look it up by hash)
+        let by_other: Option<HashMap<u32, u32>> =
+            (lower_edges.len() > 16).then(|| lower_edges.iter().map(|&e| (self.other(e, v), e)).collect());
+        let edge_to = |g: &Self, w: u32| -> u32 {
+            match &by_other {
+                Some(m) => m[&w],
+                None => *lower_edges.iter().find(|&&e| g.other(e, v) == w).expect("a lower edge"),
             }
-        }
+        };
+        let in_star = |g: &Self, t: u32| g.triangles[t as usize].iter().all(|&w| g.rank[w as usize] <= rv);
         // faces of a lower-star triangle inside the lower star: its two edges at v
         let faces = |g: &Self, t: u32| -> [u32; 2] {
             let mut f = [0u32; 2];
             let mut k = 0;
-            for &e in &lower_edges {
-                if g.edge_triangles[e as usize].contains(&t) {
-                    f[k] = e;
+            for &w in &g.triangles[t as usize] {
+                if w != v && k < 2 {
+                    f[k] = edge_to(g, w);
                     k += 1;
                 }
             }
@@ -202,63 +210,60 @@ impl DiscreteGradient {
         };
         let unpaired_faces =
             |g: &Self, t: u32| faces(g, t).iter().filter(|&&e| g.edge_pair[e as usize] == Pair::None).count();
+        let mut lower_triangles: Vec<u32> = Vec::new();
+        for &e in &lower_edges {
+            for &t in &self.edge_triangles[e as usize] {
+                if in_star(self, t) {
+                    lower_triangles.push(t);
+                }
+            }
+        }
+        lower_triangles.sort_unstable();
+        lower_triangles.dedup();
+        // cells keyed by the ranks of their other vertices, descending (edges before the
+        // triangles that contain them); both queues drop stale entries when popped
+        type Entry = Reverse<([u32; 2], u8, u32)>;
+        let edge_entry = |g: &Self, e: u32| -> Entry { Reverse((g.key(Cell::Edge(e), v), 0, e)) };
+        let triangle_entry = |g: &Self, t: u32| -> Entry { Reverse((g.key(Cell::Triangle(t), v), 1, t)) };
+        // lower-star triangles with face e and one unpaired face go to the first queue
+        let ready = |g: &Self, e: u32, pq_one: &mut BinaryHeap<Entry>| {
+            for &t in &g.edge_triangles[e as usize] {
+                if in_star(g, t) && g.triangle_pair[t as usize] == Pair::None && unpaired_faces(g, t) == 1 {
+                    pq_one.push(triangle_entry(g, t));
+                }
+            }
+        };
         let delta = *lower_edges.iter().min_by_key(|&&e| self.key(Cell::Edge(e), v)).expect("non-empty");
         self.vertex_pair[v as usize] = Pair::Cell(delta);
         self.edge_pair[delta as usize] = Pair::Cell(v);
-        let mut pq_zero: Vec<Cell> = lower_edges.iter().filter(|&&e| e != delta).map(|&e| Cell::Edge(e)).collect();
-        let mut pq_one: Vec<u32> = lower_triangles
-            .iter()
-            .copied()
-            .filter(|&t| faces(self, t).contains(&delta) && unpaired_faces(self, t) == 1)
-            .collect();
+        let mut pq_zero: BinaryHeap<Entry> =
+            lower_edges.iter().filter(|&&e| e != delta).map(|&e| edge_entry(self, e)).collect();
+        let mut pq_one: BinaryHeap<Entry> = BinaryHeap::new();
+        ready(self, delta, &mut pq_one);
         loop {
-            while let Some(k) = (0..pq_one.len()).min_by_key(|&k| self.key(Cell::Triangle(pq_one[k]), v)) {
-                let alpha = pq_one.swap_remove(k);
+            while let Some(Reverse((_, _, alpha))) = pq_one.pop() {
                 if self.triangle_pair[alpha as usize] != Pair::None {
                     continue;
                 }
                 if unpaired_faces(self, alpha) == 0 {
-                    pq_zero.push(Cell::Triangle(alpha));
+                    pq_zero.push(triangle_entry(self, alpha));
                     continue;
                 }
                 let lower =
                     *faces(self, alpha).iter().find(|&&e| self.edge_pair[e as usize] == Pair::None).expect("one");
                 self.edge_pair[lower as usize] = Pair::Cell(alpha);
                 self.triangle_pair[alpha as usize] = Pair::Cell(lower);
-                pq_zero.retain(|c| *c != Cell::Edge(lower));
-                for &t in &lower_triangles {
-                    if self.triangle_pair[t as usize] == Pair::None
-                        && (faces(self, t).contains(&lower))
-                        && unpaired_faces(self, t) == 1
-                        && !pq_one.contains(&t)
-                    {
-                        pq_one.push(t);
-                    }
-                }
+                ready(self, lower, &mut pq_one);
             }
-            let Some(k) = (0..pq_zero.len()).min_by_key(|&k| self.key(pq_zero[k], v)) else { break };
-            let gamma = pq_zero.swap_remove(k);
-            match gamma {
-                Cell::Edge(e) => {
-                    if self.edge_pair[e as usize] != Pair::None {
-                        continue;
-                    }
-                    self.edge_pair[e as usize] = Pair::Critical;
-                    for &t in &lower_triangles {
-                        if self.triangle_pair[t as usize] == Pair::None
-                            && faces(self, t).contains(&e)
-                            && unpaired_faces(self, t) == 1
-                            && !pq_one.contains(&t)
-                        {
-                            pq_one.push(t);
-                        }
-                    }
+            let Some(Reverse((_, kind, id))) = pq_zero.pop() else { break };
+            if kind == 0 {
+                if self.edge_pair[id as usize] != Pair::None {
+                    continue;
                 }
-                Cell::Triangle(t) => {
-                    if self.triangle_pair[t as usize] == Pair::None {
-                        self.triangle_pair[t as usize] = Pair::Critical;
-                    }
-                }
+                self.edge_pair[id as usize] = Pair::Critical;
+                ready(self, id, &mut pq_one);
+            } else if self.triangle_pair[id as usize] == Pair::None {
+                self.triangle_pair[id as usize] = Pair::Critical;
             }
         }
         // every lower-star triangle not reached is critical (both faces were paired elsewhere)

@@ -133,3 +133,66 @@ proptest! {
         }
     }
 }
+
+/// Grids: random small fields (many with ties), persistence thresholds, counts, both
+/// representatives and both constraint sets. A run certifies (checked by the independent
+/// 6-neighbour counter) or stops with a clear input/infeasibility error (exit 3: kept values
+/// too close for double precision); never exit 1, never a panic.
+mod grids {
+    use super::common::grid_extrema;
+    use proptest::prelude::*;
+    use toposmooth::constraints::EdgeSet;
+    use toposmooth::domain::Grid2d;
+    use toposmooth::pipeline::{smooth, RepresentativeChoice, SmoothSettings};
+    use toposmooth::topology::{Role, Selection};
+
+    fn field() -> impl Strategy<Value = (usize, usize, Vec<f64>)> {
+        (2usize..9, 2usize..9).prop_flat_map(|(nx, ny)| {
+            let n = nx * ny;
+            prop_oneof![
+                prop::collection::vec((0i32..4).prop_map(f64::from), n),
+                prop::collection::vec(-5.0f64..5.0, n),
+            ]
+            .prop_map(move |v| (nx, ny, v))
+        })
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(2000))]
+        #[test]
+        fn grid_runs_certify_or_say_why(
+            (nx, ny, h) in field(),
+            frac in 0.01f64..0.8,
+            count in proptest::option::of((1usize..4, 1usize..4)),
+            harmonic in any::<bool>(),
+            all_edges in any::<bool>(),
+        ) {
+            prop_assume!(h.iter().any(|&v| v != h[0]));
+            let selection = match count {
+                Some((a, b)) => Selection::Count { minima: a, maxima: b },
+                None => Selection::Relative(frac),
+            };
+            let settings = SmoothSettings {
+                selection,
+                representative: if harmonic { RepresentativeChoice::Harmonic } else { RepresentativeChoice::Separatrix },
+                edges: if all_edges { EdgeSet::All } else { EdgeSet::Minimal },
+                ..Default::default()
+            };
+            let g = Grid2d::new(nx, ny).unwrap();
+            match smooth(&g, &h, &settings) {
+                Ok(out) => {
+                    let (mins, maxs, flat) = grid_extrema(nx, ny, &out.output);
+                    prop_assert!(flat.is_empty());
+                    prop_assert_eq!(mins, (0..nx * ny).filter(|&v| out.roles[v] == Role::Min).collect::<Vec<_>>());
+                    prop_assert_eq!(maxs, (0..nx * ny).filter(|&v| out.roles[v] == Role::Max).collect::<Vec<_>>());
+                    for v in 0..nx * ny {
+                        if out.roles[v] != Role::Other {
+                            prop_assert_eq!(out.output[v].to_bits(), h[v].to_bits());
+                        }
+                    }
+                }
+                Err(e) => prop_assert_eq!(e.exit_code(), 3, "{}", e),
+            }
+        }
+    }
+}

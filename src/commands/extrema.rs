@@ -101,18 +101,33 @@ fn list<D: Domain>(
             .map(|r| Row { info: r, x: label(r.index), kept: matches!(kept.roles[r.index], Role::Min | Role::Max) })
             .collect(),
     };
-    if let Some(path) = &args.plot {
+    if let Some(plot_path) = &args.plot {
         let mut points = Vec::new();
+        // a series pairs each maximum with a minimum (one point per pair); on a grid the
+        // maxima have their own superlevel-set pairs, drawn below the diagonal
         for r in &table {
-            if r.kind != ExtremumKind::Min {
-                continue;
+            match r.kind {
+                ExtremumKind::Min => {
+                    let death = r.partner.map(|p| h[p]).unwrap_or(f64::INFINITY);
+                    let kept = kept.roles[r.index] == Role::Min;
+                    points.push(DiagramPoint { birth: r.value, death, is_max: false, kept });
+                }
+                ExtremumKind::Max if grid.is_some() => {
+                    let death = r.partner.map(|p| h[p]).unwrap_or(f64::NEG_INFINITY);
+                    let kept = kept.roles[r.index] == Role::Max;
+                    points.push(DiagramPoint { birth: r.value, death, is_max: true, kept });
+                }
+                _ => {}
             }
-            let death = r.partner.map(|p| h[p]).unwrap_or(f64::INFINITY);
-            points.push(DiagramPoint { birth: r.value, death, is_max: false, kept: kept.roles[r.index] == Role::Min });
         }
-        let title =
-            format!("{} — {} ({} pairs)", path.file_name().unwrap_or_default().to_string_lossy(), column, points.len());
-        stage_plot(path, |p| plot_persistence_diagram(p, &points, kept.threshold, &title, (900, 800)))?.commit()?;
+        let title = format!(
+            "{} — {} ({} points)",
+            path.file_name().unwrap_or_default().to_string_lossy(),
+            column,
+            points.len()
+        );
+        stage_plot(plot_path, |p| plot_persistence_diagram(p, &points, kept.threshold, &title, (900, 800)))?
+            .commit()?;
     }
     if args.json {
         return serde_json::to_string_pretty(&listing).map_err(|e| Error::input(e.to_string()));
@@ -157,8 +172,14 @@ fn list<D: Domain>(
         None => format!("{} samples", listing.samples),
     };
     out += &format!(
-        "{}: {what} of `{}`; SoS extrema: {} minima, {} maxima (incl. {} ends); strict in the raw values: {} minima, {} maxima\n",
-        listing.file, listing.column, listing.sos_minima, listing.sos_maxima, listing.ends, listing.strict_minima, listing.strict_maxima
+        "{}: {what} of `{}`; SoS extrema: {} minima, {} maxima{}; strict in the raw values: {} minima, {} maxima\n",
+        listing.file,
+        listing.column,
+        listing.sos_minima,
+        listing.sos_maxima,
+        if grid.is_some() { " (boundary included)".to_string() } else { format!(" (incl. {} ends)", listing.ends) },
+        listing.strict_minima,
+        listing.strict_maxima
     );
     if let Some(t) = kept.threshold {
         out += &format!(

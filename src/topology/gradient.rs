@@ -38,52 +38,87 @@ enum Pair {
     Cell(u32),
 }
 
-/// The coned complex and its discrete gradient.
+/// The coned complex: the domain's triangles plus one cone vertex per boundary loop joined to
+/// each of its boundary edges; edges and incidences in compressed rows. Shared by the
+/// descending and ascending gradients.
 #[derive(Clone, Debug)]
-pub struct DiscreteGradient {
+pub struct Complex {
     n_real: usize,
-    /// Filtration rank of every vertex (cones last).
-    rank: Vec<u32>,
+    n_loops: usize,
     edges: Vec<[u32; 2]>,
     triangles: Vec<[u32; 3]>,
-    vertex_edges: Vec<Vec<u32>>,
-    edge_triangles: Vec<Vec<u32>>,
-    vertex_pair: Vec<Pair>,
-    edge_pair: Vec<Pair>,
-    triangle_pair: Vec<Pair>,
+    vertex_edges: Csr,
+    edge_triangles: Csr,
 }
 
-impl DiscreteGradient {
-    /// Builds the coned complex of `domain` and runs ProcessLowerStars in the given direction.
+/// Compressed rows of `u32`.
+#[derive(Clone, Debug, Default)]
+struct Csr {
+    start: Vec<usize>,
+    items: Vec<u32>,
+}
+
+impl std::ops::Index<usize> for Csr {
+    type Output = [u32];
+    fn index(&self, i: usize) -> &[u32] {
+        &self.items[self.start[i]..self.start[i + 1]]
+    }
+}
+
+impl Csr {
+    fn from_pairs(rows: usize, mut pairs: Vec<(u32, u32)>) -> Csr {
+        pairs.sort_unstable();
+        let mut start = vec![0usize; rows + 1];
+        for &(r, _) in &pairs {
+            start[r as usize + 1] += 1;
+        }
+        for i in 0..rows {
+            start[i + 1] += start[i];
+        }
+        Csr { start, items: pairs.into_iter().map(|(_, x)| x).collect() }
+    }
+}
+
+/// Edges of `triangles` by sorting (a, b, triangle): the edge list and, per edge, its
+/// triangles.
+fn edges_of(triangles: &[[u32; 3]]) -> (Vec<[u32; 2]>, Csr) {
+    let mut keyed: Vec<(u64, u32)> = Vec::with_capacity(3 * triangles.len());
+    for (ti, t) in triangles.iter().enumerate() {
+        for k in 0..3 {
+            let (a, b) = (t[k].min(t[(k + 1) % 3]), t[k].max(t[(k + 1) % 3]));
+            keyed.push(((u64::from(a) << 32) | u64::from(b), ti as u32));
+        }
+    }
+    keyed.sort_unstable();
+    let mut edges: Vec<[u32; 2]> = Vec::new();
+    let mut start = vec![0usize];
+    let mut items = Vec::with_capacity(keyed.len());
+    for (k, &(key, ti)) in keyed.iter().enumerate() {
+        if k > 0 && keyed[k - 1].0 != key {
+            start.push(items.len());
+        }
+        if k == 0 || keyed[k - 1].0 != key {
+            edges.push([(key >> 32) as u32, key as u32]);
+        }
+        items.push(ti);
+    }
+    start.push(items.len());
+    (edges, Csr { start, items })
+}
+
+impl Complex {
+    /// Cones the domain's triangulation: one cone vertex `n + l` per boundary loop `l`.
     ///
     /// # Panics
-    /// If `values.len() != domain.n_vertices()` or the domain has no triangles.
-    pub fn new<D: Domain>(domain: &D, values: &[f64], direction: Direction) -> Self {
+    /// If the domain has no triangles.
+    pub fn new<D: Domain>(domain: &D) -> Complex {
         let n = domain.n_vertices();
-        assert_eq!(values.len(), n);
         let mut triangles: Vec<[u32; 3]> = domain.triangles().into_iter().map(|t| t.map(|v| v as u32)).collect();
         assert!(!triangles.is_empty(), "the discrete gradient needs a triangulated domain");
-        // edges and their triangles
-        let mut edge_id: HashMap<(u32, u32), u32> = HashMap::new();
-        let mut edges: Vec<[u32; 2]> = Vec::new();
-        let mut edge_triangles: Vec<Vec<u32>> = Vec::new();
-        let mut add_triangle = |t: [u32; 3], ti: u32, edges: &mut Vec<[u32; 2]>, et: &mut Vec<Vec<u32>>| {
-            for k in 0..3 {
-                let (a, b) = (t[k].min(t[(k + 1) % 3]), t[k].max(t[(k + 1) % 3]));
-                let id = *edge_id.entry((a, b)).or_insert_with(|| {
-                    edges.push([a, b]);
-                    et.push(Vec::new());
-                    (edges.len() - 1) as u32
-                });
-                et[id as usize].push(ti);
-            }
-        };
-        for (ti, t) in triangles.clone().into_iter().enumerate() {
-            add_triangle(t, ti as u32, &mut edges, &mut edge_triangles);
-        }
         // boundary loops: boundary edges have one triangle; walk them vertex to vertex
+        let (edges, edge_triangles) = edges_of(&triangles);
         let boundary: Vec<[u32; 2]> =
-            edges.iter().zip(&edge_triangles).filter(|(_, t)| t.len() == 1).map(|(e, _)| *e).collect();
+            (0..edges.len()).filter(|&e| edge_triangles[e].len() == 1).map(|e| edges[e]).collect();
         let mut next: HashMap<u32, Vec<u32>> = HashMap::new();
         for e in &boundary {
             next.entry(e[0]).or_default().push(e[1]);
@@ -103,14 +138,50 @@ impl DiscreteGradient {
             }
             n_loops += 1;
         }
-        let cone = |l: u32| n as u32 + l;
         for e in &boundary {
-            let t = [e[0], e[1], cone(loop_of[&e[0]])];
-            let ti = triangles.len() as u32;
-            triangles.push(t);
-            add_triangle(t, ti, &mut edges, &mut edge_triangles);
+            triangles.push([e[0], e[1], n as u32 + loop_of[&e[0]]]);
         }
+        let (edges, edge_triangles) = edges_of(&triangles);
         let n_all = n + n_loops as usize;
+        let mut incidences = Vec::with_capacity(2 * edges.len());
+        for (ei, e) in edges.iter().enumerate() {
+            incidences.push((e[0], ei as u32));
+            incidences.push((e[1], ei as u32));
+        }
+        let vertex_edges = Csr::from_pairs(n_all, incidences);
+        Complex { n_real: n, n_loops: n_loops as usize, edges, triangles, vertex_edges, edge_triangles }
+    }
+}
+
+/// A discrete gradient on a coned complex.
+#[derive(Clone, Debug)]
+pub struct DiscreteGradient {
+    c: std::sync::Arc<Complex>,
+    /// Filtration rank of every vertex (cones last).
+    rank: Vec<u32>,
+    vertex_pair: Vec<Pair>,
+    edge_pair: Vec<Pair>,
+    triangle_pair: Vec<Pair>,
+}
+
+impl DiscreteGradient {
+    /// Builds the coned complex of `domain` and runs ProcessLowerStars in the given direction.
+    ///
+    /// # Panics
+    /// If `values.len() != domain.n_vertices()` or the domain has no triangles.
+    pub fn new<D: Domain>(domain: &D, values: &[f64], direction: Direction) -> Self {
+        assert_eq!(values.len(), domain.n_vertices());
+        Self::on(std::sync::Arc::new(Complex::new(domain)), values, direction)
+    }
+
+    /// Runs ProcessLowerStars on an already coned complex.
+    ///
+    /// # Panics
+    /// If `values` does not have one entry per real vertex.
+    pub fn on(c: std::sync::Arc<Complex>, values: &[f64], direction: Direction) -> Self {
+        let n = c.n_real;
+        assert_eq!(values.len(), n);
+        let n_all = n + c.n_loops;
         let mut order = sos_sort(values);
         if direction == Direction::Ascending {
             order.reverse();
@@ -119,24 +190,15 @@ impl DiscreteGradient {
         for (k, &v) in order.iter().enumerate() {
             rank[v] = k as u32;
         }
-        for l in 0..n_loops {
-            rank[cone(l) as usize] = (n + l as usize) as u32;
-        }
-        let mut vertex_edges: Vec<Vec<u32>> = vec![Vec::new(); n_all];
-        for (ei, e) in edges.iter().enumerate() {
-            vertex_edges[e[0] as usize].push(ei as u32);
-            vertex_edges[e[1] as usize].push(ei as u32);
+        for (l, r) in rank.iter_mut().enumerate().skip(n) {
+            *r = l as u32;
         }
         let mut g = DiscreteGradient {
-            n_real: n,
             rank,
             vertex_pair: vec![Pair::None; n_all],
-            edge_pair: vec![Pair::None; edges.len()],
-            triangle_pair: vec![Pair::None; triangles.len()],
-            edges,
-            triangles,
-            vertex_edges,
-            edge_triangles,
+            edge_pair: vec![Pair::None; c.edges.len()],
+            triangle_pair: vec![Pair::None; c.triangles.len()],
+            c,
         };
         let mut by_rank: Vec<u32> = (0..n_all as u32).collect();
         by_rank.sort_by_key(|&v| g.rank[v as usize]);
@@ -147,7 +209,7 @@ impl DiscreteGradient {
     }
 
     fn other(&self, e: u32, v: u32) -> u32 {
-        let [a, b] = self.edges[e as usize];
+        let [a, b] = self.c.edges[e as usize];
         if a == v {
             b
         } else {
@@ -162,7 +224,7 @@ impl DiscreteGradient {
             Cell::Triangle(t) => {
                 let mut r = [0u32; 2];
                 let mut k = 0;
-                for &w in &self.triangles[t as usize] {
+                for &w in &self.c.triangles[t as usize] {
                     if w != v && k < 2 {
                         r[k] = self.rank[w as usize];
                         k += 1;
@@ -177,7 +239,7 @@ impl DiscreteGradient {
         use std::cmp::Reverse;
         use std::collections::BinaryHeap;
         let rv = self.rank[v as usize];
-        let lower_edges: Vec<u32> = self.vertex_edges[v as usize]
+        let lower_edges: Vec<u32> = self.c.vertex_edges[v as usize]
             .iter()
             .copied()
             .filter(|&e| self.rank[self.other(e, v) as usize] < rv)
@@ -195,12 +257,12 @@ impl DiscreteGradient {
                 None => *lower_edges.iter().find(|&&e| g.other(e, v) == w).expect("a lower edge"),
             }
         };
-        let in_star = |g: &Self, t: u32| g.triangles[t as usize].iter().all(|&w| g.rank[w as usize] <= rv);
+        let in_star = |g: &Self, t: u32| g.c.triangles[t as usize].iter().all(|&w| g.rank[w as usize] <= rv);
         // faces of a lower-star triangle inside the lower star: its two edges at v
         let faces = |g: &Self, t: u32| -> [u32; 2] {
             let mut f = [0u32; 2];
             let mut k = 0;
-            for &w in &g.triangles[t as usize] {
+            for &w in &g.c.triangles[t as usize] {
                 if w != v && k < 2 {
                     f[k] = edge_to(g, w);
                     k += 1;
@@ -212,7 +274,7 @@ impl DiscreteGradient {
             |g: &Self, t: u32| faces(g, t).iter().filter(|&&e| g.edge_pair[e as usize] == Pair::None).count();
         let mut lower_triangles: Vec<u32> = Vec::new();
         for &e in &lower_edges {
-            for &t in &self.edge_triangles[e as usize] {
+            for &t in &self.c.edge_triangles[e as usize] {
                 if in_star(self, t) {
                     lower_triangles.push(t);
                 }
@@ -227,7 +289,7 @@ impl DiscreteGradient {
         let triangle_entry = |g: &Self, t: u32| -> Entry { Reverse((g.key(Cell::Triangle(t), v), 1, t)) };
         // lower-star triangles with face e and one unpaired face go to the first queue
         let ready = |g: &Self, e: u32, pq_one: &mut BinaryHeap<Entry>| {
-            for &t in &g.edge_triangles[e as usize] {
+            for &t in &g.c.edge_triangles[e as usize] {
                 if in_star(g, t) && g.triangle_pair[t as usize] == Pair::None && unpaired_faces(g, t) == 1 {
                     pq_one.push(triangle_entry(g, t));
                 }
@@ -281,14 +343,14 @@ impl DiscreteGradient {
 
     /// Critical vertices among the real ones (minima when descending, maxima when ascending).
     pub fn critical_vertices(&self) -> Vec<usize> {
-        (0..self.n_real).filter(|&v| self.vertex_pair[v] == Pair::Critical).collect()
+        (0..self.c.n_real).filter(|&v| self.vertex_pair[v] == Pair::Critical).collect()
     }
 
     /// Critical edges (saddles) as vertex pairs; edges at a cone name the cone as `n + loop`.
     pub fn critical_edges(&self) -> Vec<[usize; 2]> {
-        (0..self.edges.len())
+        (0..self.c.edges.len())
             .filter(|&e| self.edge_pair[e] == Pair::Critical)
-            .map(|e| self.edges[e].map(|v| v as usize))
+            .map(|e| self.c.edges[e].map(|v| v as usize))
             .collect()
     }
 
@@ -346,11 +408,11 @@ impl DiscreteGradient {
             }
             let rs = self.rank[s as usize];
             let mut done = false;
-            for &e in &self.vertex_edges[s as usize].clone() {
+            for &e in &self.c.clone().vertex_edges[s as usize] {
                 if self.edge_pair[e as usize] != Pair::Critical || self.rank[self.other(e, s) as usize] > rs {
                     continue;
                 }
-                let [a, b] = self.edges[e as usize];
+                let [a, b] = self.c.edges[e as usize];
                 let (ea, eb) = (self.path_end(a), self.path_end(b));
                 let start = match (ea == m, eb == m) {
                     (true, false) => a,
@@ -395,11 +457,11 @@ impl DiscreteGradient {
     /// endpoint entering the filtration last (the highest when descending, the lowest when
     /// ascending), in whose lower star the edge was made critical.
     pub fn saddles(&self) -> Vec<Saddle> {
-        (0..self.edges.len())
+        (0..self.c.edges.len())
             .filter(|&e| self.edge_pair[e] == Pair::Critical)
             .filter_map(|e| {
-                let [a, b] = self.edges[e];
-                if a as usize >= self.n_real || b as usize >= self.n_real {
+                let [a, b] = self.c.edges[e];
+                if a as usize >= self.c.n_real || b as usize >= self.c.n_real {
                     return None;
                 }
                 let (top, other) = if self.rank[a as usize] > self.rank[b as usize] { (a, b) } else { (b, a) };
@@ -426,7 +488,7 @@ impl DiscreteGradient {
             x = self.other(e, x);
             path.push(x as usize);
         }
-        path.retain(|&w| w < self.n_real);
+        path.retain(|&w| w < self.c.n_real);
         path
     }
 }

@@ -36,8 +36,9 @@ impl MorseSmale {
     /// A description of a cancellation that failed (never expected for persistence sets).
     pub fn new<D: Domain>(domain: &D, values: &[f64], kept: &KeptSet) -> Result<Self, String> {
         let t = std::time::Instant::now();
-        let mut down = DiscreteGradient::new(domain, values, Direction::Descending);
-        let mut up = DiscreteGradient::new(domain, values, Direction::Ascending);
+        let complex = std::sync::Arc::new(super::gradient::Complex::new(domain));
+        let mut down = DiscreteGradient::on(complex.clone(), values, Direction::Descending);
+        let mut up = DiscreteGradient::on(complex, values, Direction::Ascending);
         let built = t.elapsed().as_secs_f64();
         let t = std::time::Instant::now();
         let keep_min: Vec<bool> = kept.roles.iter().map(|&r| r == Role::Min).collect();

@@ -19,6 +19,7 @@ pub mod commands;
 pub mod constraints;
 pub mod derive;
 pub mod io;
+pub mod linalg;
 pub mod pipeline;
 pub mod plot;
 pub mod representative;

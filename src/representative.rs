@@ -288,7 +288,7 @@ pub fn separatrix_representative<D: crate::domain::Domain>(
 
 /// Rounds of releasing contradicting separatrices (each one harmonic solve) before the
 /// caller falls back to another representative.
-const MAX_RELEASE_ROUNDS: usize = 6;
+const MAX_RELEASE_ROUNDS: usize = 16;
 
 fn is_regular<D: crate::domain::Domain>(domain: &D, u: &[f64], v: usize) -> bool {
     let (mut lower, mut higher) = (false, false);

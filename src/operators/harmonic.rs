@@ -1,8 +1,7 @@
 //! Harmonic interpolation: `K u = 0` at free vertices, given values at fixed ones.
 
 use super::sparse::Sparse;
-use faer::linalg::solvers::Solve;
-use faer::sparse::linalg::solvers::{Llt, SymbolicLlt};
+use crate::linalg::solve_spd_once;
 use faer::sparse::Triplet;
 
 /// Solves `(K u)_i = 0` for every free vertex `i` with `u_j = fixed_j` where given (Dirichlet
@@ -43,13 +42,10 @@ pub fn dirichlet_solve(k: &Sparse, fixed: &[Option<f64>]) -> Result<Vec<f64>, St
         }
     }
     let a = Sparse::try_new_from_triplets(nf, nf, &t).map_err(|e| format!("{e:?}"))?;
-    let sym = SymbolicLlt::try_new(a.symbolic(), faer::Side::Upper).map_err(|e| format!("{e:?}"))?;
-    let llt = Llt::try_new_with_symbolic(sym, a.as_ref(), faer::Side::Upper)
+    solve_spd_once(a.as_ref(), &mut rhs)
         .map_err(|_| "a free part of the domain touches no fixed vertex".to_string())?;
-    let mut b = faer::Mat::from_fn(nf, 1, |i, _| rhs[i]);
-    llt.solve_in_place(b.as_mut());
     for (k, &i) in free.iter().enumerate() {
-        u[i] = b[(k, 0)];
+        u[i] = rhs[k];
     }
     Ok(u)
 }

@@ -4,16 +4,19 @@
 //! Every row of A has one or two entries (an ordering constraint on an edge), so the normal
 //! matrix `N = P + Aᵀ W A` (`W = diag(z/s)`) has the pattern of P plus the constrained pairs,
 //! known before the first iteration. faer's sparse Cholesky analyses that pattern once
-//! (ordering, elimination tree, supernodes) and only refactors the values at each iteration:
+//! (ordering — nested dissection or AMD, whichever needs fewer flops, see `crate::linalg` —
+//! elimination tree, supernodes) and only refactors the values at each iteration:
 //! one factorisation and two solves per iteration, instead of an LDLᵀ of the full
 //! `(n + m) × (n + m)` KKT system. Starting from the representative u (feasible for every
 //! row) the iteration count stays low. Whatever it returns, the certificate decides.
 
 use super::qp::{QpSettings, ReducedQp, SolveStatus};
-use faer::linalg::solvers::Solve;
-use faer::sparse::linalg::solvers::{Llt, SymbolicLlt};
-use faer::sparse::{SparseColMat, SymbolicSparseColMat};
-use faer::Side;
+use crate::linalg as ordering;
+use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::linalg::cholesky::llt::factor::LltRegularization;
+use faer::sparse::linalg::cholesky::LltRef;
+use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
+use faer::{Conj, Side, Spec};
 
 /// Upper-triangular pattern of `N` and where each contribution lands in its value array.
 struct Normal {
@@ -152,11 +155,14 @@ pub fn solve(
     };
 
     let normal = Normal::new(r, &row_cols, &row_len);
-    let symbolic =
-        SymbolicLlt::try_new(normal.symbolic.as_ref(), Side::Upper).map_err(|e| format!("symbolic Cholesky: {e:?}"))?;
+    let symbolic = ordering::symbolic_cholesky(normal.symbolic.as_ref(), Side::Upper)?;
+    let par = ordering::parallelism_for(&symbolic);
+    let mut mem = MemBuffer::try_new(symbolic.factorize_numeric_llt_scratch::<f64>(par, Spec::default()))
+        .map_err(|_| "out of memory for the Cholesky workspace".to_string())?;
     let nnz = normal.symbolic.row_idx().len();
     let mut vals = vec![0.0f64; nnz];
-    let factor = |w: &[f64], vals: &mut Vec<f64>| -> Result<Llt<usize, f64>, String> {
+    let mut l_vals = vec![0.0f64; symbolic.len_val()];
+    let mut factor = |w: &[f64], vals: &mut [f64], l_vals: &mut [f64]| -> Result<(), String> {
         let mut reg = 0.0;
         for attempt in 0..4 {
             vals.iter_mut().for_each(|v| *v = 0.0);
@@ -177,29 +183,35 @@ pub fn solve(
                     vals[d] += reg;
                 }
             }
-            let mat = SparseColMat::new(normal.symbolic.clone(), std::mem::take(vals));
-            let result = Llt::try_new_with_symbolic(symbolic.clone(), mat.as_ref(), Side::Upper);
-            *vals = mat.val().to_vec();
+            let mat = SparseColMatRef::new(normal.symbolic.as_ref(), vals);
+            let result = symbolic.factorize_numeric_llt(
+                l_vals,
+                mat,
+                Side::Upper,
+                LltRegularization::default(),
+                par,
+                MemStack::new(&mut mem),
+                Spec::default(),
+            );
             match result {
-                Ok(f) => return Ok(f),
+                Ok(_) => return Ok(()),
                 Err(_) => reg = if attempt == 0 { 1e-12 } else { reg * 1e3 },
             }
         }
         Err("the normal matrix is not positive definite".into())
     };
-    let solve_with = |f: &Llt<usize, f64>, rhs: &mut [f64]| {
-        let mut b = faer::Mat::from_fn(n, 1, |i, _| rhs[i]);
-        f.solve_in_place(b.as_mut());
-        for (i, v) in rhs.iter_mut().enumerate() {
-            *v = b[(i, 0)];
-        }
+    let mut solve_mem = MemBuffer::try_new(symbolic.solve_in_place_scratch::<f64>(1, par))
+        .map_err(|_| "out of memory for the Cholesky workspace".to_string())?;
+    let mut solve_with = |l_vals: &[f64], rhs: &mut [f64]| {
+        let rhs_mat = faer::MatMut::from_column_major_slice_mut(rhs, n, 1);
+        LltRef::new(&symbolic, l_vals).solve_in_place_with_conj(Conj::No, rhs_mat, par, MemStack::new(&mut solve_mem));
     };
 
     let mut x: Vec<f64> = hint.map(|h| h.to_vec()).unwrap_or_else(|| vec![0.0; n]);
     if m == 0 {
-        let f = factor(&[], &mut vals)?;
+        factor(&[], &mut vals, &mut l_vals)?;
         let mut rhs: Vec<f64> = r.q.iter().map(|v| -v).collect();
-        solve_with(&f, &mut rhs);
+        solve_with(&l_vals, &mut rhs);
         return Ok((rhs, SolveStatus::Solved, 1));
     }
     // starting point: slacks of x (shifted to be positive), unit multipliers, then balanced
@@ -251,7 +263,8 @@ pub fn solve(
         for k in 0..m {
             w[k] = z[k] / s[k];
         }
-        let f = factor(&w, &mut vals)?;
+        factor(&w, &mut vals, &mut l_vals)?;
+        let l_vals = &l_vals;
         // one Newton direction for complementarity target rc (s∘z − rc → 0)
         let mut direction = |rc: &[f64], dx: &mut Vec<f64>, ds: &mut Vec<f64>, dz: &mut Vec<f64>| {
             for k in 0..m {
@@ -261,7 +274,7 @@ pub fn solve(
             for i in 0..n {
                 dx[i] = -rd[i] - dx[i];
             }
-            solve_with(&f, dx);
+            solve_with(l_vals, dx);
             ax(dx, ds);
             for k in 0..m {
                 let adx = ds[k];

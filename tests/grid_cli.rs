@@ -309,3 +309,58 @@ fn grid_reader_errors_name_the_file_and_the_problem() {
     assert_eq!(o.status.code(), Some(3), "{}", text(&o));
     assert!(text(&o).contains("extent.vti"), "{}", text(&o));
 }
+
+#[test]
+fn outputs_never_overwrite_inputs_or_half_write() {
+    let dir = scratch("collide");
+    let (u, v) = (path(&dir, "u.csv"), path(&dir, "v.csv"));
+    std::fs::copy(dataset("soapfilm_piv_u_63x63.csv"), &u).unwrap();
+    std::fs::copy(dataset("soapfilm_piv_v_63x63.csv"), &v).unwrap();
+    let before = std::fs::read(&v).unwrap();
+    let base =
+        ["smooth", "--derive", "vorticity", "--u", &u, "--v", &v, "--fill-missing", "--minima", "9", "--maxima", "4"];
+    let mut args = base.to_vec();
+    args.extend(["-o", &v]);
+    let o = toposmooth(&args);
+    assert_eq!(o.status.code(), Some(2), "{}", text(&o));
+    assert_eq!(std::fs::read(&v).unwrap(), before, "the --v input is untouched");
+    // a symbolic link to the input is the input
+    #[cfg(unix)]
+    {
+        let link = path(&dir, "link.csv");
+        std::os::unix::fs::symlink(&u, &link).unwrap();
+        let o = toposmooth(&["smooth", &link, "-o", &u, "--domain", "grid", "--fill-missing"]);
+        assert_eq!(o.status.code(), Some(2), "{}", text(&o));
+    }
+    // an output that is a directory is refused before anything is written
+    let plot_dir = path(&dir, "plot.png");
+    std::fs::create_dir(&plot_dir).unwrap();
+    let vti = path(&dir, "w.vti");
+    let mut args = base.to_vec();
+    args.extend(["-o", &vti, "--plot", &plot_dir]);
+    let o = toposmooth(&args);
+    assert_eq!(o.status.code(), Some(2), "{}", text(&o));
+    assert!(!Path::new(&vti).exists(), "no output left behind");
+    // the derived field's holes are reported as the derived field's
+    let o = toposmooth(&["extrema", "--derive", "vorticity", "--u", &u, "--v", &v]);
+    assert_eq!(o.status.code(), Some(3), "{}", text(&o));
+    assert!(text(&o).contains("derived vorticity") && text(&o).contains("774 missing"), "{}", text(&o));
+    // verify --input re-reads with the spacing the .vti carries
+    let piv = dataset("soapfilm_piv_vorticity_63x63.csv");
+    let o = toposmooth(&[
+        "smooth",
+        &piv,
+        "--fill-missing",
+        "--spacing",
+        "0.31248,-0.31248",
+        "--minima",
+        "9",
+        "--maxima",
+        "4",
+        "-o",
+        &vti,
+    ]);
+    assert!(o.status.success(), "{}", text(&o));
+    let o = toposmooth(&["verify", &vti, "--input", &piv, "--fill-missing"]);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+}

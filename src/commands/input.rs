@@ -245,7 +245,16 @@ pub fn read_grid(path: &Path, opts: &GridOptions) -> Result<GridInput> {
     let mut filled = None;
     if let Some(what) = describe_missing(&grid, &values, 5) {
         if !opts.fill_missing {
-            return Err(Error::input(format!("{what}; pass --fill-missing to fill them harmonically")).in_file(&source));
+            let whose = if opts.derive.is_some() {
+                format!(
+                    "the derived {description} has {what} (a missing vector makes the derivative missing wherever its stencil uses it)"
+                )
+            } else {
+                what
+            };
+            return Err(
+                Error::input(format!("{whose}; pass --fill-missing to fill them harmonically")).in_file(&source)
+            );
         }
         let mask: Vec<bool> = values.iter().map(|v| v.is_nan()).collect();
         fill_missing(&grid, &mut values).map_err(|e| e.in_file(&source))?;

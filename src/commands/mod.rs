@@ -78,12 +78,24 @@ fn stage_plot(
     crate::io::stage_with(path, |tmp| draw(tmp).map_err(|e| std::io::Error::other(e.to_string())))
 }
 
-/// Output paths must differ from each other and from the input.
-fn check_distinct(input: &Path, outputs: &[(&str, Option<&Path>)]) -> Result<()> {
-    let key = |p: &Path| std::path::absolute(p).unwrap_or_else(|_| p.to_path_buf());
-    let mut seen = vec![("the input", key(input))];
+/// Output paths must differ from each other and from the inputs (symbolic links resolved),
+/// and none may be a directory: checked before any work, so that no output is half written.
+fn check_distinct(inputs: &[&Path], outputs: &[(&str, Option<&Path>)]) -> Result<()> {
+    let key = |p: &Path| {
+        std::fs::canonicalize(p)
+            .or_else(|_| {
+                // a new file: resolve its directory
+                let parent = p.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
+                std::fs::canonicalize(parent).map(|d| d.join(p.file_name().unwrap_or_default()))
+            })
+            .unwrap_or_else(|_| std::path::absolute(p).unwrap_or_else(|_| p.to_path_buf()))
+    };
+    let mut seen: Vec<(&str, std::path::PathBuf)> = inputs.iter().map(|p| ("an input", key(p))).collect();
     for (name, p) in outputs {
         if let Some(p) = p {
+            if p.is_dir() {
+                return Err(Error::Usage(format!("{name} {} is a directory", p.display())));
+            }
             let k = key(p);
             if let Some((other, _)) = seen.iter().find(|(_, s)| *s == k) {
                 return Err(Error::Usage(format!("{name} {} is also {other}", p.display())));

@@ -53,8 +53,12 @@ struct RunReport<'a> {
 pub fn smooth(args: &SmoothArgs) -> Result<String> {
     check_png_name(args.plot.as_deref())?;
     let input_path = args.input.clone().or_else(|| args.grid.uv.as_ref().map(|(u, _)| u.clone())).unwrap_or_default();
+    let mut inputs: Vec<&Path> = args.input.iter().map(PathBuf::as_path).collect();
+    if let Some((u, v)) = &args.grid.uv {
+        inputs.extend([u.as_path(), v.as_path()]);
+    }
     check_distinct(
-        &input_path,
+        &inputs,
         &[
             ("-o", Some(&args.output)),
             ("--plot", args.plot.as_deref()),

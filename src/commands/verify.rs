@@ -95,7 +95,13 @@ fn verify_grid(args: &VerifyArgs, ext: &str) -> Result<String> {
     let n = g.nx() * g.ny();
     let mut problems = Vec::new();
     if let Some(orig) = &args.input {
-        let data = read_grid(orig, &args.grid)?;
+        // the .vti carries the spacing the input was read with (the harmonic fill and derived
+        // quantities depend on it)
+        let mut opts = args.grid.clone();
+        if opts.spacing.is_none() && ext == "vti" {
+            opts.spacing = Some(g.spacing());
+        }
+        let data = read_grid(orig, &opts)?;
         if (data.grid.nx(), data.grid.ny()) != (g.nx(), g.ny()) {
             problems.push(format!(
                 "{} is {} × {}, {} is {} × {}",

@@ -100,6 +100,12 @@ pub fn fill_missing(grid: &Grid2d, values: &mut [f64]) -> Result<usize> {
     if count == values.len() {
         return Err(Error::input("every sample is missing (NaN): nothing to fill from"));
     }
+    let known = crate::domain::value_range(values.iter().filter(|v| !v.is_nan()));
+    if known.0 == known.1 {
+        // a constant stays exactly constant (a solve would add rounding noise, i.e. extrema)
+        values.iter_mut().for_each(|v| *v = known.0);
+        return Ok(count);
+    }
     let filled = dirichlet_solve(&grid_stiffness(grid), &fixed).map_err(|e| Error::input(format!("fill: {e}")))?;
     values.copy_from_slice(&filled);
     Ok(count)
@@ -167,5 +173,10 @@ mod tests {
         }
         let mut all = vec![f64::NAN; 42];
         assert!(fill_missing(&g, &mut all).is_err());
+        // one known value fills everything with exactly that value
+        let mut one = vec![f64::NAN; 42];
+        one[17] = 0.1;
+        assert_eq!(fill_missing(&g, &mut one).unwrap(), 41);
+        assert!(one.iter().all(|&v| v == 0.1));
     }
 }

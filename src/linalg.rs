@@ -430,6 +430,56 @@ pub fn upper_pattern(n: usize, edges: &[(usize, usize)]) -> SymbolicSparseColMat
     SymbolicSparseColMat::new_checked(n, n, cp, None, ri)
 }
 
+/// A sparse SPD solver for a fixed pattern: the symbolic analysis (AMD) is done once, each
+/// [`SpdSolver::solve`] refactors the values and solves (for repeated solves with the same
+/// pattern and different values).
+pub struct SpdSolver {
+    s: SymbolicCholesky<usize>,
+    par: Par,
+    l: Vec<f64>,
+    mem: MemBuffer,
+}
+
+impl SpdSolver {
+    /// Analyses the upper-triangular pattern.
+    ///
+    /// # Errors
+    /// A message if the analysis or the workspace allocation fails.
+    pub fn new(pattern: SymbolicSparseColMatRef<'_, usize>) -> Result<Self, String> {
+        let s = factorize_symbolic_cholesky(pattern, Side::Upper, SymmetricOrdering::Amd, Default::default())
+            .map_err(|e| format!("symbolic Cholesky: {e:?}"))?;
+        let par = parallelism_for(&s);
+        let mem = MemBuffer::try_new(StackReq::any_of(&[
+            s.factorize_numeric_llt_scratch::<f64>(par, Spec::default()),
+            s.solve_in_place_scratch::<f64>(1, par),
+        ]))
+        .map_err(|_| "out of memory for the Cholesky workspace".to_string())?;
+        Ok(SpdSolver { l: vec![0.0; s.len_val()], s, par, mem })
+    }
+
+    /// Factors `a` (upper triangle, the analysed pattern) and overwrites `b` with `a⁻¹ b`.
+    ///
+    /// # Errors
+    /// A message if `a` is not positive definite.
+    pub fn solve(&mut self, a: SparseColMatRef<'_, usize, f64>, b: &mut [f64]) -> Result<(), String> {
+        let n = a.ncols();
+        let s = &self.s;
+        s.factorize_numeric_llt(
+            &mut self.l,
+            a,
+            Side::Upper,
+            Default::default(),
+            self.par,
+            MemStack::new(&mut self.mem),
+            Spec::default(),
+        )
+        .map_err(|e| format!("{e:?}"))?;
+        let rhs = faer::MatMut::from_column_major_slice_mut(b, n, 1);
+        LltRef::new(s, &self.l).solve_in_place_with_conj(Conj::No, rhs, self.par, MemStack::new(&mut self.mem));
+        Ok(())
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -234,12 +234,13 @@ pub fn separatrix_representative<D: crate::domain::Domain>(
             through[v].push(i);
         }
     }
+    let mut dirichlet = crate::operators::Dirichlet::new(k)?;
     let mut released = vec![false; n];
     let mut gone = vec![false; separatrices.len()];
     let mut count = 0;
     for _ in 0..MAX_RELEASE_ROUNDS {
         let fixed: Vec<Option<f64>> = (0..n).map(|v| if released[v] { None } else { prescribed[v] }).collect();
-        let u = crate::operators::dirichlet_solve(k, &fixed)?;
+        let u = dirichlet.solve(&fixed)?;
         let bad: Vec<usize> = (0..n)
             .filter(|&v| match kept.roles[v] {
                 Role::Other => !is_regular(domain, &u, v),

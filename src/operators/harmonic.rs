@@ -50,6 +50,74 @@ pub fn dirichlet_solve(k: &Sparse, fixed: &[Option<f64>]) -> Result<Vec<f64>, St
     Ok(u)
 }
 
+/// Repeated Dirichlet problems on one Laplacian with changing fixed sets: the matrix keeps
+/// its full pattern (fixed rows and columns become identity rows and explicit zeros), so the
+/// Cholesky analysis is done once.
+pub struct Dirichlet<'a> {
+    k: &'a Sparse,
+    /// Upper-triangle entries of `k` as (row, column, position in `k`'s values).
+    upper: Vec<(usize, usize, usize)>,
+    pattern: faer::sparse::SymbolicSparseColMat<usize>,
+    solver: crate::linalg::SpdSolver,
+}
+
+impl<'a> Dirichlet<'a> {
+    /// Analyses `k`'s pattern (square, symmetric, with every diagonal entry present).
+    ///
+    /// # Errors
+    /// A message if the analysis fails.
+    pub fn new(k: &'a Sparse) -> Result<Self, String> {
+        let (cp, ri) = (k.symbolic().col_ptr(), k.symbolic().row_idx());
+        let mut upper = Vec::new();
+        for j in 0..k.ncols() {
+            for (off, &i) in ri[cp[j]..cp[j + 1]].iter().enumerate() {
+                if i <= j {
+                    upper.push((i, j, cp[j] + off));
+                }
+            }
+        }
+        let t: Vec<Triplet<usize, usize, f64>> = upper.iter().map(|&(i, j, _)| Triplet::new(i, j, 1.0)).collect();
+        let pattern = Sparse::try_new_from_triplets(k.nrows(), k.ncols(), &t).map_err(|e| format!("{e:?}"))?;
+        let pattern = pattern.symbolic().to_owned().map_err(|e| format!("{e:?}"))?;
+        let solver = crate::linalg::SpdSolver::new(pattern.as_ref())?;
+        Ok(Dirichlet { k, upper, pattern, solver })
+    }
+
+    /// The solution of `(K u)_i = 0` at free vertices with `u_j = fixed_j` where given.
+    ///
+    /// # Errors
+    /// A message if a free part touches no fixed vertex.
+    pub fn solve(&mut self, fixed: &[Option<f64>]) -> Result<Vec<f64>, String> {
+        let n = self.k.nrows();
+        let val = self.k.val();
+        let mut rhs: Vec<f64> = fixed.iter().map(|f| f.unwrap_or(0.0)).collect();
+        let mut values = Vec::with_capacity(self.upper.len());
+        for &(i, j, p) in &self.upper {
+            values.push(match (fixed[i], fixed[j]) {
+                (None, None) => val[p],
+                (Some(_), Some(_)) if i == j => 1.0,
+                (None, Some(uj)) => {
+                    rhs[i] -= val[p] * uj;
+                    0.0
+                }
+                (Some(ui), None) => {
+                    rhs[j] -= val[p] * ui;
+                    0.0
+                }
+                _ => 0.0,
+            });
+        }
+        let a = faer::sparse::SparseColMatRef::new(self.pattern.as_ref(), &values);
+        self.solver.solve(a, &mut rhs).map_err(|_| "a free part of the domain touches no fixed vertex".to_string())?;
+        for (i, f) in fixed.iter().enumerate().take(n) {
+            if let Some(v) = f {
+                rhs[i] = *v;
+            }
+        }
+        Ok(rhs)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -75,5 +143,15 @@ mod tests {
             assert!((x - f(v)).abs() < 1e-12);
         }
         assert!(dirichlet_solve(&k, &vec![None; 20]).is_err());
+        // the reusable solver gives the same answers for changing fixed sets
+        let mut d = Dirichlet::new(&k).unwrap();
+        let u2 = d.solve(&fixed).unwrap();
+        assert!(u.iter().zip(&u2).all(|(a, b)| (a - b).abs() < 1e-12));
+        let mut fewer = fixed.clone();
+        fewer[1] = None;
+        fewer[19] = None;
+        let (a, b) = (dirichlet_solve(&k, &fewer).unwrap(), d.solve(&fewer).unwrap());
+        assert!(a.iter().zip(&b).all(|(x, y)| (x - y).abs() < 1e-12));
+        assert!(d.solve(&vec![None; 20]).is_err());
     }
 }

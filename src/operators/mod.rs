@@ -23,7 +23,7 @@ mod series;
 mod sparse;
 
 pub use cotan::{cotan_stiffness, grid_mass, grid_stiffness, lumped_mass};
-pub use harmonic::dirichlet_solve;
+pub use harmonic::{dirichlet_solve, Dirichlet};
 pub use polyharmonic::{polyharmonic, Energy};
 pub use series::{series_mass, series_stiffness};
 pub use sparse::{quadratic_form, scaled_plus_diagonal, Sparse};

@@ -31,16 +31,21 @@ pub struct BenchArgs {
     pub method: Method,
 }
 
-/// A Gaussian random walk of `n` steps from a fixed seed (splitmix64 + Box–Muller).
-pub fn random_walk(n: usize, seed: u64) -> Vec<f64> {
+/// Uniform numbers in [0, 1) from a seed (splitmix64).
+fn uniform(seed: u64) -> impl FnMut() -> f64 {
     let mut state = seed;
-    let mut next = move || {
+    move || {
         state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
         let mut z = state;
         z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
         z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
         ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
-    };
+    }
+}
+
+/// A Gaussian random walk of `n` steps from a fixed seed (splitmix64 + Box–Muller).
+pub fn random_walk(n: usize, seed: u64) -> Vec<f64> {
+    let mut next = uniform(seed);
     let mut v = 0.0;
     (0..n)
         .map(|_| {
@@ -54,14 +59,7 @@ pub fn random_walk(n: usize, seed: u64) -> Vec<f64> {
 /// A grid field with smooth structure (a few Gaussian bumps and pits, a gentle tilt) plus
 /// uniform noise of 5 % of its range: many noise extrema, a handful of persistent ones.
 pub fn noisy_bumps(nx: usize, ny: usize, seed: u64) -> Vec<f64> {
-    let mut state = seed;
-    let mut next = move || {
-        state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = state;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
-    };
+    let mut next = uniform(seed);
     // (x, y, sign·height, width) in unit coordinates
     let bumps = [
         (0.2, 0.3, 1.0, 0.08),

@@ -175,22 +175,7 @@ fn smooth_series(args: &SmoothArgs, input: &Path, data: SeriesCsv, start: Instan
         r.kept.len() - kmin,
         r.settings.threshold.map(|t| format!(" (persistence ≥ {})", sig6(t))).unwrap_or_default()
     );
-    text += &format!(
-        "{}; RMS deviation {}, max deviation {}\n",
-        r.certificate.summary(),
-        sig6(r.rms_deviation),
-        sig6(r.max_deviation)
-    );
-    text += &format!(
-        "solver {:?} {:?} in {} iterations{}, {} constraints, margin {:.3e}; repair changed {} vertices\n",
-        r.solver,
-        r.solver_status,
-        r.solver_iterations,
-        r.solver_fallback.as_ref().map(|w| format!(" (structured solver gave up: {w})")).unwrap_or_default(),
-        r.constraints,
-        r.settings.margin[0],
-        r.repair.changed_vertices
-    );
+    text += &fit_and_solver_lines(r);
     text += &format!(
         "seconds: read {:.3}, persistence {:.3}, representative {:.3}, operators {:.3}, constraints {:.3}, solve {:.3}, repair {:.3}, verify {:.3}, write {:.3}, total {:.3}\n",
         read_seconds, s.persistence, s.representative, s.operators, s.constraints, s.solve, s.repair, s.verify, write_seconds,
@@ -205,4 +190,21 @@ fn smooth_series(args: &SmoothArgs, input: &Path, data: SeriesCsv, start: Instan
     }
     text.push('\n');
     Ok(text)
+}
+
+/// The certificate, deviation and solver lines of `smooth`'s summary (series and grids).
+pub(super) fn fit_and_solver_lines(r: &Report) -> String {
+    format!(
+        "{}; RMS deviation {}, max deviation {}\nsolver {:?} {:?} in {} iterations{}, {} constraints, margin {:.3e}; repair changed {} vertices\n",
+        r.certificate.summary(),
+        sig6(r.rms_deviation),
+        sig6(r.max_deviation),
+        r.solver,
+        r.solver_status,
+        r.solver_iterations,
+        r.solver_fallback.as_ref().map(|w| format!(" (structured solver gave up: {w})")).unwrap_or_default(),
+        r.constraints,
+        r.settings.margin[0],
+        r.repair.changed_vertices
+    )
 }

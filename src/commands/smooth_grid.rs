@@ -202,22 +202,7 @@ pub fn smooth_grid(args: &SmoothArgs, data: GridInput, start: Instant) -> Result
         r.settings.threshold.map(|t| format!(" (persistence ≥ {})", sig6(t))).unwrap_or_default(),
         r.representative
     );
-    text += &format!(
-        "{}; RMS deviation {}, max deviation {}\n",
-        r.certificate.summary(),
-        sig6(r.rms_deviation),
-        sig6(r.max_deviation)
-    );
-    text += &format!(
-        "solver {:?} {:?} in {} iterations{}, {} constraints, margin {:.3e}; repair changed {} vertices\n",
-        r.solver,
-        r.solver_status,
-        r.solver_iterations,
-        r.solver_fallback.as_ref().map(|w| format!(" (structured solver gave up: {w})")).unwrap_or_default(),
-        r.constraints,
-        r.settings.margin[0],
-        r.repair.changed_vertices
-    );
+    text += &super::smooth::fit_and_solver_lines(r);
     text += &format!(
         "seconds: read {:.3}, persistence {:.3}, complex {:.3}, simplify {:.3}, representative {:.3}, operators {:.3}, constraints {:.3}, solve {:.3}, repair {:.3}, verify {:.3}, write {:.3}, total {:.3}\n",
         read_seconds, s.persistence, s.complex, s.simplify, s.representative, s.operators, s.constraints, s.solve, s.repair, s.verify, write_seconds,

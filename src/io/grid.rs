@@ -76,42 +76,8 @@ pub fn read_grid_csv(path: &Path) -> Result<GridField> {
 /// # Errors
 /// Input errors: not an .npy file, a shape that is not 2D, an unsupported dtype, truncated data.
 pub fn read_npy(path: &Path) -> Result<GridField> {
-    use npyz::{DType, Order, TypeChar};
     let bytes = std::fs::read(path).map_err(|e| io_err(path, e))?;
-    let npy = npyz::NpyFile::new(&bytes[..]).map_err(|e| err(path, format!("not a readable .npy file: {e}")))?;
-    let shape = npy.shape().to_vec();
-    if shape.len() != 2 {
-        return Err(err(path, format!("expected a 2D array (rows, columns), found shape {shape:?}")));
-    }
-    let (ny, nx) = (shape[0] as usize, shape[1] as usize);
-    let order = npy.order();
-    let dtype = npy.dtype();
-    let DType::Plain(ts) = &dtype else {
-        return Err(err(path, format!("unsupported dtype {}", dtype.descr())));
-    };
-    let bad = |e: std::io::Error| err(path, format!("cannot read the data: {e}"));
-    let values: Vec<f64> = match (ts.type_char(), ts.size_field()) {
-        (TypeChar::Float, 8) => npy.into_vec::<f64>().map_err(bad)?,
-        (TypeChar::Float, 4) => npy.into_vec::<f32>().map_err(bad)?.into_iter().map(f64::from).collect(),
-        (TypeChar::Int, 1) => npy.into_vec::<i8>().map_err(bad)?.into_iter().map(f64::from).collect(),
-        (TypeChar::Int, 2) => npy.into_vec::<i16>().map_err(bad)?.into_iter().map(f64::from).collect(),
-        (TypeChar::Int, 4) => npy.into_vec::<i32>().map_err(bad)?.into_iter().map(f64::from).collect(),
-        (TypeChar::Int, 8) => npy.into_vec::<i64>().map_err(bad)?.into_iter().map(|v| v as f64).collect(),
-        (TypeChar::Uint, 1) => npy.into_vec::<u8>().map_err(bad)?.into_iter().map(f64::from).collect(),
-        (TypeChar::Uint, 2) => npy.into_vec::<u16>().map_err(bad)?.into_iter().map(f64::from).collect(),
-        (TypeChar::Uint, 4) => npy.into_vec::<u32>().map_err(bad)?.into_iter().map(f64::from).collect(),
-        (TypeChar::Uint, 8) => npy.into_vec::<u64>().map_err(bad)?.into_iter().map(|v| v as f64).collect(),
-        (TypeChar::Bool, 1) => npy.into_vec::<bool>().map_err(bad)?.into_iter().map(|b| b as u8 as f64).collect(),
-        _ => return Err(err(path, format!("unsupported dtype {}", dtype.descr()))),
-    };
-    if values.len() != nx * ny {
-        return Err(err(path, format!("{} values for shape {ny} × {nx}", values.len())));
-    }
-    let values = match order {
-        Order::C => values,
-        // Fortran order stores column by column: element (r, c) sits at c·ny + r
-        Order::Fortran => (0..ny * nx).map(|k| values[(k % nx) * ny + k / nx]).collect(),
-    };
+    let ([ny, nx], values) = super::npz::decode_npy(&bytes).map_err(|e| err(path, e))?;
     finish(path, nx, ny, values, "values".into())
 }
 

@@ -5,6 +5,7 @@ use std::path::PathBuf;
 use toposmooth::commands::input::{Derive, DomainKind, GridOptions};
 use toposmooth::commands::{self, BenchArgs, ExtremaArgs, SmoothArgs, VerifyArgs};
 use toposmooth::constraints::EdgeSet;
+use toposmooth::domain::{MAX_SPACING, MIN_SPACING};
 use toposmooth::io::series_csv::SeriesCsvOptions;
 use toposmooth::operators::Energy;
 use toposmooth::pipeline::{RepresentativeChoice, SmoothSettings};
@@ -148,10 +149,12 @@ impl GridCli {
                     .collect::<std::result::Result<_, _>>()
                     .map_err(|_| Error::Usage(format!("--spacing `{text}` is not two numbers dx,dy")))?;
                 match parts.as_slice() {
-                    [dx, dy] if dx.is_finite() && dy.is_finite() && *dx != 0.0 && *dy != 0.0 => Some([*dx, *dy]),
+                    [dx, dy] if [dx, dy].iter().all(|d| (MIN_SPACING..=MAX_SPACING).contains(&d.abs())) => {
+                        Some([*dx, *dy])
+                    }
                     _ => {
                         return Err(Error::Usage(format!(
-                            "--spacing `{text}` must be two finite non-zero numbers dx,dy"
+                            "--spacing `{text}` must be two numbers dx,dy with {MIN_SPACING:e} ≤ |d| ≤ {MAX_SPACING:e}"
                         )))
                     }
                 }
@@ -259,8 +262,8 @@ struct SmoothCli {
     /// Constraint set.
     #[arg(long, value_enum, default_value_t = Edges::Minimal)]
     edges: Edges,
-    /// Largest number of solver iterations.
-    #[arg(long, default_value_t = 200)]
+    /// Largest number of solver iterations (at least 1).
+    #[arg(long, default_value_t = 200, value_parser = clap::value_parser!(u32).range(1..))]
     max_iter: u32,
     /// QP solver: the structured interior-point method (Clarabel takes over if it fails), or
     /// Clarabel alone.

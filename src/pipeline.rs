@@ -387,7 +387,7 @@ pub fn smooth<D: Smoothable>(domain: &D, h: &[f64], settings: &SmoothSettings) -
         return Err(Error::input(format!("the field has {} values, the domain {n} vertices", h.len())));
     }
     if let Some(&v) = settings.energy.sharp.iter().find(|&&v| v >= n) {
-        return Err(Error::Usage(format!("sharp vertex {v} is out of range (the input has {n} vertices)")));
+        return Err(Error::input(format!("--sharp vertex {v} is out of range (the input has {n} vertices)")));
     }
     let mut seconds = StageSeconds::default();
 

@@ -208,6 +208,11 @@ fn input_errors_exit_3_naming_the_file() {
         &["out of range"],
         Some(&out),
     );
+    assert_input_error(
+        &["smooth", &good, "--sharp", "17", "-o", &o],
+        &["good.csv", "--sharp vertex 17", "out of range"],
+        Some(&out),
+    );
     let missing = dir.join("nope.csv").display().to_string();
     assert_input_error(&["smooth", &missing, "-o", &o], &["nope.csv"], Some(&out));
     let unsorted = write(&dir, "dates.csv", "date,v\n2010-01-02,1\n2010-01-01,2\n2010-01-03,0\n");
@@ -232,7 +237,7 @@ fn usage_errors_exit_2() {
         vec!["smooth", &good, "-o", &o, "--order", "2:-1"],
         vec!["smooth", &good, "-o", &o, "--persistence", "5%", "--pairs", "2"],
         vec!["smooth", &good, "-o", &o, "--keep-min", "0"],
-        vec!["smooth", &good, "-o", &o, "--sharp", "17"],
+        vec!["smooth", &good, "-o", &o, "--max-iter", "0"],
         vec!["smooth", &good, "-o", &o, "--data-weight", "-1"],
         vec!["smooth", &good],
         vec!["frobnicate"],

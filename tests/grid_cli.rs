@@ -308,6 +308,33 @@ fn grid_reader_errors_name_the_file_and_the_problem() {
     let o = toposmooth(&["extrema", &f, "--derive", "vorticity"]);
     assert_eq!(o.status.code(), Some(3), "{}", text(&o));
     assert!(text(&o).contains("extent.vti"), "{}", text(&o));
+    // a spacing the operators cannot represent, from the file and from the command line
+    let s = String::from_utf8_lossy(&vti).replace("Spacing=\"1 1 1\"", "Spacing=\"1e300 1e300 1\"");
+    let f = write(&dir, "huge.vti", s.as_bytes()).display().to_string();
+    let o = toposmooth(&["extrema", &f, "--derive", "vorticity"]);
+    assert_eq!(o.status.code(), Some(3), "{}", text(&o));
+    assert!(text(&o).contains("huge.vti") && text(&o).contains("spacing"), "{}", text(&o));
+    let csv = write(&dir, "small.csv", b"1,2,3\n4,0,6\n7,8,9\n").display().to_string();
+    let o = toposmooth(&["extrema", &csv, "--spacing", "1e300,1"]);
+    assert_eq!(o.status.code(), Some(2), "{}", text(&o));
+    // trailing bytes after an .npy array's data
+    let npy = dir.join("long.npy");
+    let mut bytes = b"\x93NUMPY\x01\x00".to_vec();
+    let header = "{'descr': '<f8', 'fortran_order': False, 'shape': (2, 2), }";
+    let padded = format!("{header:<117}\n");
+    bytes.extend((padded.len() as u16).to_le_bytes());
+    bytes.extend(padded.as_bytes());
+    for v in [1.0f64, 2.0, 3.0, 0.5, 9.0] {
+        bytes.extend(v.to_le_bytes());
+    }
+    std::fs::write(&npy, &bytes).unwrap();
+    let o = toposmooth(&["extrema", &npy.display().to_string()]);
+    assert_eq!(o.status.code(), Some(3), "{}", text(&o));
+    assert!(text(&o).contains("long.npy") && text(&o).contains("8 bytes after"), "{}", text(&o));
+    bytes.truncate(bytes.len() - 8);
+    std::fs::write(&npy, &bytes).unwrap();
+    let o = toposmooth(&["extrema", &npy.display().to_string()]);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
 }
 
 #[test]

@@ -5,6 +5,11 @@
 use super::{Domain, PairingRule};
 use crate::error::{Error, Result};
 
+/// Smallest accepted spacing magnitude.
+pub const MIN_SPACING: f64 = 1e-100;
+/// Largest accepted spacing magnitude.
+pub const MAX_SPACING: f64 = 1e100;
+
 /// A grid of `nx` columns × `ny` rows with spacing `(dx, dy)` (signs kept for derived
 /// quantities; operators use |dx|, |dy|) and origin. Nothing per vertex is stored.
 #[derive(Clone, Debug, PartialEq)]
@@ -27,7 +32,8 @@ impl Grid2d {
     /// A grid with the given spacing and origin.
     ///
     /// # Errors
-    /// Fewer than 2 columns or rows, a zero or non-finite spacing, a non-finite origin.
+    /// Fewer than 2 columns or rows, a spacing that is zero, non-finite or outside
+    /// [[`MIN_SPACING`], [`MAX_SPACING`]] in magnitude, a non-finite origin.
     pub fn with_geometry(nx: usize, ny: usize, spacing: [f64; 2], origin: [f64; 2]) -> Result<Self> {
         if nx < 2 || ny < 2 {
             return Err(Error::input(format!("a grid needs at least 2 columns and 2 rows, got {nx} × {ny}")));
@@ -35,8 +41,11 @@ impl Grid2d {
         if nx.checked_mul(ny).is_none() {
             return Err(Error::input(format!("a grid of {nx} × {ny} vertices does not fit in memory")));
         }
-        if spacing.iter().any(|s| !s.is_finite() || *s == 0.0) {
-            return Err(Error::input(format!("grid spacing must be finite and non-zero, got {spacing:?}")));
+        if spacing.iter().any(|s| !(MIN_SPACING..=MAX_SPACING).contains(&s.abs())) {
+            return Err(Error::input(format!(
+                "grid spacing must be finite with {MIN_SPACING:e} ≤ |d| ≤ {MAX_SPACING:e} (so that the \
+                 operators' weights and the cell areas stay representable), got {spacing:?}"
+            )));
         }
         if origin.iter().any(|o| !o.is_finite()) {
             return Err(Error::input(format!("grid origin must be finite, got {origin:?}")));

@@ -14,7 +14,7 @@ mod grid;
 mod order;
 mod series;
 
-pub use grid::Grid2d;
+pub use grid::{Grid2d, MAX_SPACING, MIN_SPACING};
 pub use order::{sos_greater, sos_less, sos_sort, value_range};
 pub use series::Series;
 

@@ -124,6 +124,23 @@ pub fn decode_npy(bytes: &[u8]) -> std::result::Result<([usize; 2], Vec<f64>), S
         return Err(format!("unsupported dtype {}", dtype.descr()));
     };
     let bad = |e: std::io::Error| format!("cannot read the data (truncated?): {e}");
+    // the data must end where the file ends: trailing bytes mean a wrong header or a
+    // concatenated file
+    let data_start = match bytes.get(6) {
+        Some(1) => bytes.get(8..10).map(|h| 10 + u16::from_le_bytes([h[0], h[1]]) as usize),
+        Some(_) => bytes.get(8..12).map(|h| 12 + u32::from_le_bytes([h[0], h[1], h[2], h[3]]) as usize),
+        None => None,
+    };
+    let expected = ny.checked_mul(nx).and_then(|k| k.checked_mul(ts.size_field() as usize));
+    if let (Some(start), Some(len)) = (data_start, expected) {
+        if bytes.len() > start.saturating_add(len) {
+            return Err(format!(
+                "{} bytes after the {len} bytes of data the header describes (shape ({ny}, {nx}), dtype {})",
+                bytes.len() - start - len,
+                dtype.descr()
+            ));
+        }
+    }
     let values: Vec<f64> = match (ts.type_char(), ts.size_field()) {
         (TypeChar::Float, 8) => npy.into_vec::<f64>().map_err(bad)?,
         (TypeChar::Float, 4) => npy.into_vec::<f32>().map_err(bad)?.into_iter().map(f64::from).collect(),

@@ -12,11 +12,11 @@
 //! ```
 
 use crate::constraints::{choose_margin, constraint_edges, margin_cap, max_margin, EdgeSet};
-use crate::domain::{sos_sort, Domain, Grid2d, Series};
+use crate::domain::{sos_sort, Domain, Grid2d, Series, TriMesh};
 use crate::error::{Error, Result};
 use crate::operators::{
-    dirichlet_solve, grid_mass, grid_stiffness, polyharmonic, quadratic_form, scaled_plus_diagonal, series_mass,
-    series_stiffness, Energy, Sparse,
+    cotan_stiffness, dirichlet_solve, grid_mass, grid_stiffness, lumped_mass, polyharmonic, positive_cotan_stiffness,
+    quadratic_form, scaled_plus_diagonal, series_mass, series_stiffness, Energy, Sparse,
 };
 use crate::representative::{flooded_representative, separatrix_representative, series_representative};
 use crate::solve::{repair, solve_monotone_qp, Method, MonotoneQp, QpSettings, RepairSummary, SolveStatus};
@@ -104,6 +104,112 @@ fn harmonic_representative(h: &[f64], kept: &KeptSet, k: &Sparse) -> std::result
     dirichlet_solve(k, &fixed)
 }
 
+/// The representative on a triangulated surface: the chosen construction (the complex is
+/// built either way, for `--complex`); if it fails its check, the other one, then the flooded
+/// one (NOTES.md 9). `k` is the Laplacian of the harmonic fills (non-negative weights).
+fn surface_representative<D: Domain>(
+    domain: &D,
+    h: &[f64],
+    kept: &KeptSet,
+    choice: RepresentativeChoice,
+    k: &Sparse,
+    excluded: &[(&'static str, String)],
+) -> Result<Representative> {
+    let mut why: Vec<String> = excluded.iter().map(|(kind, e)| format!("{kind} representative: {e}")).collect();
+    let skip = |kind: &str| excluded.iter().any(|(x, _)| *x == kind);
+    let complex = match MorseSmale::new(domain, h, kept) {
+        Ok(ms) => Some(ms),
+        Err(e) => {
+            why.push(format!("Morse-Smale complex: {e}"));
+            None
+        }
+    };
+    let released = std::cell::Cell::new(0);
+    let separatrix = |why: &mut Vec<String>| -> Option<Vec<f64>> {
+        let ms = complex.as_ref()?;
+        match separatrix_representative(domain, h, kept, ms, k) {
+            Ok((u, r)) => {
+                let c = certify(domain, &u, &kept.roles, None);
+                released.set(r);
+                if c.passed {
+                    return Some(u);
+                }
+                why.push(format!("separatrix representative: {}", c.summary()));
+            }
+            Err(e) => why.push(format!("separatrix representative: {e}")),
+        }
+        None
+    };
+    let harmonic = |why: &mut Vec<String>| -> Option<Vec<f64>> {
+        match harmonic_representative(h, kept, k) {
+            Ok(u) => {
+                let c = certify(domain, &u, &kept.roles, None);
+                if c.passed {
+                    return Some(u);
+                }
+                why.push(format!("harmonic representative: {}", c.summary()));
+            }
+            Err(e) => why.push(format!("harmonic representative: {e}")),
+        }
+        None
+    };
+    let (first, second): (&'static str, &'static str) = match choice {
+        RepresentativeChoice::Separatrix => ("separatrix", "harmonic"),
+        RepresentativeChoice::Harmonic => ("harmonic", "separatrix"),
+    };
+    let build = |name: &str, why: &mut Vec<String>| if name == "separatrix" { separatrix(why) } else { harmonic(why) };
+    let named = |name: &str, why: &[String]| {
+        let name = if name == "separatrix" && released.get() > 0 {
+            format!("separatrix ({} contradicting separatrix vertices released to the harmonic fill)", released.get())
+        } else {
+            name.to_string()
+        };
+        if why.is_empty() {
+            name
+        } else {
+            format!("{name} (fallback: {})", why.join("; "))
+        }
+    };
+    for kind in [first, second] {
+        if skip(kind) {
+            continue;
+        }
+        if let Some(u) = build(kind, &mut why) {
+            return Ok(Representative { u, kind, name: named(kind, &why), complex });
+        }
+    }
+    if !skip("flooded") {
+        match flooded_representative(domain, h, kept) {
+            Some(u) => return Ok(Representative { u, kind: "flooded", name: named("flooded", &why), complex }),
+            None => why.push("flooded representative: the floods did not settle".into()),
+        }
+    }
+    Err(Error::Representative { path: None, message: why.join("; ") })
+}
+
+impl Smoothable for TriMesh {
+    fn stiffness(&self) -> Sparse {
+        cotan_stiffness(self.positions(), self.faces())
+    }
+    fn mass(&self) -> Vec<f64> {
+        lumped_mass(self.positions(), self.faces())
+    }
+    /// As on grids, but the harmonic fills use [`positive_cotan_stiffness`]: cotangent
+    /// weights of obtuse triangles can be negative and break the maximum principle the
+    /// representative relies on (paper section 5); `k` (the energy's) is not used.
+    fn representative(
+        &self,
+        h: &[f64],
+        kept: &KeptSet,
+        choice: RepresentativeChoice,
+        _k: &Sparse,
+        excluded: &[(&'static str, String)],
+    ) -> Result<Representative> {
+        let fill = positive_cotan_stiffness(self.positions(), self.faces());
+        surface_representative(self, h, kept, choice, &fill, excluded)
+    }
+}
+
 impl Smoothable for Grid2d {
     fn stiffness(&self) -> Sparse {
         grid_stiffness(self)
@@ -111,8 +217,6 @@ impl Smoothable for Grid2d {
     fn mass(&self) -> Vec<f64> {
         grid_mass(self)
     }
-    /// The chosen representative (the complex is built either way, for `--complex`); if it
-    /// fails its check, the other one, then the flooded one (NOTES.md 9).
     fn representative(
         &self,
         h: &[f64],
@@ -121,80 +225,7 @@ impl Smoothable for Grid2d {
         k: &Sparse,
         excluded: &[(&'static str, String)],
     ) -> Result<Representative> {
-        let mut why: Vec<String> = excluded.iter().map(|(kind, e)| format!("{kind} representative: {e}")).collect();
-        let skip = |kind: &str| excluded.iter().any(|(x, _)| *x == kind);
-        let complex = match MorseSmale::new(self, h, kept) {
-            Ok(ms) => Some(ms),
-            Err(e) => {
-                why.push(format!("Morse-Smale complex: {e}"));
-                None
-            }
-        };
-        let released = std::cell::Cell::new(0);
-        let separatrix = |why: &mut Vec<String>| -> Option<Vec<f64>> {
-            let ms = complex.as_ref()?;
-            match separatrix_representative(self, h, kept, ms, k) {
-                Ok((u, r)) => {
-                    let c = certify(self, &u, &kept.roles, None);
-                    released.set(r);
-                    if c.passed {
-                        return Some(u);
-                    }
-                    why.push(format!("separatrix representative: {}", c.summary()));
-                }
-                Err(e) => why.push(format!("separatrix representative: {e}")),
-            }
-            None
-        };
-        let harmonic = |why: &mut Vec<String>| -> Option<Vec<f64>> {
-            match harmonic_representative(h, kept, k) {
-                Ok(u) => {
-                    let c = certify(self, &u, &kept.roles, None);
-                    if c.passed {
-                        return Some(u);
-                    }
-                    why.push(format!("harmonic representative: {}", c.summary()));
-                }
-                Err(e) => why.push(format!("harmonic representative: {e}")),
-            }
-            None
-        };
-        let (first, second): (&'static str, &'static str) = match choice {
-            RepresentativeChoice::Separatrix => ("separatrix", "harmonic"),
-            RepresentativeChoice::Harmonic => ("harmonic", "separatrix"),
-        };
-        let build =
-            |name: &str, why: &mut Vec<String>| if name == "separatrix" { separatrix(why) } else { harmonic(why) };
-        let named = |name: &str, why: &[String]| {
-            let name = if name == "separatrix" && released.get() > 0 {
-                format!(
-                    "separatrix ({} contradicting separatrix vertices released to the harmonic fill)",
-                    released.get()
-                )
-            } else {
-                name.to_string()
-            };
-            if why.is_empty() {
-                name
-            } else {
-                format!("{name} (fallback: {})", why.join("; "))
-            }
-        };
-        for kind in [first, second] {
-            if skip(kind) {
-                continue;
-            }
-            if let Some(u) = build(kind, &mut why) {
-                return Ok(Representative { u, kind, name: named(kind, &why), complex });
-            }
-        }
-        if !skip("flooded") {
-            match flooded_representative(self, h, kept) {
-                Some(u) => return Ok(Representative { u, kind: "flooded", name: named("flooded", &why), complex }),
-                None => why.push("flooded representative: the floods did not settle".into()),
-            }
-        }
-        Err(Error::Representative { path: None, message: why.join("; ") })
+        surface_representative(self, h, kept, choice, k, excluded)
     }
 }
 

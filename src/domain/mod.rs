@@ -11,10 +11,12 @@
 //! ```
 
 mod grid;
+mod mesh;
 mod order;
 mod series;
 
 pub use grid::{Grid2d, MAX_SPACING, MIN_SPACING};
+pub use mesh::{shapes, triangle_area, TriMesh};
 pub use order::{sos_greater, sos_less, sos_sort, value_range};
 pub use series::Series;
 

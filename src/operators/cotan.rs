@@ -1,4 +1,5 @@
-//! Cotangent stiffness and lumped mass on triangles (grids now, meshes later).
+//! Cotangent stiffness and lumped mass on triangles (grids and meshes), and the
+//! positive-weight variant for harmonic fills.
 
 use super::sparse::{from_triplets, Sparse};
 use crate::domain::Grid2d;
@@ -38,6 +39,59 @@ pub fn cotan_stiffness(positions: &[[f64; 3]], triangles: &[[usize; 3]]) -> Spar
         }
     }
     from_triplets(n, n, &t)
+}
+
+/// Stiffness with the cotangent edge weights `w_ij = ½ (cot α_ij + cot β_ij)` clamped from
+/// below at `10⁻³ ×` their mean over the mesh's edges: every weight is strictly positive, so
+/// a harmonic function is at each free vertex a strict weighted average of *all* its
+/// neighbours (the discrete maximum principle on SPEC's neighbour graph: a free vertex is
+/// regular unless all its neighbours are equal). The plain cotangent weights of obtuse
+/// triangles can be negative and break that principle (paper section 5); this is the
+/// Laplacian of the representative's fills, the energy keeps [`cotan_stiffness`].
+pub fn positive_cotan_stiffness(positions: &[[f64; 3]], triangles: &[[usize; 3]]) -> Sparse {
+    let n = positions.len();
+    let weights = edge_weights(positions, triangles);
+    let mean = weights.iter().map(|e| e.2.abs()).sum::<f64>() / weights.len().max(1) as f64;
+    let floor = 1e-3 * mean;
+    let mut t = Vec::with_capacity(4 * weights.len());
+    for &(i, j, w, _) in &weights {
+        let w = w.max(floor);
+        t.push(Triplet::new(i, j, -w));
+        t.push(Triplet::new(j, i, -w));
+        t.push(Triplet::new(i, i, w));
+        t.push(Triplet::new(j, j, w));
+    }
+    from_triplets(n, n, &t)
+}
+
+/// Cotangent weight of every edge `(i, j, w_ij, triangles on it)`, `i < j`, sorted (a
+/// deterministic order, so that sums do not depend on hashing).
+fn edge_weights(positions: &[[f64; 3]], triangles: &[[usize; 3]]) -> Vec<(usize, usize, f64, u8)> {
+    let mut half: Vec<(usize, usize, f64)> = Vec::with_capacity(3 * triangles.len());
+    for tri in triangles {
+        for k in 0..3 {
+            let (i, j, o) = (tri[k], tri[(k + 1) % 3], tri[(k + 2) % 3]);
+            let (a, b) = (sub(positions[i], positions[o]), sub(positions[j], positions[o]));
+            half.push((i.min(j), i.max(j), 0.5 * dot(a, b) / cross_norm(a, b)));
+        }
+    }
+    half.sort_by(|a, b| (a.0, a.1).cmp(&(b.0, b.1)));
+    let mut out: Vec<(usize, usize, f64, u8)> = Vec::with_capacity(half.len() / 2 + 1);
+    for (i, j, w) in half {
+        match out.last_mut() {
+            Some(e) if e.0 == i && e.1 == j => {
+                e.2 += w;
+                e.3 += 1;
+            }
+            _ => out.push((i, j, w, 1)),
+        }
+    }
+    out
+}
+
+/// Number of interior edges whose cotangent weight is negative (obtuse opposite angles).
+pub fn negative_cotan_edges(positions: &[[f64; 3]], triangles: &[[usize; 3]]) -> usize {
+    edge_weights(positions, triangles).iter().filter(|e| e.3 == 2 && e.2 < 0.0).count()
 }
 
 /// Lumped (barycentric) mass: a third of the area of every triangle at each of its vertices.

@@ -22,7 +22,9 @@ mod polyharmonic;
 mod series;
 mod sparse;
 
-pub use cotan::{cotan_stiffness, grid_mass, grid_stiffness, lumped_mass};
+pub use cotan::{
+    cotan_stiffness, grid_mass, grid_stiffness, lumped_mass, negative_cotan_edges, positive_cotan_stiffness,
+};
 pub use harmonic::{dirichlet_solve, Dirichlet};
 pub use polyharmonic::{polyharmonic, Energy};
 pub use series::{series_mass, series_stiffness};

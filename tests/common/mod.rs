@@ -76,3 +76,28 @@ pub fn grid_extrema(nx: usize, ny: usize, f: &[f64]) -> (Vec<usize>, Vec<usize>,
     }
     (mins, maxs, flat)
 }
+
+/// Strict extrema and flat vertices of a field on a triangle mesh (neighbours: vertices
+/// sharing an edge), from the triangles alone, independently of the crate's adjacency.
+pub fn mesh_extrema(n: usize, triangles: &[[usize; 3]], f: &[f64]) -> (Vec<usize>, Vec<usize>, Vec<usize>) {
+    let mut nb: Vec<std::collections::BTreeSet<usize>> = vec![Default::default(); n];
+    for t in triangles {
+        for k in 0..3 {
+            nb[t[k]].insert(t[(k + 1) % 3]);
+            nb[t[(k + 1) % 3]].insert(t[k]);
+        }
+    }
+    let (mut mins, mut maxs, mut flat) = (vec![], vec![], vec![]);
+    for v in 0..n {
+        let lower = nb[v].iter().filter(|&&w| f[w] < f[v]).count();
+        let higher = nb[v].iter().filter(|&&w| f[w] > f[v]).count();
+        if higher == nb[v].len() {
+            mins.push(v);
+        } else if lower == nb[v].len() {
+            maxs.push(v);
+        } else if lower == 0 || higher == 0 {
+            flat.push(v);
+        }
+    }
+    (mins, maxs, flat)
+}

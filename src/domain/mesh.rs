@@ -1,0 +1,623 @@
+//! Triangle meshes in 2D or 3D (SPEC.md, "Mesh"): neighbours are the vertices sharing an edge.
+//!
+//! [`TriMesh::new`] validates what the rest of the crate relies on and says what it found:
+//! finite coordinates, indices in range, no repeated corner, no zero-area or duplicate
+//! triangle, every vertex used, every edge on at most two triangles, every vertex's triangles
+//! forming one fan (manifold vertices). Inconsistent orientation is repaired (triangles are
+//! flipped to agree with their component's first triangle, when the component is orientable)
+//! and reported in [`TriMesh::repairs`]. Duplicate positions are reported as an error: merging
+//! them would glue vertices that carry their own field values.
+//!
+//! ```
+//! use toposmooth::domain::{Domain, TriMesh};
+//! // two triangles forming a square
+//! let m = TriMesh::new(
+//!     vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.0]],
+//!     vec![[0, 1, 2], [0, 2, 3]],
+//! )?;
+//! assert_eq!(m.neighbors(0).collect::<Vec<_>>(), vec![1, 2, 3]);
+//! assert_eq!(m.boundary_loops(), 1);
+//! assert_eq!(m.euler_characteristic(), 1);
+//! # Ok::<(), toposmooth::Error>(())
+//! ```
+
+use super::{Domain, PairingRule};
+use crate::error::{Error, Result};
+use std::collections::HashMap;
+
+/// A validated triangle mesh with its vertex adjacency.
+#[derive(Clone, Debug)]
+pub struct TriMesh {
+    positions: Vec<[f64; 3]>,
+    triangles: Vec<[usize; 3]>,
+    /// Neighbours of vertex v: `adj[start[v]..start[v + 1]]`, sorted.
+    start: Vec<usize>,
+    adj: Vec<usize>,
+    n_edges: usize,
+    boundary_loops: usize,
+    components: Vec<usize>,
+    n_components: usize,
+    diameter: f64,
+    repairs: Vec<String>,
+}
+
+/// At most this many offending elements are named in a message.
+const SHOW: usize = 5;
+
+fn list<T: std::fmt::Display>(items: &[T]) -> String {
+    let shown: Vec<String> = items.iter().take(SHOW).map(|x| x.to_string()).collect();
+    if items.len() > SHOW {
+        format!("{}, … ({} in all)", shown.join(", "), items.len())
+    } else {
+        shown.join(", ")
+    }
+}
+
+fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+}
+
+fn norm(a: [f64; 3]) -> f64 {
+    (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt()
+}
+
+/// Area of a triangle given by its corner positions.
+pub fn triangle_area(a: [f64; 3], b: [f64; 3], c: [f64; 3]) -> f64 {
+    0.5 * norm(cross(sub(b, a), sub(c, a)))
+}
+
+impl TriMesh {
+    /// Validates and builds a mesh (vertex indices 0-based). Messages name the first
+    /// offending vertices or triangles; the caller adds the file name.
+    ///
+    /// # Errors
+    /// [`Error::Input`] for: no triangle, a non-finite coordinate, an index out of range, a
+    /// triangle repeating a vertex, a zero-area triangle, a duplicate triangle, an unused
+    /// vertex, two vertices at one position, an edge on more than two triangles, a vertex
+    /// whose triangles form more than one fan.
+    pub fn new(positions: Vec<[f64; 3]>, mut triangles: Vec<[usize; 3]>) -> Result<TriMesh> {
+        let n = positions.len();
+        if n == 0 || triangles.is_empty() {
+            return Err(Error::input(format!(
+                "the mesh has {n} vertices and {} triangles: it needs at least one triangle",
+                triangles.len()
+            )));
+        }
+        let bad: Vec<usize> = (0..n).filter(|&v| positions[v].iter().any(|x| !x.is_finite())).collect();
+        if !bad.is_empty() {
+            return Err(Error::input(format!("non-finite coordinates at vertices {}", list(&bad))));
+        }
+        let bad: Vec<usize> = (0..triangles.len()).filter(|&t| triangles[t].iter().any(|&v| v >= n)).collect();
+        if !bad.is_empty() {
+            return Err(Error::input(format!(
+                "triangles {} use a vertex index beyond the {n} vertices (e.g. triangle {} = {:?})",
+                list(&bad),
+                bad[0],
+                triangles[bad[0]]
+            )));
+        }
+        let bad: Vec<usize> = (0..triangles.len())
+            .filter(|&t| {
+                let [a, b, c] = triangles[t];
+                a == b || b == c || a == c
+            })
+            .collect();
+        if !bad.is_empty() {
+            return Err(Error::input(format!(
+                "triangles {} repeat a vertex (e.g. triangle {} = {:?})",
+                list(&bad),
+                bad[0],
+                triangles[bad[0]]
+            )));
+        }
+        // zero area relative to the mesh's scale (bounding-box diagonal)
+        let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+        for p in &positions {
+            for k in 0..3 {
+                lo[k] = lo[k].min(p[k]);
+                hi[k] = hi[k].max(p[k]);
+            }
+        }
+        let diameter = norm(sub(hi, lo));
+        let bad: Vec<usize> = (0..triangles.len())
+            .filter(|&t| {
+                let [a, b, c] = triangles[t];
+                triangle_area(positions[a], positions[b], positions[c]) <= 1e-14 * diameter * diameter
+            })
+            .collect();
+        if !bad.is_empty() {
+            return Err(Error::input(format!(
+                "triangles {} have zero area (degenerate: collinear or coincident corners)",
+                list(&bad)
+            )));
+        }
+        let mut seen: HashMap<[usize; 3], usize> = HashMap::with_capacity(triangles.len());
+        let mut dups = Vec::new();
+        for (t, tri) in triangles.iter().enumerate() {
+            let mut key = *tri;
+            key.sort_unstable();
+            if let Some(&first) = seen.get(&key) {
+                dups.push(format!("{t} (= {first})"));
+            } else {
+                seen.insert(key, t);
+            }
+        }
+        drop(seen);
+        if !dups.is_empty() {
+            return Err(Error::input(format!("duplicate triangles {}", list(&dups))));
+        }
+        let mut used = vec![false; n];
+        for tri in &triangles {
+            for &v in tri {
+                used[v] = true;
+            }
+        }
+        let bad: Vec<usize> = (0..n).filter(|&v| !used[v]).collect();
+        if !bad.is_empty() {
+            return Err(Error::input(format!("vertices {} are used by no triangle", list(&bad))));
+        }
+        let mut order: Vec<usize> = (0..n).collect();
+        order.sort_unstable_by(|&a, &b| positions[a].partial_cmp(&positions[b]).expect("finite"));
+        let dups: Vec<String> = order
+            .windows(2)
+            .filter(|w| positions[w[0]] == positions[w[1]])
+            .map(|w| format!("{} and {}", w[0].min(w[1]), w[0].max(w[1])))
+            .collect();
+        if !dups.is_empty() {
+            return Err(Error::input(format!(
+                "vertices at the same position: {} (a triangle soup? merge duplicate vertices first)",
+                list(&dups)
+            )));
+        }
+        // edges and their triangles
+        let mut edge_tris: HashMap<(usize, usize), Vec<usize>> = HashMap::with_capacity(3 * triangles.len() / 2);
+        for (t, tri) in triangles.iter().enumerate() {
+            for k in 0..3 {
+                let (a, b) = (tri[k], tri[(k + 1) % 3]);
+                edge_tris.entry((a.min(b), a.max(b))).or_default().push(t);
+            }
+        }
+        let mut bad: Vec<String> = edge_tris
+            .iter()
+            .filter(|(_, ts)| ts.len() > 2)
+            .map(|(e, ts)| format!("{}–{} ({} triangles)", e.0, e.1, ts.len()))
+            .collect();
+        bad.sort();
+        if !bad.is_empty() {
+            return Err(Error::input(format!("non-manifold edges (on more than two triangles): {}", list(&bad))));
+        }
+        // manifold vertices: the triangles around a vertex are connected through its edges
+        let mut vertex_tris: Vec<Vec<usize>> = vec![Vec::new(); n];
+        for (t, tri) in triangles.iter().enumerate() {
+            for &v in tri {
+                vertex_tris[v].push(t);
+            }
+        }
+        let mut bad = Vec::new();
+        for v in 0..n {
+            let ts = &vertex_tris[v];
+            if ts.len() < 2 {
+                continue;
+            }
+            // walk from the first triangle across the edges at v
+            let mut reached = vec![false; ts.len()];
+            let mut stack = vec![0usize];
+            reached[0] = true;
+            while let Some(i) = stack.pop() {
+                for &w in &triangles[ts[i]] {
+                    if w == v {
+                        continue;
+                    }
+                    for &t2 in &edge_tris[&(v.min(w), v.max(w))] {
+                        if let Some(j) = ts.iter().position(|&x| x == t2) {
+                            if !reached[j] {
+                                reached[j] = true;
+                                stack.push(j);
+                            }
+                        }
+                    }
+                }
+            }
+            if reached.iter().any(|r| !r) {
+                bad.push(v);
+            }
+        }
+        if !bad.is_empty() {
+            return Err(Error::input(format!(
+                "non-manifold vertices {} (their triangles form more than one fan)",
+                list(&bad)
+            )));
+        }
+        // components of the triangle graph; consistent orientation by BFS
+        let mut tri_comp = vec![usize::MAX; triangles.len()];
+        let mut n_components = 0;
+        let mut flipped = 0usize;
+        let mut non_orientable = 0usize;
+        for seed in 0..triangles.len() {
+            if tri_comp[seed] != usize::MAX {
+                continue;
+            }
+            tri_comp[seed] = n_components;
+            let mut queue = std::collections::VecDeque::from([seed]);
+            while let Some(t) = queue.pop_front() {
+                let tri = triangles[t];
+                for k in 0..3 {
+                    let (a, b) = (tri[k], tri[(k + 1) % 3]);
+                    for &t2 in &edge_tris[&(a.min(b), a.max(b))] {
+                        if t2 == t {
+                            continue;
+                        }
+                        // t2 agrees with t when it runs the shared edge b → a
+                        let o = triangles[t2];
+                        let same = (0..3).any(|j| o[j] == a && o[(j + 1) % 3] == b);
+                        if tri_comp[t2] == usize::MAX {
+                            tri_comp[t2] = n_components;
+                            if same {
+                                triangles[t2].swap(1, 2);
+                                flipped += 1;
+                            }
+                            queue.push_back(t2);
+                        } else if same {
+                            non_orientable += 1;
+                        }
+                    }
+                }
+            }
+            n_components += 1;
+        }
+        let mut repairs = Vec::new();
+        if flipped > 0 {
+            repairs.push(format!(
+                "{flipped} triangles flipped to agree in orientation with their neighbours (inconsistent orientation)"
+            ));
+        }
+        if non_orientable > 0 {
+            repairs.push("the surface is not orientable: orientation left inconsistent across some edges".into());
+        }
+        let mut components = vec![0usize; n];
+        for (t, tri) in triangles.iter().enumerate() {
+            for &v in tri {
+                components[v] = tri_comp[t];
+            }
+        }
+        // adjacency
+        let mut edges: Vec<(usize, usize)> = edge_tris.keys().copied().collect();
+        edges.sort_unstable();
+        let boundary: Vec<(usize, usize)> = edges.iter().copied().filter(|e| edge_tris[e].len() == 1).collect();
+        let n_edges = edges.len();
+        let mut start = vec![0usize; n + 1];
+        for &(a, b) in &edges {
+            start[a + 1] += 1;
+            start[b + 1] += 1;
+        }
+        for v in 0..n {
+            start[v + 1] += start[v];
+        }
+        let mut fill = start.clone();
+        let mut adj = vec![0usize; start[n]];
+        for &(a, b) in &edges {
+            adj[fill[a]] = b;
+            fill[a] += 1;
+            adj[fill[b]] = a;
+            fill[b] += 1;
+        }
+        for v in 0..n {
+            adj[start[v]..start[v + 1]].sort_unstable();
+        }
+        // boundary loops: components of the boundary edges (manifold vertices: each boundary
+        // vertex has exactly two boundary edges, so these are cycles)
+        let mut parent: Vec<usize> = (0..n).collect();
+        fn find(p: &mut [usize], mut x: usize) -> usize {
+            while p[x] != x {
+                p[x] = p[p[x]];
+                x = p[x];
+            }
+            x
+        }
+        for &(a, b) in &boundary {
+            let (ra, rb) = (find(&mut parent, a), find(&mut parent, b));
+            if ra != rb {
+                parent[ra] = rb;
+            }
+        }
+        let mut roots: Vec<usize> = boundary.iter().map(|&(a, _)| find(&mut parent, a)).collect();
+        roots.sort_unstable();
+        roots.dedup();
+        Ok(TriMesh {
+            positions,
+            triangles,
+            start,
+            adj,
+            n_edges,
+            boundary_loops: roots.len(),
+            components,
+            n_components,
+            diameter,
+            repairs,
+        })
+    }
+
+    /// Vertex positions.
+    pub fn positions(&self) -> &[[f64; 3]] {
+        &self.positions
+    }
+
+    /// Triangles (orientation made consistent where it was not).
+    pub fn faces(&self) -> &[[usize; 3]] {
+        &self.triangles
+    }
+
+    /// Number of edges.
+    pub fn n_edges(&self) -> usize {
+        self.n_edges
+    }
+
+    /// Number of boundary loops (0 for a closed surface).
+    pub fn boundary_loops(&self) -> usize {
+        self.boundary_loops
+    }
+
+    /// Number of connected components.
+    pub fn n_components(&self) -> usize {
+        self.n_components
+    }
+
+    /// Component of each vertex.
+    pub fn components(&self) -> &[usize] {
+        &self.components
+    }
+
+    /// `V − E + F`.
+    pub fn euler_characteristic(&self) -> i64 {
+        self.positions.len() as i64 - self.n_edges as i64 + self.triangles.len() as i64
+    }
+
+    /// Genus of an orientable surface: `(2c − χ − b) / 2` over c components and b boundary
+    /// loops (the total over components).
+    pub fn genus(&self) -> i64 {
+        (2 * self.n_components as i64 - self.euler_characteristic() - self.boundary_loops as i64) / 2
+    }
+
+    /// What validation repaired (empty when nothing).
+    pub fn repairs(&self) -> &[String] {
+        &self.repairs
+    }
+
+    /// Whether the mesh lies in the plane z = 0.
+    pub fn is_planar(&self) -> bool {
+        self.positions.iter().all(|p| p[2] == 0.0)
+    }
+
+    /// One line: vertices, triangles, components, boundary loops, genus.
+    pub fn describe(&self) -> String {
+        format!(
+            "{} vertices, {} triangles, {} component{}, {} boundary loop{}, genus {}",
+            self.positions.len(),
+            self.triangles.len(),
+            self.n_components,
+            if self.n_components == 1 { "" } else { "s" },
+            self.boundary_loops,
+            if self.boundary_loops == 1 { "" } else { "s" },
+            self.genus()
+        )
+    }
+}
+
+impl Domain for TriMesh {
+    fn n_vertices(&self) -> usize {
+        self.positions.len()
+    }
+
+    fn neighbors(&self, v: usize) -> impl Iterator<Item = usize> + '_ {
+        self.adj[self.start[v]..self.start[v + 1]].iter().copied()
+    }
+
+    fn pairing_rule(&self) -> PairingRule {
+        PairingRule::Surface
+    }
+
+    fn diameter(&self) -> f64 {
+        self.diameter
+    }
+
+    fn point(&self, v: usize) -> [f64; 3] {
+        self.positions[v]
+    }
+
+    fn triangles(&self) -> Vec<[usize; 3]> {
+        self.triangles.clone()
+    }
+}
+
+/// Test and example meshes: a UV sphere, a torus, a disk with holes.
+pub mod shapes {
+    use super::TriMesh;
+    use std::f64::consts::PI;
+
+    /// A UV sphere of radius `r` with `rings` latitude bands and `segments` meridians
+    /// (poles as single vertices).
+    ///
+    /// # Panics
+    /// If `rings < 2` or `segments < 3`.
+    pub fn sphere(r: f64, rings: usize, segments: usize) -> TriMesh {
+        assert!(rings >= 2 && segments >= 3);
+        let mut p = vec![[0.0, 0.0, r]];
+        for i in 1..rings {
+            let th = PI * i as f64 / rings as f64;
+            for j in 0..segments {
+                let ph = 2.0 * PI * j as f64 / segments as f64;
+                p.push([r * th.sin() * ph.cos(), r * th.sin() * ph.sin(), r * th.cos()]);
+            }
+        }
+        p.push([0.0, 0.0, -r]);
+        let south = p.len() - 1;
+        let ring = |i: usize, j: usize| 1 + (i - 1) * segments + j % segments;
+        let mut t = Vec::new();
+        for j in 0..segments {
+            t.push([0, ring(1, j), ring(1, j + 1)]);
+            t.push([south, ring(rings - 1, j + 1), ring(rings - 1, j)]);
+        }
+        for i in 1..rings - 1 {
+            for j in 0..segments {
+                t.push([ring(i, j), ring(i + 1, j), ring(i + 1, j + 1)]);
+                t.push([ring(i, j), ring(i + 1, j + 1), ring(i, j + 1)]);
+            }
+        }
+        TriMesh::new(p, t).expect("a valid sphere")
+    }
+
+    /// A torus with radii `big` > `small`, `nu` × `nv` vertices.
+    ///
+    /// # Panics
+    /// If `nu < 3` or `nv < 3`.
+    pub fn torus(big: f64, small: f64, nu: usize, nv: usize) -> TriMesh {
+        assert!(nu >= 3 && nv >= 3);
+        let mut p = Vec::new();
+        for i in 0..nu {
+            let a = 2.0 * PI * i as f64 / nu as f64;
+            for j in 0..nv {
+                let b = 2.0 * PI * j as f64 / nv as f64;
+                let rr = big + small * b.cos();
+                p.push([rr * a.cos(), rr * a.sin(), small * b.sin()]);
+            }
+        }
+        let id = |i: usize, j: usize| (i % nu) * nv + j % nv;
+        let mut t = Vec::new();
+        for i in 0..nu {
+            for j in 0..nv {
+                t.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
+                t.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
+            }
+        }
+        TriMesh::new(p, t).expect("a valid torus")
+    }
+
+    /// A planar disk of radius 1 triangulated in `rings` rings of `segments` vertices
+    /// around a centre vertex; rings whose radius falls inside one of `holes` (centre, radius)
+    /// lose the triangles there, leaving holes.
+    ///
+    /// # Panics
+    /// If the holes leave an invalid mesh.
+    pub fn disk(rings: usize, segments: usize, holes: &[([f64; 2], f64)]) -> TriMesh {
+        let mut p = vec![[0.0, 0.0, 0.0]];
+        for i in 1..=rings {
+            let r = i as f64 / rings as f64;
+            for j in 0..segments {
+                // alternate rings are rotated half a step: better-shaped triangles
+                let a = 2.0 * PI * (j as f64 + 0.5 * (i % 2) as f64) / segments as f64;
+                p.push([r * a.cos(), r * a.sin(), 0.0]);
+            }
+        }
+        let ring = |i: usize, j: usize| if i == 0 { 0 } else { 1 + (i - 1) * segments + j % segments };
+        let mut t = Vec::new();
+        for j in 0..segments {
+            t.push([0, ring(1, j), ring(1, j + 1)]);
+        }
+        for i in 1..rings {
+            for j in 0..segments {
+                if i % 2 == 1 {
+                    t.push([ring(i, j), ring(i + 1, j), ring(i + 1, j + 1)]);
+                    t.push([ring(i, j), ring(i + 1, j + 1), ring(i, j + 1)]);
+                } else {
+                    t.push([ring(i, j), ring(i + 1, j), ring(i, j + 1)]);
+                    t.push([ring(i, j + 1), ring(i + 1, j), ring(i + 1, j + 1)]);
+                }
+            }
+        }
+        let inside = |v: usize| holes.iter().any(|(c, r)| (p[v][0] - c[0]).hypot(p[v][1] - c[1]) < *r);
+        t.retain(|tri| !tri.iter().any(|&v| inside(v)));
+        // drop vertices no triangle uses, renumbering
+        let mut map = vec![usize::MAX; p.len()];
+        let mut q = Vec::new();
+        for tri in &t {
+            for &v in tri {
+                if map[v] == usize::MAX {
+                    map[v] = q.len();
+                    q.push(p[v]);
+                }
+            }
+        }
+        let t = t.into_iter().map(|tri| tri.map(|v| map[v])).collect();
+        TriMesh::new(q, t).expect("a valid disk")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::shapes::*;
+    use super::*;
+
+    fn square() -> (Vec<[f64; 3]>, Vec<[usize; 3]>) {
+        (vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.0]], vec![[0, 1, 2], [0, 2, 3]])
+    }
+
+    #[test]
+    fn shapes_have_the_right_topology() {
+        let s = sphere(1.0, 8, 12);
+        assert_eq!((s.euler_characteristic(), s.boundary_loops(), s.genus(), s.n_components()), (2, 0, 0, 1));
+        let t = torus(3.0, 1.0, 12, 8);
+        assert_eq!((t.euler_characteristic(), t.boundary_loops(), t.genus()), (0, 0, 1));
+        let d = disk(6, 16, &[]);
+        assert_eq!((d.euler_characteristic(), d.boundary_loops(), d.genus()), (1, 1, 0));
+        let h = disk(12, 32, &[([0.5, 0.0], 0.2), ([-0.5, 0.0], 0.2)]);
+        assert_eq!((h.euler_characteristic(), h.boundary_loops(), h.genus()), (-1, 3, 0));
+        assert!(s.repairs().is_empty() && t.repairs().is_empty() && h.repairs().is_empty());
+    }
+
+    #[test]
+    fn orientation_is_repaired_and_reported() {
+        let (p, mut t) = square();
+        t[1] = [0, 3, 2];
+        let m = TriMesh::new(p, t).unwrap();
+        assert_eq!(m.repairs().len(), 1, "{:?}", m.repairs());
+        assert_eq!(m.faces()[1], [0, 2, 3]);
+    }
+
+    #[test]
+    fn invalid_meshes_are_refused_with_the_offending_elements() {
+        let (p, t) = square();
+        let err = |p: Vec<[f64; 3]>, t: Vec<[usize; 3]>| TriMesh::new(p, t).unwrap_err().to_string();
+        let mut q = p.clone();
+        q[2][1] = f64::NAN;
+        assert!(err(q, t.clone()).contains("non-finite coordinates at vertices 2"));
+        assert!(err(p.clone(), vec![[0, 1, 7]]).contains("beyond the 4 vertices"));
+        assert!(err(p.clone(), vec![[0, 1, 1], [0, 2, 3]]).contains("repeat a vertex"));
+        let mut q = p.clone();
+        q[3] = [2.0, 2.0, 0.0]; // 0, 2, 3 collinear
+        assert!(err(q, t.clone()).contains("triangles 1 have zero area"));
+        assert!(err(p.clone(), vec![[0, 1, 2], [0, 2, 3], [2, 0, 1]]).contains("duplicate triangles 2 (= 0)"));
+        let mut q = p.clone();
+        q.push([5.0, 5.0, 0.0]);
+        assert!(err(q, t.clone()).contains("vertices 4 are used by no triangle"));
+        let mut q = p.clone();
+        q.push([1.0, 1.0, 0.0]);
+        let mut u = t.clone();
+        u.push([1, 4, 3]);
+        assert!(err(q, u).contains("same position: 2 and 4"));
+        // three triangles on edge 0–2
+        let mut q = p.clone();
+        q.push([0.5, 0.5, 1.0]);
+        let mut u = t.clone();
+        u.push([0, 2, 4]);
+        assert!(err(q, u).contains("non-manifold edges"));
+        // two fans meeting at vertex 0 (a bowtie)
+        let q = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [-1.0, 0.0, 0.0], [-1.0, -1.0, 0.0]];
+        assert!(err(q, vec![[0, 1, 2], [0, 3, 4]]).contains("non-manifold vertices 0"));
+        assert!(err(Vec::new(), Vec::new()).contains("at least one triangle"));
+    }
+
+    #[test]
+    fn components_are_counted() {
+        let (mut p, mut t) = square();
+        p.extend([[5.0, 0.0, 0.0], [6.0, 0.0, 0.0], [5.0, 1.0, 0.0]]);
+        t.push([4, 5, 6]);
+        let m = TriMesh::new(p, t).unwrap();
+        assert_eq!(m.n_components(), 2);
+        assert_eq!(m.components(), &[0, 0, 0, 0, 1, 1, 1]);
+        assert_eq!(m.boundary_loops(), 2);
+    }
+}

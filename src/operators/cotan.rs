@@ -75,7 +75,7 @@ fn edge_weights(positions: &[[f64; 3]], triangles: &[[usize; 3]]) -> Vec<(usize,
             half.push((i.min(j), i.max(j), 0.5 * dot(a, b) / cross_norm(a, b)));
         }
     }
-    half.sort_by(|a, b| (a.0, a.1).cmp(&(b.0, b.1)));
+    half.sort_by_key(|e| (e.0, e.1));
     let mut out: Vec<(usize, usize, f64, u8)> = Vec::with_capacity(half.len() / 2 + 1);
     for (i, j, w) in half {
         match out.last_mut() {

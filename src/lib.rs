@@ -9,6 +9,7 @@
 //! pipeline's report.
 #![warn(missing_docs)]
 
+pub mod apps;
 pub mod domain;
 pub mod error;
 pub mod operators;

@@ -57,6 +57,20 @@ enum Command {
         #[command(flatten)]
         grid: GridCli,
     },
+    /// Geodesic distance on a triangle mesh from source vertices (heat method).
+    Geodesic {
+        /// Mesh: .obj, .off, .ply, .vtu, .vtp.
+        input: PathBuf,
+        /// Source vertex indices (0-based, comma-separated).
+        #[arg(long, value_name = "V")]
+        source: String,
+        /// Output mesh with the point array `distance` (.vtu, .vtp, .ply).
+        #[arg(short, long)]
+        output: PathBuf,
+        /// JSON report with per-stage seconds.
+        #[arg(long, value_name = "JSON")]
+        report: Option<PathBuf>,
+    },
     /// Benchmark on random-walk series and noisy grids: seconds per stage and peak memory.
     Bench {
         /// Series lengths `N` and grid sizes `NXxNY` (grids keep 7 minima and 6 maxima).
@@ -85,12 +99,12 @@ enum Command {
 
 #[derive(Args)]
 struct GridCli {
-    /// Read the input as a series or a grid (default: by extension; a CSV whose first line is
-    /// three or more numbers is a grid matrix).
+    /// Read the input as a series, a grid or a mesh (default: by extension — .obj, .off, .ply,
+    /// .vtu, .vtp are meshes; a CSV whose first line is three or more numbers is a grid matrix).
     #[arg(long, value_enum, default_value_t = DomainCli::Auto)]
     domain: DomainCli,
-    /// Grid: point array of a VTK file (default: the only scalar array, or with --derive the
-    /// only vector array).
+    /// Point array of a VTK file or PLY vertex property (default: the only scalar array, or
+    /// with --derive the only vector array); on a mesh also `x`, `y` or `z`.
     #[arg(long, value_name = "NAME")]
     array: Option<String>,
     /// Grid spacing `dx,dy` (overrides the file's; may be negative, e.g. rows running down).
@@ -109,6 +123,10 @@ struct GridCli {
     /// Grid: fill missing (NaN) samples by harmonic interpolation instead of refusing them.
     #[arg(long)]
     fill_missing: bool,
+    /// Mesh: the field as one value per vertex and line of a text file (instead of --array;
+    /// `--array x|y|z` takes a coordinate).
+    #[arg(long, value_name = "FILE")]
+    values: Option<PathBuf>,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -116,6 +134,7 @@ enum DomainCli {
     Auto,
     Series,
     Grid,
+    Mesh,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -136,6 +155,7 @@ impl GridCli {
             DomainCli::Auto => DomainKind::Auto,
             DomainCli::Series => DomainKind::Series,
             DomainCli::Grid => DomainKind::Grid,
+            DomainCli::Mesh => DomainKind::Mesh,
         }
     }
 
@@ -169,6 +189,7 @@ impl GridCli {
             }),
             uv: self.u.clone().zip(self.v.clone()),
             fill_missing: self.fill_missing,
+            values: self.values.clone(),
         })
     }
 }
@@ -237,6 +258,13 @@ struct SmoothCli {
     /// Grids: keep the M most persistent maxima (with --minima).
     #[arg(long, value_name = "M", requires = "minima")]
     maxima: Option<usize>,
+    /// Surfaces: keep every maximum of persistence > 0 and only the global minimum (geodesic
+    /// distance from a source keeps its maxima).
+    #[arg(long, conflicts_with_all = ["persistence", "pairs", "minima", "keep_min", "keep_max", "keep_all_minima"])]
+    keep_all_maxima: bool,
+    /// Surfaces: keep every minimum of persistence > 0 and only the global maximum.
+    #[arg(long, conflicts_with_all = ["persistence", "pairs", "minima", "keep_min", "keep_max"])]
+    keep_all_minima: bool,
     /// Keep exactly these minima (vertex indices, comma-separated; grids: row·nx + column);
     /// needs --keep-max.
     #[arg(long, value_name = "I,J", requires = "keep_max")]
@@ -294,6 +322,8 @@ fn method(s: Solver) -> Method {
 
 fn smooth_args(c: SmoothCli) -> Result<SmoothArgs> {
     let selection = match (&c.persistence, c.pairs, &c.keep_min, &c.keep_max) {
+        _ if c.keep_all_maxima => Selection::AllMaxima,
+        _ if c.keep_all_minima => Selection::AllMinima,
         (Some(p), _, _, _) => commands::parse_persistence(p)?,
         (None, Some(n), _, _) => Selection::Pairs(n),
         (None, None, _, _) if c.minima.is_some() => {
@@ -347,6 +377,12 @@ fn run(cli: Cli) -> Result<String> {
             selection: commands::parse_persistence(&persistence)?,
         }),
         Command::Smooth(c) => commands::smooth(&smooth_args(*c)?),
+        Command::Geodesic { input, source, output, report } => commands::geodesic(&commands::GeodesicArgs {
+            input,
+            sources: commands::parse_indices(&source)?,
+            output,
+            report,
+        }),
         Command::Verify { file, input, csv, grid } => {
             commands::verify(&VerifyArgs { file, input, csv: csv.options(), grid: grid.options()? })
         }

@@ -35,6 +35,8 @@ pub struct Certificate {
     pub strict_maxima: usize,
     /// Vertices that are neither regular nor strict extrema (flat spots).
     pub flat: usize,
+    /// Free ends among the strict extrema (series).
+    pub free_ends: usize,
     /// Whether kept values were compared with the input (item 3).
     pub kept_values_checked: bool,
     /// Number of failures found.
@@ -47,8 +49,12 @@ impl Certificate {
     /// One line naming the failed items and the first offending vertices.
     pub fn summary(&self) -> String {
         if self.passed {
+            let ends = match self.free_ends {
+                0 => String::new(),
+                k => format!(" ({k} free end{} included)", if k == 1 { "" } else { "s" }),
+            };
             return format!(
-                "certified: {} strict minima and {} strict maxima (free ends included), exactly the kept ones; no other extremum, no flat spot",
+                "certified: {} strict minima and {} strict maxima{ends}, exactly the kept ones; no other extremum, no flat spot",
                 self.strict_minima, self.strict_maxima
             );
         }
@@ -133,6 +139,7 @@ pub fn certify<D: Domain>(domain: &D, f: &[f64], roles: &[Role], input: Option<&
         strict_minima,
         strict_maxima,
         flat,
+        free_ends: roles.iter().filter(|&&r| r == Role::End).count(),
         kept_values_checked: input.is_some(),
         failure_count,
         failures,

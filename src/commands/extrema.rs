@@ -60,7 +60,7 @@ pub fn extrema(args: &ExtremaArgs) -> Result<String> {
             let path = args.input.clone().unwrap_or_default();
             let series = Series::with_coordinates(data.x.clone()).map_err(|e| e.in_file(&path))?;
             let label = |i: usize| data.x_text[i].clone();
-            list(args, &path, &series, &data.values, &data.column, None, &label)
+            list(args, &path, &series, &data.values, &data.column, None, None, &label)
         }
         FieldInput::Grid(data) => {
             let g = &data.grid;
@@ -68,11 +68,21 @@ pub fn extrema(args: &ExtremaArgs) -> Result<String> {
                 let (r, c) = g.row_col(i);
                 format!("({r},{c})")
             };
-            list(args, &data.path, g, &data.values, &data.description, Some([g.nx(), g.ny()]), &label)
+            list(args, &data.path, g, &data.values, &data.description, Some([g.nx(), g.ny()]), None, &label)
+        }
+        FieldInput::Mesh(data) => {
+            let m = &data.mesh;
+            let label = |i: usize| {
+                let p = m.positions()[i];
+                format!("({},{},{})", sig6(p[0]), sig6(p[1]), sig6(p[2]))
+            };
+            let what = format!("mesh of {}", m.describe());
+            list(args, &data.path, m, &data.values, &data.description, None, Some(what), &label)
         }
     }
 }
 
+#[allow(clippy::too_many_arguments)]
 fn list<D: Domain>(
     args: &ExtremaArgs,
     path: &Path,
@@ -80,8 +90,10 @@ fn list<D: Domain>(
     h: &[f64],
     column: &str,
     grid: Option<[usize; 2]>,
+    mesh: Option<String>,
     label: &dyn Fn(usize) -> String,
 ) -> Result<String> {
+    let surface = grid.is_some() || mesh.is_some();
     let table = extrema_table(domain, h);
     let kept = select(domain, h, &args.selection).map_err(|e| e.in_file(path))?;
     let count = |k: ExtremumKind, strict: bool| table.iter().filter(|r| r.kind == k && (!strict || r.strict)).count();
@@ -112,7 +124,7 @@ fn list<D: Domain>(
                     let kept = kept.roles[r.index] == Role::Min;
                     points.push(DiagramPoint { birth: r.value, death, is_max: false, kept });
                 }
-                ExtremumKind::Max if grid.is_some() => {
+                ExtremumKind::Max if surface => {
                     let death = r.partner.map(|p| h[p]).unwrap_or(f64::NEG_INFINITY);
                     let kept = kept.roles[r.index] == Role::Max;
                     points.push(DiagramPoint { birth: r.value, death, is_max: true, kept });
@@ -136,7 +148,11 @@ fn list<D: Domain>(
     out += &format!(
         "{:>8} {:>12} {:>9} {:>14} {:>14} {:>6} {:>4}\n",
         "index",
-        if grid.is_some() { "(row,col)" } else { "x" },
+        match (grid, &mesh) {
+            (Some(_), _) => "(row,col)",
+            (_, Some(_)) => "(x,y,z)",
+            _ => "x",
+        },
         "type",
         "value",
         "persistence",
@@ -167,9 +183,10 @@ fn list<D: Domain>(
             if row.kept { "yes" } else { "" }
         );
     }
-    let what = match grid {
-        Some([nx, ny]) => format!("{nx} × {ny} grid"),
-        None => format!("{} samples", listing.samples),
+    let what = match (grid, mesh) {
+        (Some([nx, ny]), _) => format!("{nx} × {ny} grid"),
+        (None, Some(m)) => m,
+        (None, None) => format!("{} samples", listing.samples),
     };
     out += &format!(
         "{}: {what} of `{}`; SoS extrema: {} minima, {} maxima{}; strict in the raw values: {} minima, {} maxima\n",
@@ -177,7 +194,7 @@ fn list<D: Domain>(
         listing.column,
         listing.sos_minima,
         listing.sos_maxima,
-        if grid.is_some() { " (boundary included)".to_string() } else { format!(" (incl. {} ends)", listing.ends) },
+        if surface { " (boundary included)".to_string() } else { format!(" (incl. {} ends)", listing.ends) },
         listing.strict_minima,
         listing.strict_maxima
     );

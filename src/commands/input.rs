@@ -3,9 +3,10 @@
 //! `--spacing`, `--derive` and `--fill-missing` applied.
 
 use crate::derive::{describe_missing, fill_missing, magnitude, vorticity};
-use crate::domain::Grid2d;
+use crate::domain::{Domain, Grid2d, TriMesh};
 use crate::error::{Error, Result};
 use crate::io::grid::{read_grid_csv, read_npy, read_raster, GridField};
+use crate::io::mesh::{is_mesh_path, read_mesh, MeshData};
 use crate::io::series_csv::{read_series, SeriesCsv, SeriesCsvOptions};
 use crate::io::vtk::read_image;
 use std::path::{Path, PathBuf};
@@ -21,6 +22,8 @@ pub enum DomainKind {
     Series,
     /// A grid.
     Grid,
+    /// A triangle mesh (.obj, .off, .ply, .vtu, .vtp).
+    Mesh,
 }
 
 /// A scalar to derive from a velocity field.
@@ -47,6 +50,8 @@ pub struct GridOptions {
     pub uv: Option<(PathBuf, PathBuf)>,
     /// Fill NaN samples harmonically instead of refusing them.
     pub fill_missing: bool,
+    /// Meshes: one value per vertex from a text file (one per line) instead of an array.
+    pub values: Option<PathBuf>,
 }
 
 /// A grid field ready to smooth.
@@ -64,6 +69,21 @@ pub struct GridInput {
     pub path: PathBuf,
 }
 
+/// A field on a triangle mesh, ready to smooth.
+#[derive(Clone, Debug)]
+pub struct MeshInput {
+    /// The validated mesh (orientation repaired where needed).
+    pub mesh: TriMesh,
+    /// The values to smooth.
+    pub values: Vec<f64>,
+    /// What the values are: the array read, the coordinate or the values file.
+    pub description: String,
+    /// What reading and validation changed (polygons split, triangles flipped).
+    pub notes: Vec<String>,
+    /// The mesh file.
+    pub path: PathBuf,
+}
+
 /// A field read by a command.
 #[derive(Clone, Debug)]
 pub enum FieldInput {
@@ -71,6 +91,100 @@ pub enum FieldInput {
     Series(SeriesCsv),
     /// A grid.
     Grid(GridInput),
+    /// A field on a triangle mesh.
+    Mesh(MeshInput),
+}
+
+/// Reads a mesh and validates it.
+///
+/// # Errors
+/// Input errors naming the file.
+pub fn read_trimesh(path: &Path) -> Result<(TriMesh, MeshData)> {
+    let data = read_mesh(path)?;
+    let mesh = TriMesh::new(data.positions.clone(), data.triangles.clone()).map_err(|e| e.in_file(path))?;
+    Ok((mesh, data))
+}
+
+/// Reads the field on a mesh: `--values FILE`, `--array NAME` (a vertex array or the
+/// coordinate `x`, `y`, `z`), or the file's only scalar vertex array.
+///
+/// # Errors
+/// Input errors naming the file: unreadable or invalid mesh, no or several candidate
+/// arrays, a values file of the wrong length, non-finite values.
+pub fn read_mesh_field(path: &Path, opts: &GridOptions) -> Result<MeshInput> {
+    if opts.derive.is_some() || opts.uv.is_some() || opts.spacing.is_some() || opts.fill_missing {
+        return Err(Error::Usage(format!(
+            "{}: --derive, --u/--v, --spacing and --fill-missing are for grids",
+            path.display()
+        )));
+    }
+    let (mesh, data) = read_trimesh(path)?;
+    let n = mesh.n_vertices();
+    let (values, description, source): (Vec<f64>, String, PathBuf) = match (&opts.values, &opts.array) {
+        (Some(_), Some(_)) => return Err(Error::Usage("give --values or --array, not both".into())),
+        (Some(file), None) => {
+            let text = std::fs::read_to_string(file).map_err(|source| Error::Io { path: file.clone(), source })?;
+            let mut values = Vec::with_capacity(n);
+            for (l, line) in text.lines().enumerate() {
+                let t = line.trim();
+                if t.is_empty() || t.starts_with('#') {
+                    continue;
+                }
+                let v: f64 = t
+                    .parse()
+                    .map_err(|_| Error::input(format!("line {}: `{t}` is not a number", l + 1)).in_file(file))?;
+                values.push(v);
+            }
+            if values.len() != n {
+                return Err(Error::input(format!(
+                    "{} values for the {n} vertices of {}",
+                    values.len(),
+                    path.display()
+                ))
+                .in_file(file));
+            }
+            (values, format!("values from {}", file.display()), file.clone())
+        }
+        (None, Some(name)) => {
+            let a = data.array(name).map_err(|m| Error::input(m).in_file(path))?;
+            if a.components != 1 {
+                return Err(Error::input(format!(
+                    "array `{name}` has {} components; a scalar is needed",
+                    a.components
+                ))
+                .in_file(path));
+            }
+            (a.values, name.clone(), path.to_path_buf())
+        }
+        (None, None) => {
+            let scalars: Vec<&crate::io::vtk::PointArray> = data.arrays.iter().filter(|a| a.components == 1).collect();
+            match scalars.as_slice() {
+                [one] => (one.values.clone(), one.name.clone(), path.to_path_buf()),
+                [] => {
+                    return Err(Error::input(
+                        "the mesh carries no scalar vertex array: give the field with --values FILE or --array x|y|z",
+                    )
+                    .in_file(path))
+                }
+                _ => {
+                    return Err(Error::Usage(format!(
+                        "{}: several vertex arrays fit, choose one with --array: {}",
+                        path.display(),
+                        data.names().join(", ")
+                    )))
+                }
+            }
+        }
+    };
+    let bad: Vec<usize> = (0..n).filter(|&v| !values[v].is_finite()).collect();
+    if !bad.is_empty() {
+        let shown: Vec<String> = bad.iter().take(5).map(|v| v.to_string()).collect();
+        return Err(Error::input(format!("{} non-finite values (first at vertices {})", bad.len(), shown.join(", ")))
+            .in_file(&source));
+    }
+    let mut notes = data.notes.clone();
+    notes.extend(mesh.repairs().iter().cloned());
+    Ok(MeshInput { mesh, values, description, notes, path: path.to_path_buf() })
 }
 
 fn extension(path: &Path) -> String {
@@ -80,7 +194,7 @@ fn extension(path: &Path) -> String {
 /// Whether a file is read as a grid.
 pub fn is_grid_file(path: &Path, kind: DomainKind) -> Result<bool> {
     Ok(match kind {
-        DomainKind::Series => false,
+        DomainKind::Series | DomainKind::Mesh => false,
         DomainKind::Grid => true,
         DomainKind::Auto => match extension(path).as_str() {
             "vti" | "vtk" | "npy" | "png" | "tif" | "tiff" => true,
@@ -102,6 +216,19 @@ pub fn read_field(
     grid: &GridOptions,
 ) -> Result<FieldInput> {
     let grid_wanted = grid.uv.is_some() || grid.derive.is_some() || grid.fill_missing || grid.array.is_some();
+    if let Some(p) = path {
+        let mesh = match kind {
+            DomainKind::Mesh => true,
+            DomainKind::Auto => is_mesh_path(p),
+            _ => false,
+        };
+        if mesh {
+            return Ok(FieldInput::Mesh(read_mesh_field(p, grid)?));
+        }
+    }
+    if let Some(v) = &grid.values {
+        return Err(Error::Usage(format!("--values {} is for meshes", v.display())));
+    }
     match path {
         Some(p) if !is_grid_file(p, kind)? => {
             if grid_wanted || grid.spacing.is_some() {

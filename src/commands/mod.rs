@@ -3,13 +3,16 @@
 
 mod bench;
 mod extrema;
+mod geodesic;
 pub mod input;
 mod smooth;
 mod smooth_grid;
+mod smooth_mesh;
 mod verify;
 
 pub use bench::{bench, BenchArgs, BenchCase};
 pub use extrema::{extrema, ExtremaArgs};
+pub use geodesic::{geodesic, GeodesicArgs};
 pub use smooth::{smooth, SmoothArgs};
 pub use verify::{verify, VerifyArgs};
 

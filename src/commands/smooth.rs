@@ -83,6 +83,13 @@ pub fn smooth(args: &SmoothArgs) -> Result<String> {
             }
             super::smooth_grid::smooth_grid(args, data, start)
         }
+        FieldInput::Mesh(data) => {
+            check_output_extension(&args.output, &["vtu", "vtp", "ply"], "a mesh")?;
+            if let Some(c) = &args.complex {
+                check_output_extension(c, &["vtp"], "--complex")?;
+            }
+            super::smooth_mesh::smooth_mesh(args, data, start)
+        }
     }
 }
 

@@ -52,13 +52,14 @@ fn physical(grid: &Grid2d, v: usize) -> [f64; 3] {
 /// The kept extrema, surviving saddles and separatrices as PolyData: vertex cells first
 /// (cell array `type`: −1 minimum, +1 maximum, 0 saddle), then one polyline per separatrix
 /// (`type` −1 descending to a minimum, +1 ascending to a maximum).
-pub fn complex_polydata(grid: &Grid2d, h: &[f64], roles: &[Role], ms: &MorseSmale) -> PolyData {
+/// `place` gives each vertex's position.
+pub fn complex_polydata(place: &dyn Fn(usize) -> [f64; 3], h: &[f64], roles: &[Role], ms: &MorseSmale) -> PolyData {
     let mut slot = std::collections::HashMap::new();
     let mut points = Vec::new();
     let mut values = Vec::new();
     let mut id = |v: usize, points: &mut Vec<[f64; 3]>, values: &mut Vec<f64>| -> usize {
         *slot.entry(v).or_insert_with(|| {
-            points.push(physical(grid, v));
+            points.push(place(v));
             values.push(h[v]);
             points.len() - 1
         })
@@ -88,6 +89,7 @@ pub fn complex_polydata(grid: &Grid2d, h: &[f64], roles: &[Role], ms: &MorseSmal
         lines,
         point_arrays: vec![("input".into(), values)],
         cell_arrays: vec![("type".into(), types)],
+        ..Default::default()
     }
 }
 
@@ -124,7 +126,7 @@ pub fn smooth_grid(args: &SmoothArgs, data: GridInput, start: Instant) -> Result
                 message: format!("no Morse-Smale complex to write ({})", result.report.representative),
             });
         };
-        staged.push(stage_vtp(path, &complex_polydata(grid, h, &result.roles, ms))?);
+        staged.push(stage_vtp(path, &complex_polydata(&|v| physical(grid, v), h, &result.roles, ms))?);
     }
     let r = &result.report;
     let kmin = r.kept.iter().filter(|k| k.role == Role::Min).count();

@@ -1,7 +1,7 @@
 //! `toposmooth verify`: re-check an output file from what it carries, independently of `smooth`.
 
-use super::input::{read_grid, GridOptions};
-use crate::domain::{Grid2d, Series};
+use super::input::{read_grid, read_mesh_field, read_trimesh, GridOptions};
+use crate::domain::{Domain, Grid2d, Series};
 use crate::error::{Error, Result};
 use crate::io::npz::read_npz;
 use crate::io::series_csv::{read_series, read_series_output, SeriesCsvOptions};
@@ -28,6 +28,7 @@ pub fn verify(args: &VerifyArgs) -> Result<String> {
     let ext = args.file.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
     match ext.as_str() {
         "vti" | "npz" => verify_grid(args, &ext),
+        "vtu" | "vtp" | "ply" => verify_mesh(args),
         "npy" => Err(Error::Usage(format!(
             "{}: a .npy export holds the smoothed array only and cannot be verified alone; verify the .vti or .npz output",
             args.file.display()
@@ -204,5 +205,67 @@ fn verify_series(args: &VerifyArgs) -> Result<String> {
         args.file.display(),
         cert.summary(),
         if args.input.is_some() { ", input column matches" } else { "" }
+    ))
+}
+
+fn verify_mesh(args: &VerifyArgs) -> Result<String> {
+    let (mesh, data) = read_trimesh(&args.file)?;
+    let n = mesh.n_vertices();
+    let take = |name: &str| -> Result<Vec<f64>> {
+        data.array(name).map(|a| a.values).map_err(|m| {
+            Error::input(format!("{m} (a verifiable output holds input, smoothed, representative, role)"))
+                .in_file(&args.file)
+        })
+    };
+    let (input, smoothed, representative, role) =
+        (take("input")?, take("smoothed")?, take("representative")?, take("role")?);
+    let roles = role
+        .iter()
+        .enumerate()
+        .map(|(i, &c)| {
+            Role::from_code(c).ok_or_else(|| {
+                Error::input(format!("role {c} at vertex {i} is not one of −1, 0, 1, 2, 3")).in_file(&args.file)
+            })
+        })
+        .collect::<Result<Vec<Role>>>()?;
+    let mut problems = Vec::new();
+    if let Some(orig) = &args.input {
+        let original = read_mesh_field(orig, &args.grid)?;
+        if original.mesh.n_vertices() != n || original.mesh.faces() != mesh.faces() {
+            problems.push(format!("{} is not the mesh of {}", orig.display(), args.file.display()));
+        } else if let Some(i) = (0..n).find(|&i| original.values[i].to_bits() != input[i].to_bits()) {
+            problems.push(format!(
+                "input array differs from {} at vertex {i}: {} vs {}",
+                orig.display(),
+                input[i],
+                original.values[i]
+            ));
+        }
+    }
+    if let Some(i) = roles.iter().position(|&r| r == Role::End || r == Role::Fixed) {
+        problems.push(format!("vertex {i} has role {}: smoothing outputs keep extrema only", roles[i].code()));
+    }
+    if !roles.contains(&Role::Min) || !roles.contains(&Role::Max) {
+        problems.push("the role array keeps no minimum or no maximum".into());
+    }
+    let cert = certify(&mesh, &smoothed, &roles, Some(&input));
+    if !cert.passed {
+        problems.push(format!("smoothed: {}", cert.summary()));
+    }
+    let ucert = certify(&mesh, &representative, &roles, None);
+    if !ucert.passed {
+        problems.push(format!("representative: {}", ucert.summary()));
+    }
+    if !problems.is_empty() {
+        return Err(Error::Uncertified { path: Some(args.file.clone()), message: problems.join("; ") });
+    }
+    let kmin = roles.iter().filter(|&&r| r == Role::Min).count();
+    let kmax = roles.iter().filter(|&&r| r == Role::Max).count();
+    Ok(format!(
+        "{}: {} (mesh of {}, {kmin} minima and {kmax} maxima kept at their input values, representative consistent{})\n",
+        args.file.display(),
+        cert.summary(),
+        mesh.describe(),
+        if args.input.is_some() { ", input array matches" } else { "" }
     ))
 }

@@ -2,6 +2,7 @@
 //! and is renamed into place, so a failed run never leaves a half-written file.
 
 pub mod grid;
+pub mod mesh;
 pub mod npz;
 pub mod series_csv;
 pub mod vtk;

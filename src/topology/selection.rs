@@ -21,6 +21,11 @@ pub enum Selection {
     },
     /// Series: the N most persistent (minimum, maximum) pairs besides the essential minimum.
     Pairs(usize),
+    /// Surfaces: every maximum of persistence > 0 and only the essential (global) minimum of
+    /// each component (`--keep-all-maxima`: geodesic distance keeps its maxima).
+    AllMaxima,
+    /// Surfaces: every minimum of persistence > 0 and only the global maximum of each component.
+    AllMinima,
     /// Explicit vertex indices.
     Explicit {
         /// Kept minima.
@@ -195,6 +200,23 @@ pub fn select<D: Domain>(domain: &D, values: &[f64], selection: &Selection) -> R
                 warnings.push(format!("asked for {count} pairs, the series has {available}: keeping all"));
             }
             path_by_rank(values, &minima_pairs, |p| p.persistence > 0.0, *count)
+        }
+        Selection::AllMaxima | Selection::AllMinima => {
+            if domain.pairing_rule() == PairingRule::Path {
+                return Err(Error::Usage("--keep-all-maxima/--keep-all-minima apply to surfaces".into()));
+            }
+            let maxima_pairs = superlevel_pairs(domain, values);
+            let all = |pairs: &[Pair]| -> Kept {
+                pairs.iter().filter(|p| p.persistence > 0.0).map(|p| (p.extremum, Some(p.persistence))).collect()
+            };
+            let essential = |pairs: &[Pair]| -> Kept {
+                pairs.iter().filter(|p| p.partner.is_none()).map(|p| (p.extremum, Some(p.persistence))).collect()
+            };
+            if *selection == Selection::AllMaxima {
+                (essential(&minima_pairs), all(&maxima_pairs))
+            } else {
+                (all(&minima_pairs), essential(&maxima_pairs))
+            }
         }
         Selection::Count { minima, maxima } => {
             if domain.pairing_rule() == PairingRule::Path {

@@ -1,0 +1,3 @@
+//! Applications built on the operators: geodesic distance (heat method).
+
+pub mod geodesic;

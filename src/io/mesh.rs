@@ -1,0 +1,670 @@
+//! Triangle meshes: OBJ (tobj), OFF, PLY ascii and binary (ply-rs-bw), VTK XML `.vtu`/`.vtp`
+//! and legacy `.vtk` unstructured grids and polydata (vtkio); written as `.vtu`, `.vtp` (see
+//! [`super::vtk`]) and binary PLY with Float64 vertex properties.
+//!
+//! Polygons with more than three corners are split into fans (reported). Per-vertex data comes
+//! back as [`PointArray`]s: PLY vertex properties other than x, y, z; VTK point data. The
+//! topology is validated by [`crate::domain::TriMesh::new`], not here.
+
+use super::vtk::PointArray;
+use super::{stage, Staged};
+use crate::error::{Error, Result};
+use std::io::Write;
+use std::path::Path;
+
+/// A mesh as read: positions, triangles, per-vertex arrays and what reading changed.
+#[derive(Clone, Debug, Default)]
+pub struct MeshData {
+    /// Vertex positions (2D formats get z = 0).
+    pub positions: Vec<[f64; 3]>,
+    /// Triangles (0-based vertex indices, not yet validated).
+    pub triangles: Vec<[usize; 3]>,
+    /// Per-vertex arrays found in the file.
+    pub arrays: Vec<PointArray>,
+    /// What reading did to the data (fan triangulation of polygons, dropped cells).
+    pub notes: Vec<String>,
+}
+
+impl MeshData {
+    /// Names of the per-vertex arrays, then the coordinates `x`, `y`, `z`.
+    pub fn names(&self) -> Vec<String> {
+        self.arrays.iter().map(|a| a.name.clone()).chain(["x", "y", "z"].map(String::from)).collect()
+    }
+
+    /// The array `name`, or the coordinate `x`, `y` or `z` (1 component).
+    ///
+    /// # Errors
+    /// A message listing the arrays there are.
+    pub fn array(&self, name: &str) -> std::result::Result<PointArray, String> {
+        if let Some(a) = self.arrays.iter().find(|a| a.name == name) {
+            return Ok(a.clone());
+        }
+        if let Some(k) = ["x", "y", "z"].iter().position(|c| *c == name) {
+            return Ok(PointArray {
+                name: name.into(),
+                components: 1,
+                values: self.positions.iter().map(|p| p[k]).collect(),
+            });
+        }
+        Err(format!("no vertex array `{name}`; there are: {}", self.names().join(", ")))
+    }
+}
+
+fn input(path: &Path, msg: impl Into<String>) -> Error {
+    Error::input(msg).in_file(path)
+}
+
+/// Which reader a path goes to, by extension.
+pub fn is_mesh_path(path: &Path) -> bool {
+    matches!(extension(path).as_str(), "obj" | "off" | "ply" | "vtu" | "vtp")
+}
+
+fn extension(path: &Path) -> String {
+    path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase()
+}
+
+/// Reads a triangle mesh; the format follows the extension (`.vtk`: legacy unstructured
+/// grid or polydata).
+///
+/// # Errors
+/// Input errors naming the file: unreadable or malformed content, indices out of range,
+/// non-surface cells, no triangle. I/O errors.
+pub fn read_mesh(path: &Path) -> Result<MeshData> {
+    let bytes = std::fs::read(path).map_err(|source| Error::Io { path: path.to_path_buf(), source })?;
+    if bytes.is_empty() {
+        return Err(input(path, "the file is empty"));
+    }
+    let mut data = match extension(path).as_str() {
+        "obj" => read_obj(&bytes),
+        "off" => read_off(&bytes),
+        "ply" => read_ply(&bytes),
+        "vtu" | "vtp" | "vtk" => read_vtk(&bytes, &extension(path)),
+        other => Err(format!("`.{other}` is not a mesh format (obj, off, ply, vtu, vtp, vtk)")),
+    }
+    .map_err(|m| input(path, m))?;
+    if data.triangles.is_empty() {
+        return Err(input(path, "the file holds no triangle"));
+    }
+    let n = data.positions.len();
+    if let Some((t, tri)) = data.triangles.iter().enumerate().find(|(_, t)| t.iter().any(|&v| v >= n)) {
+        return Err(input(
+            path,
+            format!("face {t} refers to vertex {} but there are {n} vertices", tri.iter().max().unwrap_or(&0)),
+        ));
+    }
+    for a in &data.arrays {
+        if a.values.len() != n * a.components {
+            return Err(input(
+                path,
+                format!(
+                    "array `{}` has {} values for {n} vertices × {} components",
+                    a.name,
+                    a.values.len(),
+                    a.components
+                ),
+            ));
+        }
+    }
+    data.arrays.retain(|a| !a.name.is_empty());
+    Ok(data)
+}
+
+/// Splits a polygon into a fan of triangles.
+fn fan(poly: &[usize], out: &mut Vec<[usize; 3]>) {
+    for k in 1..poly.len().saturating_sub(1) {
+        out.push([poly[0], poly[k], poly[k + 1]]);
+    }
+}
+
+fn polygon_note(split: usize, notes: &mut Vec<String>) {
+    if split > 0 {
+        notes.push(format!("{split} polygons with more than 3 corners split into triangle fans"));
+    }
+}
+
+fn read_obj(bytes: &[u8]) -> std::result::Result<MeshData, String> {
+    let options = tobj::LoadOptions { triangulate: false, single_index: false, ..Default::default() };
+    let mut reader = std::io::BufReader::new(bytes);
+    let (models, _) = tobj::load_obj_buf(&mut reader, &options, |_| Err(tobj::LoadError::OpenFileFailed))
+        .map_err(|e| format!("cannot parse the OBJ file: {e}"))?;
+    // tobj gives every object/group its own vertex list; positions shared between groups are
+    // merged back below by their coordinates (exact equality), so groups stay connected
+    let mut data = MeshData::default();
+    let mut split = 0;
+    let mut index: std::collections::HashMap<[u64; 3], usize> = std::collections::HashMap::new();
+    let several = models.len() > 1;
+    for model in &models {
+        let m = &model.mesh;
+        if m.positions.len() % 3 != 0 {
+            return Err("a vertex has fewer than 3 coordinates".into());
+        }
+        let map: Vec<usize> = m
+            .positions
+            .chunks(3)
+            .map(|c| {
+                let p = [c[0], c[1], c[2]];
+                if several {
+                    *index.entry(p.map(f64::to_bits)).or_insert_with(|| {
+                        data.positions.push(p);
+                        data.positions.len() - 1
+                    })
+                } else {
+                    data.positions.push(p);
+                    data.positions.len() - 1
+                }
+            })
+            .collect();
+        let arity: Vec<usize> = if m.face_arities.is_empty() {
+            vec![3; m.indices.len() / 3]
+        } else {
+            m.face_arities.iter().map(|&a| a as usize).collect()
+        };
+        let mut at = 0;
+        for a in arity {
+            let face: Vec<usize> = m.indices[at..at + a]
+                .iter()
+                .map(|&i| {
+                    map.get(i as usize).copied().ok_or_else(|| format!("face refers to missing vertex {}", i + 1))
+                })
+                .collect::<std::result::Result<_, _>>()?;
+            if a < 3 {
+                return Err(format!("a face has {a} corners"));
+            }
+            if a > 3 {
+                split += 1;
+            }
+            fan(&face, &mut data.triangles);
+            at += a;
+        }
+    }
+    polygon_note(split, &mut data.notes);
+    Ok(data)
+}
+
+fn read_off(bytes: &[u8]) -> std::result::Result<MeshData, String> {
+    let text = std::str::from_utf8(bytes).map_err(|_| "an OFF file must be text (binary OFF is not supported)")?;
+    // tokens with their line numbers, comments removed
+    let mut tokens = text
+        .lines()
+        .enumerate()
+        .flat_map(|(l, line)| line.split('#').next().unwrap_or("").split_whitespace().map(move |t| (l + 1, t)));
+    let (l, head) = tokens.next().ok_or("the file is empty")?;
+    let mut first_count = None;
+    if !head.ends_with("OFF") {
+        // some writers omit the keyword
+        first_count = Some((l, head));
+    }
+    if head != "OFF" && head.ends_with("OFF") {
+        return Err(format!(
+            "line {l}: `{head}` variants (colours, normals, texture) are not supported; use plain OFF"
+        ));
+    }
+    let mut next_num = |what: &str| -> std::result::Result<(usize, f64), String> {
+        let (l, t) = match first_count.take() {
+            Some(x) => x,
+            None => tokens.next().ok_or_else(|| format!("the file ends before {what}"))?,
+        };
+        t.parse::<f64>().map(|v| (l, v)).map_err(|_| format!("line {l}: `{t}` is not a number ({what})"))
+    };
+    let count = |v: f64, l: usize, what: &str| -> std::result::Result<usize, String> {
+        if v >= 0.0 && v.fract() == 0.0 && v < 1e12 {
+            Ok(v as usize)
+        } else {
+            Err(format!("line {l}: {what} {v} is not a count"))
+        }
+    };
+    let (l, nv) = next_num("the vertex count")?;
+    let nv = count(nv, l, "vertex count")?;
+    let (l, nf) = next_num("the face count")?;
+    let nf = count(nf, l, "face count")?;
+    next_num("the edge count")?;
+    let mut data = MeshData::default();
+    for _ in 0..nv {
+        let x = next_num("a vertex coordinate")?.1;
+        let y = next_num("a vertex coordinate")?.1;
+        let z = next_num("a vertex coordinate")?.1;
+        data.positions.push([x, y, z]);
+    }
+    let mut split = 0;
+    for f in 0..nf {
+        let (l, k) = next_num("a face")?;
+        let k = count(k, l, "corner count")?;
+        if k < 3 {
+            return Err(format!("line {l}: face {f} has {k} corners"));
+        }
+        let mut face = Vec::with_capacity(k);
+        for _ in 0..k {
+            let (l, v) = next_num("a face index")?;
+            let v = count(v, l, "vertex index")?;
+            if v >= nv {
+                return Err(format!("line {l}: face {f} refers to vertex {v} but there are {nv} vertices"));
+            }
+            face.push(v);
+        }
+        // anything after the indices on the line is a colour: ignored
+        if k > 3 {
+            split += 1;
+        }
+        fan(&face, &mut data.triangles);
+    }
+    polygon_note(split, &mut data.notes);
+    Ok(data)
+}
+
+fn read_ply(bytes: &[u8]) -> std::result::Result<MeshData, String> {
+    use ply_rs_bw::ply::Property;
+    let parser = ply_rs_bw::parser::Parser::<ply_rs_bw::ply::DefaultElement>::new();
+    let mut reader = std::io::Cursor::new(bytes);
+    let ply = parser.read_ply(&mut reader).map_err(|e| format!("cannot parse the PLY file: {e}"))?;
+    let scalar = |p: &Property| -> Option<f64> {
+        Some(match *p {
+            Property::Char(v) => v.into(),
+            Property::UChar(v) => v.into(),
+            Property::Short(v) => v.into(),
+            Property::UShort(v) => v.into(),
+            Property::Int(v) => v.into(),
+            Property::UInt(v) => v.into(),
+            Property::Float(v) => v.into(),
+            Property::Double(v) => v,
+            _ => return None,
+        })
+    };
+    let list = |p: &Property| -> Option<Vec<i64>> {
+        Some(match p {
+            Property::ListChar(v) => v.iter().map(|&x| x.into()).collect(),
+            Property::ListUChar(v) => v.iter().map(|&x| x.into()).collect(),
+            Property::ListShort(v) => v.iter().map(|&x| x.into()).collect(),
+            Property::ListUShort(v) => v.iter().map(|&x| x.into()).collect(),
+            Property::ListInt(v) => v.iter().map(|&x| x.into()).collect(),
+            Property::ListUInt(v) => v.iter().map(|&x| x.into()).collect(),
+            _ => return None,
+        })
+    };
+    let vertices = ply.payload.get("vertex").ok_or("the PLY file has no `vertex` element")?;
+    let def = ply.header.elements.get("vertex").ok_or("the PLY header declares no `vertex` element")?;
+    let names: Vec<String> = def.properties.keys().cloned().collect();
+    for c in ["x", "y"] {
+        if !names.iter().any(|n| n == c) {
+            return Err(format!("the vertex element has no `{c}` property"));
+        }
+    }
+    let mut data = MeshData::default();
+    let mut columns: Vec<(String, Vec<f64>)> =
+        names.iter().filter(|n| !["x", "y", "z"].contains(&n.as_str())).map(|n| (n.clone(), Vec::new())).collect();
+    for (i, v) in vertices.iter().enumerate() {
+        let get = |name: &str| -> std::result::Result<f64, String> {
+            match v.get(name) {
+                None => Ok(0.0),
+                Some(p) => scalar(p).ok_or_else(|| format!("vertex {i}: property `{name}` is a list")),
+            }
+        };
+        data.positions.push([get("x")?, get("y")?, get("z")?]);
+        for (name, col) in &mut columns {
+            if let Some(p) = v.get(name.as_str()) {
+                if let Some(x) = scalar(p) {
+                    col.push(x);
+                }
+            }
+        }
+    }
+    let n = data.positions.len();
+    for (name, values) in columns {
+        if values.len() == n {
+            data.arrays.push(PointArray { name, components: 1, values });
+        }
+    }
+    let faces = ply.payload.get("face").ok_or("the PLY file has no `face` element")?;
+    let mut split = 0;
+    for (f, face) in faces.iter().enumerate() {
+        let idx = face
+            .get("vertex_indices")
+            .or_else(|| face.get("vertex_index"))
+            .ok_or_else(|| format!("face {f} has no `vertex_indices` list"))?;
+        let idx = list(idx).ok_or_else(|| format!("face {f}: `vertex_indices` is not an integer list"))?;
+        if idx.len() < 3 {
+            return Err(format!("face {f} has {} corners", idx.len()));
+        }
+        if let Some(&bad) = idx.iter().find(|&&v| v < 0 || v as usize >= n) {
+            return Err(format!("face {f} refers to vertex {bad} but there are {n} vertices"));
+        }
+        if idx.len() > 3 {
+            split += 1;
+        }
+        let poly: Vec<usize> = idx.iter().map(|&v| v as usize).collect();
+        fan(&poly, &mut data.triangles);
+    }
+    polygon_note(split, &mut data.notes);
+    Ok(data)
+}
+
+/// Cells as (type code, corner list) from either vtkio encoding, checked for consistency.
+fn cells_of(numbers: vtkio::model::VertexNumbers, what: &str) -> std::result::Result<Vec<Vec<usize>>, String> {
+    use vtkio::model::VertexNumbers;
+    let mut out = Vec::new();
+    match numbers {
+        VertexNumbers::Legacy { num_cells, vertices } => {
+            let mut at = 0usize;
+            for c in 0..num_cells as usize {
+                let k = *vertices.get(at).ok_or_else(|| format!("{what}: the cell list ends at cell {c}"))? as usize;
+                let cell = vertices.get(at + 1..at + 1 + k).ok_or_else(|| format!("{what}: cell {c} is truncated"))?;
+                out.push(cell.iter().map(|&v| v as usize).collect());
+                at += 1 + k;
+            }
+        }
+        VertexNumbers::XML { connectivity, offsets } => {
+            let offsets: Vec<u64> =
+                if offsets.first() == Some(&0) && offsets.len() > 1 { offsets[1..].to_vec() } else { offsets };
+            let mut start = 0usize;
+            for (c, &end) in offsets.iter().enumerate() {
+                let end = end as usize;
+                let cell = connectivity
+                    .get(start..end)
+                    .ok_or_else(|| format!("{what}: offsets of cell {c} run outside the connectivity"))?;
+                out.push(cell.iter().map(|&v| v as usize).collect());
+                start = end;
+            }
+        }
+    }
+    Ok(out)
+}
+
+fn point_arrays(attrs: Vec<vtkio::model::Attribute>, n: usize) -> std::result::Result<Vec<PointArray>, String> {
+    use vtkio::model::{Attribute, ElementType};
+    let mut arrays = Vec::new();
+    for attr in attrs {
+        let mut push = |name: String, comps: usize, buf: &vtkio::IOBuffer| -> std::result::Result<(), String> {
+            let values = buf
+                .cast_into::<f64>()
+                .ok_or_else(|| format!("point array `{name}` has a data type that cannot be read as numbers"))?;
+            if values.len() != n * comps {
+                return Err(format!("point array `{name}` holds {} values for {n} points × {comps}", values.len()));
+            }
+            arrays.push(PointArray { name, components: comps, values });
+            Ok(())
+        };
+        match attr {
+            Attribute::DataArray(da) => {
+                if !matches!(da.elem, ElementType::LookupTable) {
+                    push(da.name.clone(), da.elem.num_comp() as usize, &da.data)?;
+                }
+            }
+            Attribute::Field { data_array, .. } => {
+                for fa in data_array {
+                    push(fa.name.clone(), fa.elem as usize, &fa.data)?;
+                }
+            }
+        }
+    }
+    Ok(arrays)
+}
+
+fn read_vtk(bytes: &[u8], ext: &str) -> std::result::Result<MeshData, String> {
+    use vtkio::model::{CellType, DataSet, Piece};
+    let parsed = std::panic::catch_unwind(|| {
+        if ext == "vtk" {
+            vtkio::Vtk::parse_legacy_be(bytes).map_err(|e| e.to_string())
+        } else {
+            vtkio::Vtk::parse_xml(std::io::BufReader::new(bytes)).map_err(|e| e.to_string())
+        }
+    })
+    .map_err(|_| "the VTK reader failed on this file (malformed?)".to_string())?
+    .map_err(|e| {
+        format!(
+            "cannot parse the VTK file ({e}); raw appended data (ParaView's default) is not supported: \
+             save with `Data Mode: Ascii` or `Binary` and no raw encoding"
+        )
+    })?;
+    let mut data = MeshData::default();
+    let mut dropped = 0usize;
+    let mut split = 0usize;
+    let add_points = |buf: &vtkio::IOBuffer, data: &mut MeshData| -> std::result::Result<usize, String> {
+        let p = buf.cast_into::<f64>().ok_or("the point coordinates are not numbers")?;
+        if p.len() % 3 != 0 {
+            return Err("the point coordinates are not triples".into());
+        }
+        let base = data.positions.len();
+        data.positions.extend(p.chunks(3).map(|c| [c[0], c[1], c[2]]));
+        Ok(base)
+    };
+    match parsed.data {
+        DataSet::UnstructuredGrid { pieces, .. } => {
+            if pieces.len() != 1 {
+                return Err(format!("{} pieces: only single-piece files are supported", pieces.len()));
+            }
+            for piece in pieces {
+                let Piece::Inline(piece) = piece else { return Err("the file refers to external pieces".into()) };
+                let base = add_points(&piece.points, &mut data)?;
+                let n = data.positions.len() - base;
+                let cells = cells_of(piece.cells.cell_verts, "cells")?;
+                if cells.len() != piece.cells.types.len() {
+                    return Err(format!("{} cells but {} cell types", cells.len(), piece.cells.types.len()));
+                }
+                for (c, (cell, ty)) in cells.iter().zip(&piece.cells.types).enumerate() {
+                    match ty {
+                        CellType::Triangle => fan(cell, &mut data.triangles),
+                        CellType::Quad | CellType::Polygon => {
+                            split += 1;
+                            fan(cell, &mut data.triangles)
+                        }
+                        CellType::TriangleStrip => strip(cell, &mut data.triangles),
+                        CellType::Vertex | CellType::PolyVertex | CellType::Line | CellType::PolyLine => dropped += 1,
+                        other => {
+                            return Err(format!(
+                                "cell {c} is a {other:?} cell: only surface cells (triangles, quads, polygons, strips) are supported"
+                            ))
+                        }
+                    }
+                }
+                data.arrays = point_arrays(piece.data.point, n)?;
+            }
+        }
+        DataSet::PolyData { pieces, .. } => {
+            if pieces.len() != 1 {
+                return Err(format!("{} pieces: only single-piece files are supported", pieces.len()));
+            }
+            for piece in pieces {
+                let Piece::Inline(piece) = piece else { return Err("the file refers to external pieces".into()) };
+                let base = add_points(&piece.points, &mut data)?;
+                let n = data.positions.len() - base;
+                if let Some(polys) = piece.polys {
+                    for cell in cells_of(polys, "polygons")? {
+                        if cell.len() > 3 {
+                            split += 1;
+                        }
+                        if cell.len() < 3 {
+                            return Err(format!("a polygon has {} corners", cell.len()));
+                        }
+                        fan(&cell, &mut data.triangles);
+                    }
+                }
+                if let Some(strips) = piece.strips {
+                    for cell in cells_of(strips, "strips")? {
+                        strip(&cell, &mut data.triangles);
+                    }
+                }
+                for v in [piece.verts, piece.lines].into_iter().flatten() {
+                    dropped += v.num_cells();
+                }
+                data.arrays = point_arrays(piece.data.point, n)?;
+            }
+        }
+        _ => return Err("the data set is neither an unstructured grid nor polydata".into()),
+    }
+    polygon_note(split, &mut data.notes);
+    if dropped > 0 {
+        data.notes.push(format!("{dropped} vertex and line cells ignored"));
+    }
+    Ok(data)
+}
+
+/// Triangles of a triangle strip (alternating orientation kept consistent).
+fn strip(cell: &[usize], out: &mut Vec<[usize; 3]>) {
+    for k in 0..cell.len().saturating_sub(2) {
+        if k % 2 == 0 {
+            out.push([cell[k], cell[k + 1], cell[k + 2]]);
+        } else {
+            out.push([cell[k + 1], cell[k], cell[k + 2]]);
+        }
+    }
+}
+
+/// Stages a binary little-endian PLY file: vertices with `x`, `y`, `z` and one `double`
+/// property per array, faces as `uchar`/`int` lists. Values round-trip bit for bit.
+///
+/// # Errors
+/// Input errors naming the file for arrays of the wrong length or names PLY cannot hold;
+/// I/O errors.
+pub fn stage_ply(
+    path: &Path,
+    positions: &[[f64; 3]],
+    triangles: &[[usize; 3]],
+    arrays: &[(&str, &[f64])],
+) -> Result<Staged> {
+    let n = positions.len();
+    for (name, values) in arrays {
+        if values.len() != n {
+            return Err(input(path, format!("array `{name}` has {} values for {n} vertices", values.len())));
+        }
+        if name.is_empty() || name.chars().any(|c| c.is_whitespace() || c.is_control()) {
+            return Err(input(path, format!("`{name}` cannot be a PLY property name")));
+        }
+    }
+    if triangles.iter().flatten().any(|&v| v > i32::MAX as usize) {
+        return Err(input(path, "vertex indices beyond the 32-bit range of PLY lists"));
+    }
+    stage(path, |w: &mut dyn Write| {
+        writeln!(w, "ply\nformat binary_little_endian 1.0\ncomment written by toposmooth")?;
+        writeln!(w, "element vertex {n}\nproperty double x\nproperty double y\nproperty double z")?;
+        for (name, _) in arrays {
+            writeln!(w, "property double {name}")?;
+        }
+        writeln!(w, "element face {}\nproperty list uchar int vertex_indices\nend_header", triangles.len())?;
+        for (i, p) in positions.iter().enumerate() {
+            for c in p {
+                w.write_all(&c.to_le_bytes())?;
+            }
+            for (_, values) in arrays {
+                w.write_all(&values[i].to_le_bytes())?;
+            }
+        }
+        for t in triangles {
+            w.write_all(&[3u8])?;
+            for &v in t {
+                w.write_all(&(v as i32).to_le_bytes())?;
+            }
+        }
+        Ok(())
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn tmp(name: &str, content: &[u8]) -> std::path::PathBuf {
+        let d = std::env::temp_dir().join(format!("toposmooth-mesh-io-{}", std::process::id()));
+        std::fs::create_dir_all(&d).unwrap();
+        let p = d.join(name);
+        std::fs::write(&p, content).unwrap();
+        p
+    }
+
+    const SQUARE_OBJ: &str = "# a square\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0.5\nf 1 2 3 4\n";
+
+    #[test]
+    fn obj_off_and_ply_give_the_same_mesh() {
+        let obj = read_mesh(&tmp("sq.obj", SQUARE_OBJ.as_bytes())).unwrap();
+        assert_eq!(obj.positions.len(), 4);
+        assert_eq!(obj.triangles, vec![[0, 1, 2], [0, 2, 3]]);
+        assert_eq!(obj.notes.len(), 1);
+        let off = read_mesh(&tmp("sq.off", b"OFF\n4 1 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0.5\n4 0 1 2 3\n")).unwrap();
+        assert_eq!((off.positions.clone(), off.triangles.clone()), (obj.positions.clone(), obj.triangles.clone()));
+        let ply = "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n\
+                   property double temp\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n\
+                   0 0 0 1.5\n1 0 0 2.5\n1 1 0 3.5\n0 1 0.5 4.5\n4 0 1 2 3\n";
+        let p = read_mesh(&tmp("sq.ply", ply.as_bytes())).unwrap();
+        assert_eq!((p.positions.clone(), p.triangles.clone()), (obj.positions.clone(), obj.triangles.clone()));
+        assert_eq!(p.array("temp").unwrap().values, vec![1.5, 2.5, 3.5, 4.5]);
+        assert_eq!(p.array("z").unwrap().values, vec![0.0, 0.0, 0.0, 0.5]);
+        assert!(p.array("pressure").unwrap_err().contains("temp, x, y, z"));
+    }
+
+    #[test]
+    fn obj_groups_share_their_vertices() {
+        let two = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\ng a\nf 1 2 3\ng b\nf 1 3 4\n";
+        let m = read_mesh(&tmp("groups.obj", two.as_bytes())).unwrap();
+        assert_eq!(m.positions.len(), 4, "{:?}", m.positions);
+        assert_eq!(m.triangles.len(), 2);
+        let mesh = crate::domain::TriMesh::new(m.positions, m.triangles).unwrap();
+        assert_eq!(mesh.n_components(), 1);
+    }
+
+    #[test]
+    fn written_ply_reads_back_bit_for_bit() {
+        let d = std::env::temp_dir().join(format!("toposmooth-mesh-io-{}", std::process::id()));
+        std::fs::create_dir_all(&d).unwrap();
+        let path = d.join("out.ply");
+        let pos = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.1], [0.0, 1.0, -0.2]];
+        let vals = [0.1, 1.0 / 3.0, -2e-300];
+        stage_ply(&path, &pos, &[[0, 1, 2]], &[("smoothed", &vals)]).unwrap().commit().unwrap();
+        let m = read_mesh(&path).unwrap();
+        assert_eq!(m.positions, pos.to_vec());
+        assert_eq!(m.triangles, vec![[0, 1, 2]]);
+        let got = m.array("smoothed").unwrap().values;
+        assert!(got.iter().zip(&vals).all(|(a, b)| a.to_bits() == b.to_bits()));
+    }
+
+    #[test]
+    fn broken_files_are_input_errors() {
+        for (name, content, needle) in [
+            ("empty.obj", &b""[..], "empty"),
+            ("bad.off", &b"OFF\n3 1 0\n0 0 0\n1 0 0\n"[..], "ends before"),
+            ("range.off", &b"OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 5\n"[..], "vertex 5"),
+            ("text.off", &b"OFF\n3 1 0\n0 0 0\n1 x 0\n0 1 0\n3 0 1 2\n"[..], "line 4"),
+            ("range.obj", &b"v 0 0 0\nv 1 0 0\nf 1 2 3\n"[..], "obj"),
+            (
+                "noface.ply",
+                &b"ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nend_header\n0 0\n"[..],
+                "face",
+            ),
+            ("junk.vtu", &b"<VTKFile type=\"UnstructuredGrid\"><broken"[..], "junk.vtu"),
+            ("x.stl", &b"solid"[..], "not a mesh format"),
+        ] {
+            let e = read_mesh(&tmp(name, content)).unwrap_err();
+            let msg = e.to_string();
+            assert_eq!(e.exit_code(), 3, "{name}: {msg}");
+            assert!(msg.contains(name) && msg.contains(needle), "{name}: {msg}");
+        }
+    }
+}
+
+#[cfg(test)]
+mod vtk_round_trip {
+    use super::*;
+
+    #[test]
+    fn vtu_and_vtp_written_here_read_back_bit_for_bit() {
+        let d = std::env::temp_dir().join(format!("toposmooth-mesh-vtk-{}", std::process::id()));
+        std::fs::create_dir_all(&d).unwrap();
+        let pos = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.1], [0.0, 1.0, -0.2], [1.0, 1.0, 0.3]];
+        let tris = vec![[0, 1, 2], [1, 3, 2]];
+        let vals = [0.1, 1.0 / 3.0, -2e-300, 7.0];
+        let vtu = d.join("m.vtu");
+        super::super::vtk::stage_vtu(&vtu, &pos, &tris, &[("smoothed", &vals)]).unwrap().commit().unwrap();
+        let vtp = d.join("m.vtp");
+        let poly = super::super::vtk::PolyData {
+            points: pos.clone(),
+            polys: tris.clone(),
+            point_arrays: vec![("smoothed".into(), vals.to_vec())],
+            ..Default::default()
+        };
+        super::super::vtk::stage_vtp(&vtp, &poly).unwrap().commit().unwrap();
+        for p in [vtu, vtp] {
+            let m = read_mesh(&p).unwrap_or_else(|e| panic!("{e}"));
+            assert_eq!(m.positions, pos);
+            assert_eq!(m.triangles, tris);
+            let got = m.array("smoothed").unwrap().values;
+            assert!(got.iter().zip(&vals).all(|(a, b)| a.to_bits() == b.to_bits()));
+        }
+    }
+}

@@ -154,3 +154,47 @@ fn obtuse_triangles_break_the_cotangent_maximum_principle_but_not_the_positive_o
     assert!(count_bad(&plain) > 0, "the plain cotangent Laplacian should violate the maximum principle here");
     assert_eq!(count_bad(&positive), 0);
 }
+
+/// mountain.obj: 13,549 interior edges with negative cotangent weight. A harmonic fill of
+/// boundary values with the plain cotangent Laplacian creates interior extrema there; the
+/// positive-weight one creates none.
+#[test]
+fn negative_cotangent_weights_matter_on_the_mountain() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("datasets/mountain.obj");
+    let data = toposmooth::io::mesh::read_mesh(&path).unwrap();
+    let m = TriMesh::new(data.positions, data.triangles).unwrap();
+    assert_eq!(negative_cotan_edges(m.positions(), m.faces()), 13_549);
+    let n = m.n_vertices();
+    // boundary vertices: those on an edge with one triangle
+    let mut count = std::collections::HashMap::new();
+    for t in m.faces() {
+        for k in 0..3 {
+            let (a, b) = (t[k], t[(k + 1) % 3]);
+            *count.entry((a.min(b), a.max(b))).or_insert(0) += 1;
+        }
+    }
+    let mut boundary = vec![false; n];
+    for (&(a, b), &c) in &count {
+        if c == 1 {
+            boundary[a] = true;
+            boundary[b] = true;
+        }
+    }
+    // boundary values: a smooth function of the position around the rim
+    let fixed: Vec<Option<f64>> = (0..n)
+        .map(|v| {
+            let p = m.point(v);
+            boundary[v].then(|| (0.3 * p[0]).sin() + (0.2 * p[2]).cos())
+        })
+        .collect();
+    let defects = |u: &[f64]| {
+        let (mins, maxs, flat) = mesh_extrema(n, m.faces(), u);
+        mins.iter().chain(&maxs).chain(&flat).filter(|&&v| !boundary[v]).count()
+    };
+    let plain = dirichlet_solve(&cotan_stiffness(m.positions(), m.faces()), &fixed).unwrap();
+    let positive = dirichlet_solve(&positive_cotan_stiffness(m.positions(), m.faces()), &fixed).unwrap();
+    let (dp, dq) = (defects(&plain), defects(&positive));
+    eprintln!("mountain harmonic fill: interior extrema or flat vertices: cotangent {dp}, positive weights {dq}");
+    assert!(dp > 0);
+    assert_eq!(dq, 0);
+}

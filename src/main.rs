@@ -9,6 +9,7 @@ use toposmooth::domain::{MAX_SPACING, MIN_SPACING};
 use toposmooth::io::series_csv::SeriesCsvOptions;
 use toposmooth::operators::Energy;
 use toposmooth::pipeline::{RepresentativeChoice, SmoothSettings};
+use toposmooth::plot::MeshView;
 use toposmooth::solve::{Method, QpSettings};
 use toposmooth::topology::Selection;
 use toposmooth::{Error, Result};
@@ -243,6 +244,9 @@ struct SmoothCli {
     /// Grid: representative function.
     #[arg(long, value_enum, default_value_t = RepresentativeCli::Separatrix)]
     representative: RepresentativeCli,
+    /// Mesh plot: camera azimuth and elevation in degrees (y up).
+    #[arg(long, value_name = "AZ,EL", allow_hyphen_values = true)]
+    view: Option<String>,
     /// Grid plot: number of isolines (0: none).
     #[arg(long, default_value_t = 0)]
     isolines: usize,
@@ -358,6 +362,16 @@ fn smooth_args(c: SmoothCli) -> Result<SmoothArgs> {
         grid: c.grid.options()?,
         complex: c.complex,
         isolines: c.isolines,
+        view: match &c.view {
+            None => MeshView::default(),
+            Some(text) => {
+                let parts: Vec<f64> = text.split(',').filter_map(|p| p.trim().parse().ok()).collect();
+                match parts.as_slice() {
+                    [az, el] if az.is_finite() && el.is_finite() => MeshView { azimuth: *az, elevation: *el },
+                    _ => return Err(Error::Usage(format!("--view `{text}` is not two angles AZ,EL in degrees"))),
+                }
+            }
+        },
         output: c.output,
         settings,
         plot: c.plot,

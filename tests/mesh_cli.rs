@@ -34,6 +34,7 @@ fn geodesic_distance_keeps_all_its_maxima_on_spot_and_mountain() {
         let h = d.array("distance").unwrap().values;
         assert_eq!(h[0], 0.0);
         assert!(h.iter().all(|&x| x >= 0.0), "{mesh}: distances are non-negative");
+        let png = dir.join(format!("{mesh}.png")).display().to_string();
         let o = toposmooth(&[
             "smooth",
             &dist,
@@ -44,8 +45,17 @@ fn geodesic_distance_keeps_all_its_maxima_on_spot_and_mountain() {
             &out,
             "--complex",
             &complex,
+            "--plot",
+            &png,
+            "--view",
+            "150,20",
         ]);
         assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+        let img = image::open(&png).unwrap().to_rgb8();
+        assert!(img.width() > 1000 && img.height() > 600);
+        // the picture is not blank: many coloured (non-grey) pixels
+        let coloured = img.pixels().filter(|p| p.0.iter().max().unwrap() - p.0.iter().min().unwrap() > 40).count();
+        assert!(coloured > 50_000, "{coloured}");
         // independent check: the output has the input's maxima of persistence > 0 (all of
         // them: every maximum of a distance field is kept) and the source as only minimum
         let r = read_mesh(Path::new(&out)).unwrap();

@@ -27,6 +27,8 @@ pub struct SmoothArgs {
     pub complex: Option<PathBuf>,
     /// Isolines in the grid plot.
     pub isolines: usize,
+    /// Camera of the mesh plot.
+    pub view: crate::plot::MeshView,
     /// Output CSV.
     pub output: PathBuf,
     /// Pipeline settings.

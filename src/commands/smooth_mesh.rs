@@ -11,6 +11,7 @@ use crate::io::mesh::stage_ply;
 use crate::io::vtk::{stage_vtp, stage_vtu, PolyData};
 use crate::io::{stage_json, Staged};
 use crate::pipeline::{smooth as run_pipeline, Report, Smoothed};
+use crate::plot::{plot_mesh_fields, GridMarker, GridPanel};
 use crate::topology::Role;
 use std::path::Path;
 use std::time::Instant;
@@ -68,9 +69,6 @@ pub fn smooth_mesh(args: &SmoothArgs, data: MeshInput, start: Instant) -> Result
     let read_seconds = start.elapsed().as_secs_f64();
     let mesh = &data.mesh;
     let h = &data.values;
-    if args.plot.is_some() {
-        return Err(Error::Usage("--plot is not available for meshes yet (open the .vtu in ParaView)".into()));
-    }
     let result = run_pipeline(mesh, h, &args.settings).map_err(|e| e.in_file(&data.path))?;
     let t = Instant::now();
     let mut staged = vec![stage_output(&args.output, &data, &result)?];
@@ -86,6 +84,39 @@ pub fn smooth_mesh(args: &SmoothArgs, data: MeshInput, start: Instant) -> Result
     let r = &result.report;
     let kmin = r.kept.iter().filter(|k| k.role == Role::Min).count();
     let kmax = r.kept.len() - kmin;
+    let mut hidden = 0;
+    if let Some(path) = &args.plot {
+        let markers: Vec<GridMarker> = result
+            .roles
+            .iter()
+            .enumerate()
+            .filter_map(|(i, r)| match r {
+                Role::Min => Some(GridMarker { index: i, is_max: false }),
+                Role::Max => Some(GridMarker { index: i, is_max: true }),
+                _ => None,
+            })
+            .collect();
+        let (lo, hi) = crate::domain::value_range(h);
+        let name = data.path.file_name().unwrap_or_default().to_string_lossy().to_string();
+        let panels = [
+            GridPanel { title: format!("input: {} minima, {} maxima", r.input_minima, r.input_maxima), values: h },
+            GridPanel { title: format!("smoothed: {kmin} minima, {kmax} maxima (certified)"), values: &result.output },
+        ];
+        let title = format!("{name} — {} (RMS change {})", data.description, sig6(r.rms_deviation));
+        staged.push(super::stage_plot(path, |p| {
+            hidden = plot_mesh_fields(
+                p,
+                mesh.positions(),
+                mesh.faces(),
+                &panels,
+                &markers,
+                &title,
+                args.view,
+                lo < 0.0 && hi > 0.0,
+            )?;
+            Ok(())
+        })?);
+    }
     let write_seconds = t.elapsed().as_secs_f64();
     let negative = crate::operators::negative_cotan_edges(mesh.positions(), mesh.faces());
     if let Some(path) = &args.report {
@@ -140,7 +171,10 @@ pub fn smooth_mesh(args: &SmoothArgs, data: MeshInput, start: Instant) -> Result
         start.elapsed().as_secs_f64()
     );
     let mut wrote = vec![args.output.display().to_string()];
-    for p in [&args.complex, &args.report].into_iter().flatten() {
+    if args.plot.is_some() && hidden > 0 {
+        text += &format!("plot: {hidden} kept extrema face away from the camera (try --view)\n");
+    }
+    for p in [&args.complex, &args.plot, &args.report].into_iter().flatten() {
         wrote.push(p.display().to_string());
     }
     text += &format!("wrote {}\n", wrote.join(", "));

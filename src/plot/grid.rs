@@ -172,16 +172,16 @@ const DIVERGING: [[u8; 3]; 9] = [
 
 /// The shared colour scale: values `lo..=hi` map linearly onto a colour ramp.
 #[derive(Clone, Copy, Debug, PartialEq)]
-struct Scale {
-    lo: f64,
-    hi: f64,
+pub(super) struct Scale {
+    pub(super) lo: f64,
+    pub(super) hi: f64,
     ramp: &'static [[u8; 3]; 9],
 }
 
 impl Scale {
     /// The scale over all panels' finite values: symmetric about 0 if `diverging`, widened around
     /// a constant, 0..1 if there is no finite value.
-    fn new(panels: &[GridPanel], diverging: bool) -> Scale {
+    pub(super) fn new(panels: &[GridPanel], diverging: bool) -> Scale {
         let (lo, hi) = min_max(panels.iter().flat_map(|p| p.values.iter().copied()));
         if diverging {
             let m = lo.abs().max(hi.abs());
@@ -203,7 +203,7 @@ impl Scale {
     }
 
     /// Colour of value `v`: NaN is [`MISSING`], values beyond the range (±∞ included) are clamped.
-    fn colour(&self, v: f64) -> RGBColor {
+    pub(super) fn colour(&self, v: f64) -> RGBColor {
         if v.is_nan() {
             MISSING
         } else {
@@ -352,7 +352,17 @@ pub fn plot_grid_fields(
 
 /// Draws the colour bar (high values at the top) with ticks and labels, and the "missing" swatch.
 fn draw_colour_bar(root: &Area<'_>, layout: &Layout, scale: &Scale, missing: bool) -> Result<(), Box<dyn Error>> {
-    let ((bx, by), (bw, bh)) = layout.bar(missing);
+    draw_colour_bar_at(root, layout.bar(missing), scale, missing)
+}
+
+/// Draws a colour bar at `((x, y), (w, h))` with ticks and labels to its right, and the
+/// "missing" swatch below it when `missing`.
+pub(super) fn draw_colour_bar_at(
+    root: &Area<'_>,
+    ((bx, by), (bw, bh)): ((i32, i32), (u32, u32)),
+    scale: &Scale,
+    missing: bool,
+) -> Result<(), Box<dyn Error>> {
     let mut buf = Vec::with_capacity(bw as usize * bh as usize * 3);
     for y in 0..bh {
         let RGBColor(a, b, c) = scale.at(1.0 - (y as f64 + 0.5) / bh as f64);

@@ -14,7 +14,9 @@ use std::path::Path;
 use std::sync::OnceLock;
 
 mod grid;
+mod mesh;
 pub use grid::{plot_grid_fields, GridMarker, GridPanel, GridPlotOptions};
+pub use mesh::{plot_mesh_fields, MeshView};
 
 /// Error of a plot: carries a message.
 #[derive(Debug, thiserror::Error)]

@@ -214,13 +214,21 @@ pub fn solve(
         solve_with(&l_vals, &mut rhs);
         return Ok((rhs, SolveStatus::Solved, 1));
     }
-    // starting point: slacks of x (shifted to be positive), unit multipliers, then balanced
+    // starting point: slacks of x (shifted to be positive), multipliers below, then balanced
     let mut s = vec![0.0; m];
     ax(&x, &mut s);
     for (sk, bk) in s.iter_mut().zip(&r.b) {
         *sk = bk - *sk;
     }
-    let mut z = vec![1.0; m];
+    // multipliers at the scale of the objective's gradient at the start, which they must
+    // balance (each row of A has entries ±1): 3 × mean |P x + q|. Against unit multipliers
+    // this cut the iterations from 14 to 7 (mountain distance), 27 to 15 (Kármán vorticity),
+    // 15 to 11 (300² noisy grid).
+    let mut g = vec![0.0; n];
+    px(&x, &mut g);
+    let gmean = g.iter().zip(&r.q).map(|(a, b)| (a + b).abs()).sum::<f64>() / n.max(1) as f64;
+    let z0 = (3.0 * gmean).max(1e-12);
+    let mut z = vec![z0; m];
     let smin = s.iter().cloned().fold(f64::INFINITY, f64::min);
     if smin <= 0.0 {
         s.iter_mut().for_each(|v| *v += -1.5 * smin + 1e-3);

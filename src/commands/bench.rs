@@ -98,19 +98,37 @@ fn peak_rss_mib() -> f64 {
         .unwrap_or(f64::NAN)
 }
 
-/// One benchmark case: a series of n samples or an nx × ny grid.
-#[derive(Clone, Copy, Debug, PartialEq)]
+/// One benchmark case: a series of n samples, an nx × ny grid, or a mesh file.
+#[derive(Clone, Debug, PartialEq)]
 pub enum BenchCase {
     /// Random-walk series.
     Series(usize),
     /// Noisy bumps on a grid (columns, rows).
     Grid(usize, usize),
+    /// A mesh file, midpoint-subdivided this many times: geodesic distance from vertex 0,
+    /// then smoothing with every maximum kept (the paper's figure 13).
+    Mesh(String, usize),
 }
 
 impl BenchCase {
-    /// Parses `N` or `NXxNY`.
+    /// Parses `N`, `NXxNY`, or a mesh path with an optional `@LEVELS` of subdivision.
     pub fn parse(s: &str) -> Result<BenchCase> {
-        let bad = || Error::Usage(format!("bench size `{s}` is not N (series) or NXxNY (grid)"));
+        let (file, levels) = match s.rsplit_once('@') {
+            Some((f, l)) => (f, Some(l)),
+            None => (s, None),
+        };
+        if crate::io::mesh::is_mesh_path(std::path::Path::new(file)) {
+            let levels = match levels {
+                None => 0,
+                Some(l) => l
+                    .parse::<usize>()
+                    .ok()
+                    .filter(|&l| l <= 4)
+                    .ok_or_else(|| Error::Usage(format!("bench mesh `{s}`: subdivision levels 0..=4 after @")))?,
+            };
+            return Ok(BenchCase::Mesh(file.to_string(), levels));
+        }
+        let bad = || Error::Usage(format!("bench size `{s}` is not N (series), NXxNY (grid) or a mesh file[@levels]"));
         let case = match s.split_once(['x', 'X', '×']) {
             Some((a, b)) => BenchCase::Grid(a.trim().parse().map_err(|_| bad())?, b.trim().parse().map_err(|_| bad())?),
             None => BenchCase::Series(s.trim().parse().map_err(|_| bad())?),
@@ -130,6 +148,8 @@ impl BenchCase {
         match self {
             BenchCase::Series(n) => n.to_string(),
             BenchCase::Grid(a, b) => format!("{a}x{b}"),
+            BenchCase::Mesh(f, 0) => f.clone(),
+            BenchCase::Mesh(f, l) => format!("{f}@{l}"),
         }
     }
 }
@@ -143,13 +163,28 @@ fn run_single(case: BenchCase, args: &BenchArgs) -> Result<String> {
         ..Default::default()
     };
     let t = Instant::now();
-    let (r, n) = match case {
-        BenchCase::Series(n) => (smooth(&Series::uniform(n), &random_walk(n, args.seed), &settings)?, n),
+    let mut extra = serde_json::json!({});
+    let (r, n) = match &case {
+        BenchCase::Series(n) => (smooth(&Series::uniform(*n), &random_walk(*n, args.seed), &settings)?, *n),
         BenchCase::Grid(nx, ny) => {
             // the benchmark: 13 kept extrema
             settings.selection = Selection::Count { minima: 7, maxima: 6 };
-            let grid = Grid2d::new(nx, ny)?;
-            (smooth(&grid, &noisy_bumps(nx, ny, args.seed), &settings)?, nx * ny)
+            let grid = Grid2d::new(*nx, *ny)?;
+            (smooth(&grid, &noisy_bumps(*nx, *ny, args.seed), &settings)?, nx * ny)
+        }
+        BenchCase::Mesh(file, levels) => {
+            let path = std::path::Path::new(file);
+            let (mut mesh, _) = super::input::read_trimesh(path)?;
+            for _ in 0..*levels {
+                mesh = mesh.subdivide();
+            }
+            let read = t.elapsed().as_secs_f64();
+            let tg = Instant::now();
+            let (h, _) = crate::apps::geodesic::heat_geodesic(&mesh, &[0]).map_err(|m| Error::input(m).in_file(path))?;
+            let geodesic = tg.elapsed().as_secs_f64();
+            extra = serde_json::json!({ "read": read, "geodesic": geodesic, "triangles": mesh.faces().len() });
+            settings.selection = Selection::AllMaxima;
+            (smooth(&mesh, &h, &settings).map_err(|e| e.in_file(path))?, crate::domain::Domain::n_vertices(&mesh))
         }
     };
     let total = t.elapsed().as_secs_f64();
@@ -169,6 +204,7 @@ fn run_single(case: BenchCase, args: &BenchArgs) -> Result<String> {
         "seconds": rep.seconds,
         "total": total,
         "peak_rss_mib": peak_rss_mib(),
+        "extra": extra,
     });
     Ok(format!("{line}\n"))
 }
@@ -181,7 +217,7 @@ pub fn bench(args: &BenchArgs) -> Result<String> {
     let exe = std::env::current_exe().map_err(|source| Error::Io { path: "current executable".into(), source })?;
     let order = args.energy.terms.iter().map(|(k, w)| format!("{k}:{w}")).collect::<Vec<_>>().join(",");
     let mut out = String::from(
-        "| size | input extrema | kept | constraints | iterations | persistence s | complex s | simplify s | representative s | operators s | constraints s | solve s | repair s | verify s | total s | peak MiB |\n|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n",
+        "| size | input extrema | kept | constraints | iterations | read s | geodesic s | persistence s | complex s | simplify s | representative s | operators s | constraints s | solve s | repair s | verify s | total s | peak MiB |\n|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n",
     );
     for case in &args.cases {
         let child = std::process::Command::new(&exe)
@@ -210,12 +246,14 @@ pub fn bench(args: &BenchArgs) -> Result<String> {
         let s = &v["seconds"];
         let f = |x: &serde_json::Value| x.as_f64().unwrap_or(f64::NAN);
         out += &format!(
-            "| {} | {} | {} | {} | {} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} | {:.0} |\n",
+            "| {} | {} | {} | {} | {} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} | {:.0} |\n",
             case.label(),
             v["input_extrema"],
             v["kept"],
             v["constraints"],
             v["iterations"],
+            v["extra"]["read"].as_f64().unwrap_or(0.0),
+            v["extra"]["geodesic"].as_f64().unwrap_or(0.0),
             f(&s["persistence"]),
             f(&s["complex"]),
             f(&s["simplify"]),

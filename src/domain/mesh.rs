@@ -392,6 +392,30 @@ impl TriMesh {
         self.positions.iter().all(|p| p[2] == 0.0)
     }
 
+    /// Midpoint subdivision: every triangle split into four at its edge midpoints (the
+    /// geometry is unchanged; for benchmarks at larger sizes).
+    pub fn subdivide(&self) -> TriMesh {
+        let mut positions = self.positions.clone();
+        let mut mid: HashMap<(usize, usize), usize> = HashMap::with_capacity(self.n_edges);
+        let mut triangles = Vec::with_capacity(4 * self.triangles.len());
+        for t in &self.triangles {
+            let mut m = [0usize; 3];
+            for k in 0..3 {
+                let (a, b) = (t[k], t[(k + 1) % 3]);
+                m[k] = *mid.entry((a.min(b), a.max(b))).or_insert_with(|| {
+                    let (p, q) = (self.positions[a], self.positions[b]);
+                    positions.push([(p[0] + q[0]) / 2.0, (p[1] + q[1]) / 2.0, (p[2] + q[2]) / 2.0]);
+                    positions.len() - 1
+                });
+            }
+            triangles.push([t[0], m[0], m[2]]);
+            triangles.push([m[0], t[1], m[1]]);
+            triangles.push([m[2], m[1], t[2]]);
+            triangles.push([m[0], m[1], m[2]]);
+        }
+        TriMesh::new(positions, triangles).expect("subdividing a valid mesh gives a valid mesh")
+    }
+
     /// One line: vertices, triangles, components, boundary loops, genus.
     pub fn describe(&self) -> String {
         format!(
@@ -608,6 +632,15 @@ mod tests {
         let q = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [-1.0, 0.0, 0.0], [-1.0, -1.0, 0.0]];
         assert!(err(q, vec![[0, 1, 2], [0, 3, 4]]).contains("non-manifold vertices 0"));
         assert!(err(Vec::new(), Vec::new()).contains("at least one triangle"));
+    }
+
+    #[test]
+    fn subdivision_keeps_the_topology() {
+        for m in [sphere(1.0, 6, 8), torus(3.0, 1.0, 8, 6), disk(4, 10, &[])] {
+            let s = m.subdivide();
+            assert_eq!(s.faces().len(), 4 * m.faces().len());
+            assert_eq!((s.euler_characteristic(), s.boundary_loops()), (m.euler_characteristic(), m.boundary_loops()));
+        }
     }
 
     #[test]

@@ -836,11 +836,13 @@ fn b64_encode(bytes: &[u8]) -> String {
 /// The base64 text of one zlib-compressed array in VTK's layout (UInt64 header words,
 /// little-endian): the header `[blocks, block size, last block size, compressed sizes...]`
 /// encoded on its own, then the compressed blocks.
+/// zlib level 1: Float64 fields gain little from harder compression (level 6 took 4.6× longer
+/// on a 25,600-vertex mesh, 0.115 s against 0.025 s, for a file 4.5 % smaller).
 fn compressed_b64(raw: &[u8]) -> std::io::Result<String> {
     let blocks: Vec<Vec<u8>> = raw
         .chunks(BLOCK)
         .map(|chunk| {
-            let mut z = flate2::write::ZlibEncoder::new(Vec::new(), flate2::Compression::default());
+            let mut z = flate2::write::ZlibEncoder::new(Vec::new(), flate2::Compression::fast());
             z.write_all(chunk)?;
             z.finish()
         })

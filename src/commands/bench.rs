@@ -180,7 +180,8 @@ fn run_single(case: BenchCase, args: &BenchArgs) -> Result<String> {
             }
             let read = t.elapsed().as_secs_f64();
             let tg = Instant::now();
-            let (h, _) = crate::apps::geodesic::heat_geodesic(&mesh, &[0]).map_err(|m| Error::input(m).in_file(path))?;
+            let (h, _) =
+                crate::apps::geodesic::heat_geodesic(&mesh, &[0]).map_err(|m| Error::input(m).in_file(path))?;
             let geodesic = tg.elapsed().as_secs_f64();
             extra = serde_json::json!({ "read": read, "geodesic": geodesic, "triangles": mesh.faces().len() });
             settings.selection = Selection::AllMaxima;

@@ -6,7 +6,7 @@ use crate::derive::{describe_missing, fill_missing, magnitude, vorticity};
 use crate::domain::{Domain, Grid2d, TriMesh};
 use crate::error::{Error, Result};
 use crate::io::grid::{read_grid_csv, read_npy, read_raster, GridField};
-use crate::io::mesh::{is_mesh_path, read_mesh, MeshData};
+use crate::io::mesh::{is_mesh_file, read_mesh, MeshData};
 use crate::io::series_csv::{read_series, SeriesCsv, SeriesCsvOptions};
 use crate::io::vtk::read_image;
 use std::path::{Path, PathBuf};
@@ -219,7 +219,7 @@ pub fn read_field(
     if let Some(p) = path {
         let mesh = match kind {
             DomainKind::Mesh => true,
-            DomainKind::Auto => is_mesh_path(p),
+            DomainKind::Auto => is_mesh_file(p),
             _ => false,
         };
         if mesh {

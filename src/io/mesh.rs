@@ -59,6 +59,24 @@ pub fn is_mesh_path(path: &Path) -> bool {
     matches!(extension(path).as_str(), "obj" | "off" | "ply" | "vtu" | "vtp")
 }
 
+/// Whether a file is a mesh: by extension, and for legacy `.vtk` by its `DATASET` line
+/// (POLYDATA or UNSTRUCTURED_GRID; STRUCTURED_POINTS is an image).
+pub fn is_mesh_file(path: &Path) -> bool {
+    if is_mesh_path(path) {
+        return true;
+    }
+    if extension(path) != "vtk" {
+        return false;
+    }
+    let mut head = vec![0u8; 1024];
+    let read = std::fs::File::open(path).and_then(|mut f| std::io::Read::read(&mut f, &mut head)).unwrap_or(0);
+    let text = String::from_utf8_lossy(&head[..read]).to_ascii_uppercase();
+    text.lines().any(|l| {
+        let l = l.trim();
+        l.starts_with("DATASET") && (l.contains("POLYDATA") || l.contains("UNSTRUCTURED_GRID"))
+    })
+}
+
 fn extension(path: &Path) -> String {
     path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase()
 }
@@ -612,6 +630,24 @@ mod tests {
         assert_eq!(m.triangles, vec![[0, 1, 2]]);
         let got = m.array("smoothed").unwrap().values;
         assert!(got.iter().zip(&vals).all(|(a, b)| a.to_bits() == b.to_bits()));
+    }
+
+    #[test]
+    fn legacy_vtk_polydata_and_unstructured_grids_are_read() {
+        let poly = "# vtk DataFile Version 3.0\nsquare\nASCII\nDATASET POLYDATA\nPOINTS 4 float\n\
+                    0 0 0 1 0 0 1 1 0 0 1 0.5\nPOLYGONS 1 5\n4 0 1 2 3\nPOINT_DATA 4\nSCALARS t double 1\n\
+                    LOOKUP_TABLE default\n1.5 2.5 3.5 4.5\n";
+        let m = read_mesh(&tmp("sq.vtk", poly.as_bytes())).unwrap();
+        assert_eq!(m.triangles, vec![[0, 1, 2], [0, 2, 3]]);
+        assert_eq!(m.array("t").unwrap().values, vec![1.5, 2.5, 3.5, 4.5]);
+        let ug = "# vtk DataFile Version 3.0\nsquare\nASCII\nDATASET UNSTRUCTURED_GRID\nPOINTS 4 double\n\
+                  0 0 0 1 0 0 1 1 0 0 1 0.5\nCELLS 3 10\n3 0 1 2\n3 0 2 3\n1 3\nCELL_TYPES 3\n5\n5\n1\n";
+        let m = read_mesh(&tmp("ug.vtk", ug.as_bytes())).unwrap();
+        assert_eq!(m.triangles, vec![[0, 1, 2], [0, 2, 3]]);
+        assert_eq!(m.notes, vec!["1 vertex and line cells ignored".to_string()]);
+        let tet = ug.replace("CELL_TYPES 3\n5\n5\n1", "CELL_TYPES 3\n5\n5\n10");
+        let e = read_mesh(&tmp("tet.vtk", tet.as_bytes())).unwrap_err().to_string();
+        assert!(e.contains("tet.vtk") && e.contains("cell 2"), "{e}");
     }
 
     #[test]

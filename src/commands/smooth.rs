@@ -59,6 +59,9 @@ pub fn smooth(args: &SmoothArgs) -> Result<String> {
     if let Some((u, v)) = &args.grid.uv {
         inputs.extend([u.as_path(), v.as_path()]);
     }
+    if let Some(values) = &args.grid.values {
+        inputs.push(values.as_path());
+    }
     check_distinct(
         &inputs,
         &[

@@ -135,18 +135,21 @@ impl TriMesh {
                 list(&bad)
             )));
         }
-        let mut seen: HashMap<[usize; 3], usize> = HashMap::with_capacity(triangles.len());
-        let mut dups = Vec::new();
-        for (t, tri) in triangles.iter().enumerate() {
-            let mut key = *tri;
-            key.sort_unstable();
-            if let Some(&first) = seen.get(&key) {
-                dups.push(format!("{t} (= {first})"));
-            } else {
-                seen.insert(key, t);
-            }
-        }
-        drop(seen);
+        let mut keyed: Vec<([usize; 3], usize)> = triangles
+            .iter()
+            .enumerate()
+            .map(|(t, tri)| {
+                let mut key = *tri;
+                key.sort_unstable();
+                (key, t)
+            })
+            .collect();
+        keyed.sort_unstable();
+        let mut dups: Vec<(usize, usize)> =
+            keyed.windows(2).filter(|w| w[0].0 == w[1].0).map(|w| (w[1].1, w[0].1)).collect();
+        dups.sort_unstable();
+        let dups: Vec<String> = dups.iter().map(|(t, first)| format!("{t} (= {first})")).collect();
+        drop(keyed);
         if !dups.is_empty() {
             return Err(Error::input(format!("duplicate triangles {}", list(&dups))));
         }
@@ -173,59 +176,72 @@ impl TriMesh {
                 list(&dups)
             )));
         }
-        // edges and their triangles
-        let mut edge_tris: HashMap<(usize, usize), Vec<usize>> = HashMap::with_capacity(3 * triangles.len() / 2);
+        // edges and their triangles, from the sorted half-edges (no hashing: this is the
+        // hot part of reading a large mesh)
+        let nt = triangles.len();
+        let mut half: Vec<(usize, usize, usize)> = Vec::with_capacity(3 * nt);
         for (t, tri) in triangles.iter().enumerate() {
             for k in 0..3 {
                 let (a, b) = (tri[k], tri[(k + 1) % 3]);
-                edge_tris.entry((a.min(b), a.max(b))).or_default().push(t);
+                half.push((a.min(b), a.max(b), t));
             }
         }
-        let mut bad: Vec<String> = edge_tris
-            .iter()
-            .filter(|(_, ts)| ts.len() > 2)
-            .map(|(e, ts)| format!("{}–{} ({} triangles)", e.0, e.1, ts.len()))
-            .collect();
-        bad.sort();
+        half.sort_unstable();
+        let mut edges: Vec<(usize, usize)> = Vec::with_capacity(3 * nt / 2 + 1);
+        let mut edge_tris: Vec<[usize; 2]> = Vec::with_capacity(3 * nt / 2 + 1);
+        let mut bad: Vec<String> = Vec::new();
+        let mut i = 0;
+        while i < half.len() {
+            let (a, b, t) = half[i];
+            let mut j = i + 1;
+            while j < half.len() && (half[j].0, half[j].1) == (a, b) {
+                j += 1;
+            }
+            if j - i > 2 {
+                bad.push(format!("{a}–{b} ({} triangles)", j - i));
+            }
+            edges.push((a, b));
+            edge_tris.push([t, if j - i >= 2 { half[i + 1].2 } else { usize::MAX }]);
+            i = j;
+        }
+        drop(half);
         if !bad.is_empty() {
             return Err(Error::input(format!("non-manifold edges (on more than two triangles): {}", list(&bad))));
         }
-        // manifold vertices: the triangles around a vertex are connected through its edges
-        let mut vertex_tris: Vec<Vec<usize>> = vec![Vec::new(); n];
-        for (t, tri) in triangles.iter().enumerate() {
-            for &v in tri {
-                vertex_tris[v].push(t);
+        let edge_of = |a: usize, b: usize| -> usize {
+            edges.binary_search(&(a.min(b), a.max(b))).expect("every triangle edge is listed")
+        };
+        // manifold vertices: the corners (vertex, triangle) at a vertex are joined across its
+        // interior edges; more than one group is more than one fan
+        let corner = |tris: &[[usize; 3]], v: usize, t: usize| 3 * t + tris[t].iter().position(|&x| x == v).expect("corner");
+        let mut parent: Vec<usize> = (0..3 * nt).collect();
+        fn root(p: &mut [usize], mut x: usize) -> usize {
+            while p[x] != x {
+                p[x] = p[p[x]];
+                x = p[x];
             }
+            x
         }
-        let mut bad = Vec::new();
-        for v in 0..n {
-            let ts = &vertex_tris[v];
-            if ts.len() < 2 {
+        for (e, &(a, b)) in edges.iter().enumerate() {
+            let [t1, t2] = edge_tris[e];
+            if t2 == usize::MAX {
                 continue;
             }
-            // walk from the first triangle across the edges at v
-            let mut reached = vec![false; ts.len()];
-            let mut stack = vec![0usize];
-            reached[0] = true;
-            while let Some(i) = stack.pop() {
-                for &w in &triangles[ts[i]] {
-                    if w == v {
-                        continue;
-                    }
-                    for &t2 in &edge_tris[&(v.min(w), v.max(w))] {
-                        if let Some(j) = ts.iter().position(|&x| x == t2) {
-                            if !reached[j] {
-                                reached[j] = true;
-                                stack.push(j);
-                            }
-                        }
-                    }
+            for v in [a, b] {
+                let (r1, r2) = (root(&mut parent, corner(&triangles, v, t1)), root(&mut parent, corner(&triangles, v, t2)));
+                if r1 != r2 {
+                    parent[r1] = r2;
                 }
             }
-            if reached.iter().any(|r| !r) {
-                bad.push(v);
+        }
+        let mut fans = vec![0u32; n];
+        for c in 0..3 * nt {
+            if root(&mut parent, c) == c {
+                fans[triangles[c / 3][c % 3]] += 1;
             }
         }
+        drop(parent);
+        let bad: Vec<usize> = (0..n).filter(|&v| fans[v] > 1).collect();
         if !bad.is_empty() {
             return Err(Error::input(format!(
                 "non-manifold vertices {} (their triangles form more than one fan)",
@@ -233,11 +249,11 @@ impl TriMesh {
             )));
         }
         // components of the triangle graph; consistent orientation by BFS
-        let mut tri_comp = vec![usize::MAX; triangles.len()];
+        let mut tri_comp = vec![usize::MAX; nt];
         let mut n_components = 0;
         let mut flipped = 0usize;
         let mut non_orientable = 0usize;
-        for seed in 0..triangles.len() {
+        for seed in 0..nt {
             if tri_comp[seed] != usize::MAX {
                 continue;
             }
@@ -247,23 +263,23 @@ impl TriMesh {
                 let tri = triangles[t];
                 for k in 0..3 {
                     let (a, b) = (tri[k], tri[(k + 1) % 3]);
-                    for &t2 in &edge_tris[&(a.min(b), a.max(b))] {
-                        if t2 == t {
-                            continue;
+                    let [t1, t2] = edge_tris[edge_of(a, b)];
+                    let other = if t1 == t { t2 } else { t1 };
+                    if other == usize::MAX {
+                        continue;
+                    }
+                    // the neighbour agrees with t when it runs the shared edge b → a
+                    let o = triangles[other];
+                    let same = (0..3).any(|j| o[j] == a && o[(j + 1) % 3] == b);
+                    if tri_comp[other] == usize::MAX {
+                        tri_comp[other] = n_components;
+                        if same {
+                            triangles[other].swap(1, 2);
+                            flipped += 1;
                         }
-                        // t2 agrees with t when it runs the shared edge b → a
-                        let o = triangles[t2];
-                        let same = (0..3).any(|j| o[j] == a && o[(j + 1) % 3] == b);
-                        if tri_comp[t2] == usize::MAX {
-                            tri_comp[t2] = n_components;
-                            if same {
-                                triangles[t2].swap(1, 2);
-                                flipped += 1;
-                            }
-                            queue.push_back(t2);
-                        } else if same {
-                            non_orientable += 1;
-                        }
+                        queue.push_back(other);
+                    } else if same {
+                        non_orientable += 1;
                     }
                 }
             }
@@ -285,9 +301,8 @@ impl TriMesh {
             }
         }
         // adjacency
-        let mut edges: Vec<(usize, usize)> = edge_tris.keys().copied().collect();
-        edges.sort_unstable();
-        let boundary: Vec<(usize, usize)> = edges.iter().copied().filter(|e| edge_tris[e].len() == 1).collect();
+        let boundary: Vec<(usize, usize)> =
+            edges.iter().zip(&edge_tris).filter(|(_, t)| t[1] == usize::MAX).map(|(e, _)| *e).collect();
         let n_edges = edges.len();
         let mut start = vec![0usize; n + 1];
         for &(a, b) in &edges {

@@ -26,7 +26,8 @@ struct Cli {
 enum Command {
     /// List the extrema with their persistence and strictness; draw the persistence diagram.
     Extrema {
-        /// Input: a series (CSV) or a grid (.vti, .vtk, .npy, CSV matrix, PNG, TIFF).
+        /// Input: a series (CSV), a grid (.vti, .vtk, .npy, CSV matrix, PNG, TIFF) or a mesh
+        /// (.obj, .off, .ply, .vtu, .vtp, legacy .vtk polydata).
         #[arg(required_unless_present = "u")]
         input: Option<PathBuf>,
         #[command(flatten)]
@@ -47,7 +48,8 @@ enum Command {
     Smooth(Box<SmoothCli>),
     /// Re-check an output file of `smooth` from what it carries.
     Verify {
-        /// Output file of `smooth`: series CSV (x,input,output,u,role), .vti or .npz.
+        /// Output file of `smooth`: series CSV (x,input,output,u,role), .vti, .npz, .vtu, .vtp
+        /// or .ply.
         file: PathBuf,
         /// The original input: check the file's input array against it (read with the same
         /// options as for `smooth`).
@@ -227,21 +229,23 @@ enum Edges {
 
 #[derive(Args)]
 struct SmoothCli {
-    /// Input: a series (CSV) or a grid (.vti, .vtk, .npy, CSV matrix, PNG, TIFF).
+    /// Input: a series (CSV), a grid (.vti, .vtk, .npy, CSV matrix, PNG, TIFF) or a mesh
+    /// (.obj, .off, .ply, .vtu, .vtp, legacy .vtk polydata).
     #[arg(required_unless_present = "u")]
     input: Option<PathBuf>,
     /// Output: a series CSV (x,input,output,u,role); for grids .vti or .npz (verifiable:
-    /// input, smoothed, representative, role) or .npy / CSV (the smoothed array only).
+    /// input, smoothed, representative, role) or .npy / CSV (the smoothed array only); for
+    /// meshes .vtu, .vtp or .ply (verifiable, the same arrays).
     #[arg(short, long)]
     output: PathBuf,
     #[command(flatten)]
     csv: CsvArgs,
     #[command(flatten)]
     grid: GridCli,
-    /// Grid: kept extrema, saddles and separatrices as VTK PolyData (.vtp).
+    /// Grids and meshes: kept extrema, saddles and separatrices as VTK PolyData (.vtp).
     #[arg(long, value_name = "VTP")]
     complex: Option<PathBuf>,
-    /// Grid: representative function.
+    /// Grids and meshes: representative function.
     #[arg(long, value_enum, default_value_t = RepresentativeCli::Separatrix)]
     representative: RepresentativeCli,
     /// Mesh plot: camera azimuth and elevation in degrees (y up).
@@ -256,10 +260,10 @@ struct SmoothCli {
     /// Series: keep the N most persistent (minimum, maximum) pairs besides the global minimum.
     #[arg(long, value_name = "N", conflicts_with_all = ["minima", "keep_min", "keep_max"])]
     pairs: Option<usize>,
-    /// Grids: keep the N most persistent minima (with --maxima).
+    /// Grids and meshes: keep the N most persistent minima (with --maxima).
     #[arg(long, value_name = "N", requires = "maxima", conflicts_with_all = ["keep_min", "keep_max"])]
     minima: Option<usize>,
-    /// Grids: keep the M most persistent maxima (with --minima).
+    /// Grids and meshes: keep the M most persistent maxima (with --minima).
     #[arg(long, value_name = "M", requires = "minima")]
     maxima: Option<usize>,
     /// Surfaces: keep every maximum of persistence > 0 and only the global minimum (geodesic

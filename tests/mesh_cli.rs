@@ -83,10 +83,27 @@ fn a_coordinate_or_a_values_file_is_the_field() {
     let o = toposmooth(&["smooth", &mesh, "--array", "y", "--persistence", "10%", "-o", &out]);
     assert_eq!(o.status.code(), Some(0), "{}", text(&o));
     assert_eq!(toposmooth(&["verify", &out]).status.code(), Some(0));
-    // tampering with the smoothed array is caught
+    // tampering with the smoothed array is caught: raise a free vertex above all its neighbours
     let m = read_mesh(Path::new(&out)).unwrap();
     let n = m.positions.len();
-    let values: String = (0..n).map(|v| format!("{}\n", m.positions[v][1])).collect();
+    let get = |name: &str| m.array(name).unwrap().values;
+    let (input, mut smoothed, u, role) = (get("input"), get("smoothed"), get("representative"), get("role"));
+    let v = (0..n).find(|&v| role[v] == 0.0).unwrap();
+    smoothed[v] = 1e9;
+    let bad = dir.join("tampered.ply");
+    let arrays: Vec<(&str, &[f64])> =
+        vec![("input", &input), ("smoothed", &smoothed), ("representative", &u), ("role", &role)];
+    toposmooth::io::mesh::stage_ply(&bad, &m.positions, &m.triangles, &arrays).unwrap().commit().unwrap();
+    let o = toposmooth(&["verify", &bad.display().to_string()]);
+    assert_eq!(o.status.code(), Some(1), "{}", text(&o));
+    assert!(text(&o).contains(&format!("vertex {v}")), "{}", text(&o));
+    // the same field from a values file: the y coordinates in the OBJ file's own vertex order
+    let obj = std::fs::read_to_string(&mesh).unwrap();
+    let values: String = obj
+        .lines()
+        .filter(|l| l.starts_with("v "))
+        .map(|l| format!("{}\n", l.split_whitespace().nth(2).unwrap()))
+        .collect();
     let file = dir.join("y.txt");
     std::fs::write(&file, values).unwrap();
     let out2 = dir.join("b2.vtu").display().to_string();

@@ -22,9 +22,12 @@ fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
     [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
 }
 
-/// Seconds spent in the stages of [`heat_geodesic`].
+/// Seconds spent in the stages of [`heat_geodesic`], and the heat time used.
 #[derive(Clone, Copy, Debug, Default, serde::Serialize)]
 pub struct GeodesicSeconds {
+    /// The heat time as a multiple of (mean edge length)²: 1 unless the heat underflowed far
+    /// from the sources (very fine meshes), then 4, 16, … until it reaches every vertex.
+    pub time_scale: f64,
     /// Operators and the symbolic analysis.
     pub setup: f64,
     /// Heat step: factorisation and solve.
@@ -70,6 +73,21 @@ fn upper(
     (faer::sparse::SymbolicSparseColMat::new_checked(n, n, col_ptr, None, rows), values)
 }
 
+/// The triangle with the smallest angle, and that angle in degrees.
+fn smallest_angle(p: &[[f64; 3]], tris: &[[usize; 3]]) -> (usize, f64) {
+    let mut best = (0, f64::INFINITY);
+    for (t, tri) in tris.iter().enumerate() {
+        for k in 0..3 {
+            let (a, b) = (sub(p[tri[(k + 1) % 3]], p[tri[k]]), sub(p[tri[(k + 2) % 3]], p[tri[k]]));
+            let angle = dot(cross(a, b), cross(a, b)).sqrt().atan2(dot(a, b)).to_degrees();
+            if angle < best.1 {
+                best = (t, angle);
+            }
+        }
+    }
+    best
+}
+
 /// Geodesic distance from `sources` (vertex indices) to every vertex of `mesh`.
 ///
 /// # Errors
@@ -113,14 +131,40 @@ pub fn heat_geodesic(mesh: &TriMesh, sources: &[usize]) -> Result<(Vec<f64>, Geo
     let (pattern, heat_values) = upper(&k, time, &m, &none);
     let mut solver = SpdSolver::new(pattern.as_ref())?;
     seconds.setup = t0.elapsed().as_secs_f64();
+    let factor_failed = |e: String| {
+        let (worst, angle) = smallest_angle(p, tris);
+        format!(
+            "the sparse Cholesky factorisation failed ({e}): the mesh has nearly degenerate triangles \
+             (smallest angle {angle:.2e}° in triangle {worst})"
+        )
+    };
 
-    // heat: (M + tK) u = δ_sources
+    // heat: (M + tK) u = δ_sources. With t = h² the heat decays like exp(−d²/4t): on a fine
+    // mesh it underflows far from the sources, where the normalised gradient is then
+    // undefined; t grows ×4 until every vertex gets heat.
     let t = std::time::Instant::now();
-    let mut u = vec![0.0; n];
-    for &s in sources {
-        u[s] = 1.0;
-    }
-    solver.solve(faer::sparse::SparseColMatRef::new(pattern.as_ref(), &heat_values), &mut u)?;
+    let mut scale = 1.0;
+    let mut heat_values = heat_values;
+    let u = loop {
+        let mut u = vec![0.0; n];
+        for &s in sources {
+            u[s] = 1.0;
+        }
+        solver
+            .solve(faer::sparse::SparseColMatRef::new(pattern.as_ref(), &heat_values), &mut u)
+            .map_err(factor_failed)?;
+        let top = u.iter().fold(0.0f64, |a, &v| a.max(v));
+        let cold = u.iter().filter(|&&v| v.is_nan() || v <= 1e-250 * top).count();
+        if cold == 0 {
+            break u;
+        }
+        if scale >= 4f64.powi(10) {
+            return Err(format!("the heat does not reach {cold} vertices even with t = {scale} h²"));
+        }
+        scale *= 4.0;
+        heat_values = upper(&k, time * scale, &m, &none).1;
+    };
+    seconds.time_scale = scale;
     seconds.heat = t.elapsed().as_secs_f64();
 
     // X = −∇u/|∇u| per triangle, then its integrated divergence at the vertices
@@ -167,7 +211,9 @@ pub fn heat_geodesic(mesh: &TriMesh, sources: &[usize]) -> Result<(Vec<f64>, Geo
     }
     let (_, poisson_values) = upper(&k, 1.0, &vec![0.0; n], &pinned);
     let mut phi: Vec<f64> = (0..n).map(|i| if pinned[i] { 0.0 } else { div[i] }).collect();
-    solver.solve(faer::sparse::SparseColMatRef::new(pattern.as_ref(), &poisson_values), &mut phi)?;
+    solver
+        .solve(faer::sparse::SparseColMatRef::new(pattern.as_ref(), &poisson_values), &mut phi)
+        .map_err(factor_failed)?;
     seconds.poisson = t.elapsed().as_secs_f64();
     // K φ = div gives −φ of L φ = div: distances grow away from the sources
     for (i, v) in phi.iter_mut().enumerate() {
@@ -204,6 +250,27 @@ mod tests {
             assert!(mean < 0.03 && worst < 0.08, "source {source}: mean {mean} max {worst}");
             assert_eq!(d[source], 0.0);
         }
+    }
+
+    #[test]
+    fn the_heat_reaches_every_vertex_of_a_fine_mesh() {
+        // a long thin strip of many small triangles: with t = h² the heat underflows at the far end
+        let (nx, ny) = (800, 3);
+        let p: Vec<[f64; 3]> = (0..nx * ny).map(|v| [(v % nx) as f64, (v / nx) as f64, 0.0]).collect();
+        let mut t = Vec::new();
+        for r in 0..ny - 1 {
+            for c in 0..nx - 1 {
+                let v = r * nx + c;
+                t.push([v, v + 1, v + nx + 1]);
+                t.push([v, v + nx + 1, v + nx]);
+            }
+        }
+        let m = TriMesh::new(p, t).unwrap();
+        let (d, s) = heat_geodesic(&m, &[0]).unwrap();
+        assert!(s.time_scale > 1.0, "{}", s.time_scale);
+        let far = nx - 1;
+        assert!((d[far] - far as f64).abs() / (far as f64) < 0.05, "distance {} for {far}", d[far]);
+        assert!(d.windows(2).take(nx - 1).all(|w| w[1] > w[0]), "increasing along the strip");
     }
 
     #[test]

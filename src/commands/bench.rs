@@ -176,7 +176,7 @@ fn run_single(case: BenchCase, args: &BenchArgs) -> Result<String> {
             let path = std::path::Path::new(file);
             let (mut mesh, _) = super::input::read_trimesh(path)?;
             for _ in 0..*levels {
-                mesh = mesh.subdivide();
+                mesh = mesh.subdivide().map_err(|e| e.in_file(path))?;
             }
             let read = t.elapsed().as_secs_f64();
             let tg = Instant::now();

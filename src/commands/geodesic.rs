@@ -75,6 +75,7 @@ pub fn geodesic(args: &GeodesicArgs) -> Result<String> {
     }
     Ok(format!(
         "{}: heat-method geodesic distance on a mesh of {} from {} source{} (vertex {}); largest {} at vertex {farthest}\n\
+         heat time t = {} × (mean edge length)²\n\
          seconds: read {read_seconds:.3}, setup {:.3}, heat {:.3}, field {:.3}, poisson {:.3}, write {write_seconds:.3}, total {:.3}\n\
          wrote {}\n",
         args.input.display(),
@@ -83,6 +84,7 @@ pub fn geodesic(args: &GeodesicArgs) -> Result<String> {
         if args.sources.len() == 1 { "" } else { "s" },
         args.sources.iter().map(|s| s.to_string()).collect::<Vec<_>>().join(", "),
         super::sig6(max),
+        seconds.time_scale,
         seconds.setup,
         seconds.heat,
         seconds.field,

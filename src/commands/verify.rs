@@ -212,10 +212,19 @@ fn verify_mesh(args: &VerifyArgs) -> Result<String> {
     let (mesh, data) = read_trimesh(&args.file)?;
     let n = mesh.n_vertices();
     let take = |name: &str| -> Result<Vec<f64>> {
-        data.array(name).map(|a| a.values).map_err(|m| {
+        let a = data.array(name).map_err(|m| {
             Error::input(format!("{m} (a verifiable output holds input, smoothed, representative, role)"))
                 .in_file(&args.file)
-        })
+        })?;
+        if a.components != 1 || a.values.len() != n {
+            return Err(Error::input(format!(
+                "array `{name}` has {} components ({} values for {n} vertices); a scalar is needed",
+                a.components,
+                a.values.len()
+            ))
+            .in_file(&args.file));
+        }
+        Ok(a.values)
     };
     let (input, smoothed, representative, role) =
         (take("input")?, take("smoothed")?, take("representative")?, take("role")?);

@@ -39,6 +39,7 @@ pub struct TriMesh {
     n_components: usize,
     diameter: f64,
     repairs: Vec<String>,
+    orientable: bool,
 }
 
 /// At most this many offending elements are named in a message.
@@ -213,7 +214,8 @@ impl TriMesh {
         };
         // manifold vertices: the corners (vertex, triangle) at a vertex are joined across its
         // interior edges; more than one group is more than one fan
-        let corner = |tris: &[[usize; 3]], v: usize, t: usize| 3 * t + tris[t].iter().position(|&x| x == v).expect("corner");
+        let corner =
+            |tris: &[[usize; 3]], v: usize, t: usize| 3 * t + tris[t].iter().position(|&x| x == v).expect("corner");
         let mut parent: Vec<usize> = (0..3 * nt).collect();
         fn root(p: &mut [usize], mut x: usize) -> usize {
             while p[x] != x {
@@ -228,7 +230,8 @@ impl TriMesh {
                 continue;
             }
             for v in [a, b] {
-                let (r1, r2) = (root(&mut parent, corner(&triangles, v, t1)), root(&mut parent, corner(&triangles, v, t2)));
+                let (r1, r2) =
+                    (root(&mut parent, corner(&triangles, v, t1)), root(&mut parent, corner(&triangles, v, t2)));
                 if r1 != r2 {
                     parent[r1] = r2;
                 }
@@ -353,6 +356,7 @@ impl TriMesh {
             n_components,
             diameter,
             repairs,
+            orientable: non_orientable == 0,
         })
     }
 
@@ -391,8 +395,13 @@ impl TriMesh {
         self.positions.len() as i64 - self.n_edges as i64 + self.triangles.len() as i64
     }
 
+    /// Whether every component could be oriented consistently.
+    pub fn is_orientable(&self) -> bool {
+        self.orientable
+    }
+
     /// Genus of an orientable surface: `(2c − χ − b) / 2` over c components and b boundary
-    /// loops (the total over components).
+    /// loops (the total over components); meaningless for a non-orientable one.
     pub fn genus(&self) -> i64 {
         (2 * self.n_components as i64 - self.euler_characteristic() - self.boundary_loops as i64) / 2
     }
@@ -409,7 +418,10 @@ impl TriMesh {
 
     /// Midpoint subdivision: every triangle split into four at its edge midpoints (the
     /// geometry is unchanged; for benchmarks at larger sizes).
-    pub fn subdivide(&self) -> TriMesh {
+    ///
+    /// # Errors
+    /// When a quarter of a triangle falls below the zero-area threshold.
+    pub fn subdivide(&self) -> Result<TriMesh> {
         let mut positions = self.positions.clone();
         let mut mid: HashMap<(usize, usize), usize> = HashMap::with_capacity(self.n_edges);
         let mut triangles = Vec::with_capacity(4 * self.triangles.len());
@@ -428,20 +440,24 @@ impl TriMesh {
             triangles.push([m[2], m[1], t[2]]);
             triangles.push([m[0], m[1], m[2]]);
         }
-        TriMesh::new(positions, triangles).expect("subdividing a valid mesh gives a valid mesh")
+        TriMesh::new(positions, triangles)
     }
 
     /// One line: vertices, triangles, components, boundary loops, genus.
     pub fn describe(&self) -> String {
         format!(
-            "{} vertices, {} triangles, {} component{}, {} boundary loop{}, genus {}",
+            "{} vertices, {} triangles, {} component{}, {} boundary loop{}, {}",
             self.positions.len(),
             self.triangles.len(),
             self.n_components,
             if self.n_components == 1 { "" } else { "s" },
             self.boundary_loops,
             if self.boundary_loops == 1 { "" } else { "s" },
-            self.genus()
+            if self.orientable {
+                format!("genus {}", self.genus())
+            } else {
+                format!("non-orientable, Euler characteristic {}", self.euler_characteristic())
+            }
         )
     }
 }
@@ -652,7 +668,7 @@ mod tests {
     #[test]
     fn subdivision_keeps_the_topology() {
         for m in [sphere(1.0, 6, 8), torus(3.0, 1.0, 8, 6), disk(4, 10, &[])] {
-            let s = m.subdivide();
+            let s = m.subdivide().unwrap();
             assert_eq!(s.faces().len(), 4 * m.faces().len());
             assert_eq!((s.euler_characteristic(), s.boundary_loops()), (m.euler_characteristic(), m.boundary_loops()));
         }

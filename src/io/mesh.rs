@@ -1,4 +1,4 @@
-//! Triangle meshes: OBJ (tobj), OFF, PLY ascii and binary (ply-rs-bw), VTK XML `.vtu`/`.vtp`
+//! Triangle meshes: OBJ, OFF, PLY ascii and binary (ply-rs-bw), VTK XML `.vtu`/`.vtp`
 //! and legacy `.vtk` unstructured grids and polydata (vtkio); written as `.vtu`, `.vtp` (see
 //! [`super::vtk`]) and binary PLY with Float64 vertex properties.
 //!
@@ -140,126 +140,134 @@ fn polygon_note(split: usize, notes: &mut Vec<String>) {
     }
 }
 
+/// OBJ: `v` lines (x y z, extra values such as colours ignored) and `f` lines (1-based or
+/// negative relative indices, `v/vt/vn` forms, polygons); other statements are ignored.
+/// Written here rather than with tobj: tobj numbers vertices in the order faces first use
+/// them and drops unused ones, but vertex indices must follow the file (`--values`,
+/// `--source`, `--keep-min` refer to them) and unused vertices must be reported.
 fn read_obj(bytes: &[u8]) -> std::result::Result<MeshData, String> {
-    let options = tobj::LoadOptions { triangulate: false, single_index: false, ..Default::default() };
-    let mut reader = std::io::BufReader::new(bytes);
-    let (models, _) = tobj::load_obj_buf(&mut reader, &options, |_| Err(tobj::LoadError::OpenFileFailed))
-        .map_err(|e| format!("cannot parse the OBJ file: {e}"))?;
-    // tobj gives every object/group its own vertex list; positions shared between groups are
-    // merged back below by their coordinates (exact equality), so groups stay connected
+    let text = std::str::from_utf8(bytes).map_err(|_| "an OBJ file must be text (UTF-8)".to_string())?;
     let mut data = MeshData::default();
     let mut split = 0;
-    let mut index: std::collections::HashMap<[u64; 3], usize> = std::collections::HashMap::new();
-    let several = models.len() > 1;
-    for model in &models {
-        let m = &model.mesh;
-        if m.positions.len() % 3 != 0 {
-            return Err("a vertex has fewer than 3 coordinates".into());
-        }
-        let map: Vec<usize> = m
-            .positions
-            .chunks(3)
-            .map(|c| {
-                let p = [c[0], c[1], c[2]];
-                if several {
-                    *index.entry(p.map(f64::to_bits)).or_insert_with(|| {
-                        data.positions.push(p);
-                        data.positions.len() - 1
+    let mut faces: Vec<(usize, Vec<i64>, i64)> = Vec::new();
+    for (l, line) in text.lines().enumerate() {
+        let line = line.split('#').next().unwrap_or("");
+        let mut tokens = line.split_whitespace();
+        match tokens.next() {
+            Some("v") => {
+                let mut c = [0.0f64; 3];
+                for (k, slot) in c.iter_mut().enumerate() {
+                    let t = tokens.next().ok_or_else(|| format!("line {}: a vertex has {k} coordinates", l + 1))?;
+                    *slot = t.parse().map_err(|_| format!("line {}: `{t}` is not a number", l + 1))?;
+                }
+                data.positions.push(c);
+            }
+            Some("f") => {
+                let idx: Vec<i64> = tokens
+                    .map(|t| {
+                        let v = t.split('/').next().unwrap_or("");
+                        v.parse::<i64>().map_err(|_| format!("line {}: `{t}` is not a vertex reference", l + 1))
                     })
+                    .collect::<std::result::Result<_, _>>()?;
+                faces.push((l + 1, idx, data.positions.len() as i64));
+            }
+            _ => {}
+        }
+    }
+    let n = data.positions.len() as i64;
+    for (line, idx, before) in faces {
+        if idx.len() < 3 {
+            return Err(format!("line {line}: a face has {} corners", idx.len()));
+        }
+        // negative indices count back from the last vertex read before the face
+        let face: Vec<usize> = idx
+            .iter()
+            .map(|&i| {
+                let v = if i > 0 { i - 1 } else { before + i };
+                if i == 0 || v < 0 || v >= n {
+                    Err(format!("line {line}: vertex reference {i} is out of range (there are {n} vertices)"))
                 } else {
-                    data.positions.push(p);
-                    data.positions.len() - 1
+                    Ok(v as usize)
                 }
             })
-            .collect();
-        let arity: Vec<usize> = if m.face_arities.is_empty() {
-            vec![3; m.indices.len() / 3]
-        } else {
-            m.face_arities.iter().map(|&a| a as usize).collect()
-        };
-        let mut at = 0;
-        for a in arity {
-            let face: Vec<usize> = m.indices[at..at + a]
-                .iter()
-                .map(|&i| {
-                    map.get(i as usize).copied().ok_or_else(|| format!("face refers to missing vertex {}", i + 1))
-                })
-                .collect::<std::result::Result<_, _>>()?;
-            if a < 3 {
-                return Err(format!("a face has {a} corners"));
-            }
-            if a > 3 {
-                split += 1;
-            }
-            fan(&face, &mut data.triangles);
-            at += a;
+            .collect::<std::result::Result<_, _>>()?;
+        if face.len() > 3 {
+            split += 1;
         }
+        fan(&face, &mut data.triangles);
     }
     polygon_note(split, &mut data.notes);
     Ok(data)
 }
 
+/// OFF (ascii): the `OFF` keyword (optional), counts, one vertex per line (values after x y z,
+/// such as colours, ignored), one face per line (`k i1 … ik`, values after them ignored).
 fn read_off(bytes: &[u8]) -> std::result::Result<MeshData, String> {
     let text = std::str::from_utf8(bytes).map_err(|_| "an OFF file must be text (binary OFF is not supported)")?;
-    // tokens with their line numbers, comments removed
-    let mut tokens = text
+    // non-empty lines with their numbers, comments removed
+    let mut lines = text
         .lines()
         .enumerate()
-        .flat_map(|(l, line)| line.split('#').next().unwrap_or("").split_whitespace().map(move |t| (l + 1, t)));
-    let (l, head) = tokens.next().ok_or("the file is empty")?;
-    let mut first_count = None;
-    if !head.ends_with("OFF") {
-        // some writers omit the keyword
-        first_count = Some((l, head));
-    }
-    if head != "OFF" && head.ends_with("OFF") {
+        .map(|(l, line)| (l + 1, line.split('#').next().unwrap_or("").split_whitespace().collect::<Vec<&str>>()))
+        .filter(|(_, t)| !t.is_empty());
+    let (mut l, mut first) = lines.next().ok_or("the file is empty")?;
+    if first[0] != "OFF" && first[0].ends_with("OFF") {
         return Err(format!(
-            "line {l}: `{head}` variants (colours, normals, texture) are not supported; use plain OFF"
+            "line {l}: `{}` variants (colours, normals, texture) are not supported; use plain OFF",
+            first[0]
         ));
     }
-    let mut next_num = |what: &str| -> std::result::Result<(usize, f64), String> {
-        let (l, t) = match first_count.take() {
-            Some(x) => x,
-            None => tokens.next().ok_or_else(|| format!("the file ends before {what}"))?,
-        };
-        t.parse::<f64>().map(|v| (l, v)).map_err(|_| format!("line {l}: `{t}` is not a number ({what})"))
+    if first[0] == "OFF" {
+        first.remove(0);
+        if first.is_empty() {
+            (l, first) = lines.next().ok_or("the file ends before the counts")?;
+        }
+    }
+    let num = |t: &str, l: usize, what: &str| -> std::result::Result<f64, String> {
+        t.parse::<f64>().map_err(|_| format!("line {l}: `{t}` is not a number ({what})"))
     };
-    let count = |v: f64, l: usize, what: &str| -> std::result::Result<usize, String> {
+    let count = |t: &str, l: usize, what: &str| -> std::result::Result<usize, String> {
+        let v = num(t, l, what)?;
         if v >= 0.0 && v.fract() == 0.0 && v < 1e12 {
             Ok(v as usize)
         } else {
             Err(format!("line {l}: {what} {v} is not a count"))
         }
     };
-    let (l, nv) = next_num("the vertex count")?;
-    let nv = count(nv, l, "vertex count")?;
-    let (l, nf) = next_num("the face count")?;
-    let nf = count(nf, l, "face count")?;
-    next_num("the edge count")?;
+    if first.len() < 2 {
+        return Err(format!("line {l}: expected the vertex, face and edge counts"));
+    }
+    let nv = count(first[0], l, "vertex count")?;
+    let nf = count(first[1], l, "face count")?;
     let mut data = MeshData::default();
     for _ in 0..nv {
-        let x = next_num("a vertex coordinate")?.1;
-        let y = next_num("a vertex coordinate")?.1;
-        let z = next_num("a vertex coordinate")?.1;
-        data.positions.push([x, y, z]);
+        let (l, t) = lines.next().ok_or("the file ends before all vertices are read")?;
+        if t.len() < 3 {
+            return Err(format!("line {l}: a vertex needs 3 coordinates"));
+        }
+        data.positions.push([num(t[0], l, "x")?, num(t[1], l, "y")?, num(t[2], l, "z")?]);
     }
     let mut split = 0;
     for f in 0..nf {
-        let (l, k) = next_num("a face")?;
-        let k = count(k, l, "corner count")?;
+        let (l, t) = lines.next().ok_or("the file ends before all faces are read")?;
+        let k = count(t[0], l, "corner count")?;
         if k < 3 {
             return Err(format!("line {l}: face {f} has {k} corners"));
         }
-        let mut face = Vec::with_capacity(k);
-        for _ in 0..k {
-            let (l, v) = next_num("a face index")?;
-            let v = count(v, l, "vertex index")?;
-            if v >= nv {
-                return Err(format!("line {l}: face {f} refers to vertex {v} but there are {nv} vertices"));
-            }
-            face.push(v);
+        if t.len() < k + 1 {
+            return Err(format!("line {l}: face {f} lists {} of its {k} corners", t.len() - 1));
         }
-        // anything after the indices on the line is a colour: ignored
+        let face: Vec<usize> = t[1..=k]
+            .iter()
+            .map(|x| {
+                let v = count(x, l, "vertex index")?;
+                if v >= nv {
+                    Err(format!("line {l}: face {f} refers to vertex {v} but there are {nv} vertices"))
+                } else {
+                    Ok(v)
+                }
+            })
+            .collect::<std::result::Result<_, _>>()?;
         if k > 3 {
             split += 1;
         }
@@ -427,10 +435,15 @@ fn read_vtk(bytes: &[u8], ext: &str) -> std::result::Result<MeshData, String> {
     })
     .map_err(|_| "the VTK reader failed on this file (malformed?)".to_string())?
     .map_err(|e| {
-        format!(
-            "cannot parse the VTK file ({e}); raw appended data (ParaView's default) is not supported: \
-             save with `Data Mode: Ascii` or `Binary` and no raw encoding"
-        )
+        let raw = ext != "vtk" && bytes.windows(14).any(|w| w == b"encoding=\"raw\"");
+        if raw {
+            format!(
+                "cannot parse the VTK file ({e}): its appended data is raw (ParaView's default), which the \
+                 reader does not support; save with `Data Mode: Ascii` or `Binary` (base64)"
+            )
+        } else {
+            format!("cannot parse the VTK file ({e}): truncated or malformed")
+        }
     })?;
     let mut data = MeshData::default();
     let mut dropped = 0usize;
@@ -608,6 +621,24 @@ mod tests {
     }
 
     #[test]
+    fn vertex_order_follows_the_file_and_extras_are_ignored() {
+        // the first vertex is used last; negative indices; v/vt/vn forms; an unused vertex
+        let obj = "v 5 5 1\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nf 2/1 3/1 4/1\nf -4 -3 -1\nv 9 9 9\n";
+        let m = read_mesh(&tmp("order.obj", obj.as_bytes())).unwrap();
+        assert_eq!(m.positions[0], [5.0, 5.0, 1.0]);
+        assert_eq!(m.positions.len(), 5);
+        assert_eq!(m.triangles, vec![[1, 2, 3], [0, 1, 3]]);
+        let e = crate::domain::TriMesh::new(m.positions, m.triangles).unwrap_err().to_string();
+        assert!(e.contains("vertices 4 are used by no triangle"), "{e}");
+        // OFF with per-vertex and per-face colours and comments
+        let off = "OFF # a square\n4 2 0\n0 0 0 255 0 0\n1 0 0 0 255 0\n1 1 0 0 0 255\n0 1 0 9 9 9\n\
+                   3 0 1 2 255 0 0\n3 0 2 3 0 255 0 # second\n";
+        let m = read_mesh(&tmp("colour.off", off.as_bytes())).unwrap();
+        assert_eq!(m.triangles, vec![[0, 1, 2], [0, 2, 3]]);
+        assert_eq!(m.positions[3], [0.0, 1.0, 0.0]);
+    }
+
+    #[test]
     fn obj_groups_share_their_vertices() {
         let two = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\ng a\nf 1 2 3\ng b\nf 1 3 4\n";
         let m = read_mesh(&tmp("groups.obj", two.as_bytes())).unwrap();
@@ -654,16 +685,17 @@ mod tests {
     fn broken_files_are_input_errors() {
         for (name, content, needle) in [
             ("empty.obj", &b""[..], "empty"),
-            ("bad.off", &b"OFF\n3 1 0\n0 0 0\n1 0 0\n"[..], "ends before"),
+            ("bad.off", &b"OFF\n3 1 0\n0 0 0\n1 0 0\n"[..], "ends before all vertices"),
             ("range.off", &b"OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 5\n"[..], "vertex 5"),
             ("text.off", &b"OFF\n3 1 0\n0 0 0\n1 x 0\n0 1 0\n3 0 1 2\n"[..], "line 4"),
-            ("range.obj", &b"v 0 0 0\nv 1 0 0\nf 1 2 3\n"[..], "obj"),
+            ("range.obj", &b"v 0 0 0\nv 1 0 0\nf 1 2 3\n"[..], "line 3: vertex reference 3 is out of range"),
+            ("short.off", &b"OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1\n"[..], "lists 2 of its 3 corners"),
             (
                 "noface.ply",
                 &b"ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nend_header\n0 0\n"[..],
                 "face",
             ),
-            ("junk.vtu", &b"<VTKFile type=\"UnstructuredGrid\"><broken"[..], "junk.vtu"),
+            ("junk.vtu", &b"<VTKFile type=\"UnstructuredGrid\"><broken"[..], "cannot parse the VTK file"),
             ("x.stl", &b"solid"[..], "not a mesh format"),
         ] {
             let e = read_mesh(&tmp(name, content)).unwrap_err();

@@ -163,6 +163,12 @@ pub fn select<D: Domain>(domain: &D, values: &[f64], selection: &Selection) -> R
     if lo == hi {
         return Err(Error::input(format!("the field is constant ({lo}): it has no extrema to keep")));
     }
+    if let Some((v, size)) = constant_component(domain, values) {
+        return Err(Error::input(format!(
+            "the connected component of vertex {v} ({size} vertices) is constant ({}): it has no extrema to keep",
+            values[v]
+        )));
+    }
     let mut warnings = Vec::new();
     let mut threshold = None;
     let minima_pairs = sublevel_pairs(domain, values);
@@ -266,6 +272,35 @@ pub fn select<D: Domain>(domain: &D, values: &[f64], selection: &Selection) -> R
         }
     }
     Ok(KeptSet { roles, kept, threshold, warnings })
+}
+
+/// A connected component on which the field is constant: its first vertex and its size.
+fn constant_component<D: Domain>(domain: &D, values: &[f64]) -> Option<(usize, usize)> {
+    let n = domain.n_vertices();
+    let mut seen = vec![false; n];
+    let mut stack = Vec::new();
+    for start in 0..n {
+        if seen[start] {
+            continue;
+        }
+        seen[start] = true;
+        stack.push(start);
+        let (mut size, mut constant) = (0usize, true);
+        while let Some(v) = stack.pop() {
+            size += 1;
+            constant &= values[v] == values[start];
+            for w in domain.neighbors(v) {
+                if !seen[w] {
+                    seen[w] = true;
+                    stack.push(w);
+                }
+            }
+        }
+        if constant {
+            return Some((start, size));
+        }
+    }
+    None
 }
 
 /// Series rule: rank (minimum, maximum) pairs by persistence (ties: lower (value, index) of

@@ -236,6 +236,7 @@ pub fn separatrix_representative<D: crate::domain::Domain>(
     }
     let mut dirichlet = crate::operators::Dirichlet::new(k)?;
     let mut released = vec![false; n];
+    let mut reach: std::collections::HashMap<usize, usize> = std::collections::HashMap::new();
     let mut gone = vec![false; separatrices.len()];
     let mut count = 0;
     for _ in 0..MAX_RELEASE_ROUNDS {
@@ -260,7 +261,23 @@ pub fn separatrix_representative<D: crate::domain::Domain>(
             }
         };
         for &v in &bad {
-            for w in std::iter::once(v).chain(domain.neighbors(v)) {
+            // around a failing kept extremum the release reaches one ring further each round
+            // (its free neighbours can stay above a kept maximum while prescribed vertices
+            // farther out hold them up)
+            let around: Vec<usize> = if kept.roles[v].is_fixed() {
+                // widen until the rings hold a vertex still prescribed (at most 64 rings)
+                let r = reach.entry(v).or_insert(0);
+                loop {
+                    *r += 1;
+                    let ring = rings(domain, v, *r);
+                    if *r >= 64 || ring.iter().any(|&w| fixed[w].is_some() && !kept.roles[w].is_fixed()) {
+                        break ring;
+                    }
+                }
+            } else {
+                std::iter::once(v).chain(domain.neighbors(v)).collect()
+            };
+            for w in around {
                 if fixed[w].is_none() {
                     continue;
                 }
@@ -285,6 +302,26 @@ pub fn separatrix_representative<D: crate::domain::Domain>(
         }
     }
     Err(format!("separatrix vertices still contradict each other after {MAX_RELEASE_ROUNDS} rounds of releasing them"))
+}
+
+/// Vertices within `radius` rings of `v` (itself included).
+fn rings<D: crate::domain::Domain>(domain: &D, v: usize, radius: usize) -> Vec<usize> {
+    let mut seen = std::collections::HashSet::from([v]);
+    let mut out = vec![v];
+    let mut frontier = vec![v];
+    for _ in 0..radius {
+        let mut next = Vec::new();
+        for &x in &frontier {
+            for y in domain.neighbors(x) {
+                if seen.insert(y) {
+                    next.push(y);
+                }
+            }
+        }
+        out.extend(&next);
+        frontier = next;
+    }
+    out
 }
 
 /// Rounds of releasing contradicting separatrices (each one harmonic solve) before the

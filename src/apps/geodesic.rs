@@ -73,21 +73,6 @@ fn upper(
     (faer::sparse::SymbolicSparseColMat::new_checked(n, n, col_ptr, None, rows), values)
 }
 
-/// The triangle with the smallest angle, and that angle in degrees.
-fn smallest_angle(p: &[[f64; 3]], tris: &[[usize; 3]]) -> (usize, f64) {
-    let mut best = (0, f64::INFINITY);
-    for (t, tri) in tris.iter().enumerate() {
-        for k in 0..3 {
-            let (a, b) = (sub(p[tri[(k + 1) % 3]], p[tri[k]]), sub(p[tri[(k + 2) % 3]], p[tri[k]]));
-            let angle = dot(cross(a, b), cross(a, b)).sqrt().atan2(dot(a, b)).to_degrees();
-            if angle < best.1 {
-                best = (t, angle);
-            }
-        }
-    }
-    best
-}
-
 /// Geodesic distance from `sources` (vertex indices) to every vertex of `mesh`.
 ///
 /// # Errors
@@ -132,7 +117,7 @@ pub fn heat_geodesic(mesh: &TriMesh, sources: &[usize]) -> Result<(Vec<f64>, Geo
     let mut solver = SpdSolver::new(pattern.as_ref())?;
     seconds.setup = t0.elapsed().as_secs_f64();
     let factor_failed = |e: String| {
-        let (worst, angle) = smallest_angle(p, tris);
+        let (worst, angle) = mesh.smallest_angle();
         format!(
             "the sparse Cholesky factorisation failed ({e}): the mesh has nearly degenerate triangles \
              (smallest angle {angle:.2e}° in triangle {worst})"

@@ -73,8 +73,9 @@ pub fn geodesic(args: &GeodesicArgs) -> Result<String> {
     for s in staged {
         s.commit()?;
     }
+    let warning = mesh.sliver_warning().map(|w| format!("warning: {w}\n")).unwrap_or_default();
     Ok(format!(
-        "{}: heat-method geodesic distance on a mesh of {} from {} source{} (vertex {}); largest {} at vertex {farthest}\n\
+        "{warning}{}: heat-method geodesic distance on a mesh of {} from {} source{} (vertex {}); largest {} at vertex {farthest}\n\
          heat time t = {} × (mean edge length)²\n\
          seconds: read {read_seconds:.3}, setup {:.3}, heat {:.3}, field {:.3}, poisson {:.3}, write {write_seconds:.3}, total {:.3}\n\
          wrote {}\n",

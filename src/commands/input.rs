@@ -184,6 +184,7 @@ pub fn read_mesh_field(path: &Path, opts: &GridOptions) -> Result<MeshInput> {
     }
     let mut notes = data.notes.clone();
     notes.extend(mesh.repairs().iter().cloned());
+    notes.extend(mesh.sliver_warning());
     Ok(MeshInput { mesh, values, description, notes, path: path.to_path_buf() })
 }
 

@@ -395,6 +395,34 @@ impl TriMesh {
         self.positions.len() as i64 - self.n_edges as i64 + self.triangles.len() as i64
     }
 
+    /// The triangle with the smallest angle, and that angle in degrees.
+    pub fn smallest_angle(&self) -> (usize, f64) {
+        let p = &self.positions;
+        let mut best = (0, f64::INFINITY);
+        for (t, tri) in self.triangles.iter().enumerate() {
+            for k in 0..3 {
+                let (a, b) = (sub(p[tri[(k + 1) % 3]], p[tri[k]]), sub(p[tri[(k + 2) % 3]], p[tri[k]]));
+                let c = cross(a, b);
+                let angle = norm(c).atan2(a[0] * b[0] + a[1] * b[1] + a[2] * b[2]).to_degrees();
+                if angle < best.1 {
+                    best = (t, angle);
+                }
+            }
+        }
+        best
+    }
+
+    /// A warning when some triangle has an angle below 0.5° (huge cotangent weights: the
+    /// operators lose accuracy), else `None`.
+    pub fn sliver_warning(&self) -> Option<String> {
+        let (t, angle) = self.smallest_angle();
+        (angle < 0.5).then(|| {
+            format!(
+                "triangle {t} has an angle of {angle:.2e}°: nearly degenerate triangles make the cotangent operators inaccurate (remesh or collapse them)"
+            )
+        })
+    }
+
     /// Whether every component could be oriented consistently.
     pub fn is_orientable(&self) -> bool {
         self.orientable

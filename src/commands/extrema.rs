@@ -77,7 +77,11 @@ pub fn extrema(args: &ExtremaArgs) -> Result<String> {
                 format!("({},{},{})", sig6(p[0]), sig6(p[1]), sig6(p[2]))
             };
             let what = format!("mesh of {}", m.describe());
-            list(args, &data.path, m, &data.values, &data.description, None, Some(what), &label)
+            let text = list(args, &data.path, m, &data.values, &data.description, None, Some(what), &label)?;
+            if args.json {
+                return Ok(text);
+            }
+            Ok(data.notes.iter().map(|n| format!("note: {n}\n")).collect::<String>() + &text)
         }
     }
 }

@@ -74,9 +74,10 @@ enum Command {
         #[arg(long, value_name = "JSON")]
         report: Option<PathBuf>,
     },
-    /// Benchmark on random-walk series and noisy grids: seconds per stage and peak memory.
+    /// Benchmark on random-walk series, noisy grids and meshes: seconds per stage and peak memory.
     Bench {
-        /// Series lengths `N` and grid sizes `NXxNY` (grids keep 7 minima and 6 maxima).
+        /// Series lengths `N`, grid sizes `NXxNY` (grids keep 7 minima and 6 maxima) and mesh files
+        /// `MESH[@levels]` (midpoint-subdivided; geodesic from vertex 0, every maximum kept).
         #[arg(long, value_delimiter = ',', default_value = "1000,10000,100000,1000000")]
         sizes: Vec<String>,
         /// Energy order or blend.

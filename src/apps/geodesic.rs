@@ -8,19 +8,10 @@
 //! numeric factorisations. Boundaries get the natural (Neumann) condition. The distance is 0
 //! at the sources; its error against exact distances is measured in the tests and docs.
 
+use crate::domain::vec3::{cross, dot, sub};
 use crate::domain::TriMesh;
 use crate::linalg::SpdSolver;
 use crate::operators::{cotan_stiffness, lumped_mass, Sparse};
-
-fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
-}
 
 /// Seconds spent in the stages of [`heat_geodesic`], and the heat time used.
 #[derive(Clone, Copy, Debug, Default, serde::Serialize)]

@@ -36,6 +36,27 @@ struct GridRunReport<'a> {
     report: &'a Report,
 }
 
+/// The kept extrema of a surface result as plot markers.
+pub fn kept_markers(roles: &[Role]) -> Vec<GridMarker> {
+    roles
+        .iter()
+        .enumerate()
+        .filter_map(|(i, r)| match r {
+            Role::Min => Some(GridMarker { index: i, is_max: false }),
+            Role::Max => Some(GridMarker { index: i, is_max: true }),
+            _ => None,
+        })
+        .collect()
+}
+
+/// The `seconds:` line of a surface run.
+pub fn surface_seconds_line(read: f64, s: &crate::pipeline::StageSeconds, write: f64, total: f64) -> String {
+    format!(
+        "seconds: read {:.3}, persistence {:.3}, complex {:.3}, simplify {:.3}, representative {:.3}, operators {:.3}, constraints {:.3}, solve {:.3}, repair {:.3}, verify {:.3}, write {:.3}, total {:.3}\n",
+        read, s.persistence, s.complex, s.simplify, s.representative, s.operators, s.constraints, s.solve, s.repair, s.verify, write, total
+    )
+}
+
 /// Role codes as Float64 (SPEC.md: −1 kept min, +1 kept max, 2 fixed, 3 end, 0 other).
 pub fn role_codes(roles: &[Role]) -> Vec<f64> {
     roles.iter().map(|r| f64::from(r.code())).collect()
@@ -132,16 +153,7 @@ pub fn smooth_grid(args: &SmoothArgs, data: GridInput, start: Instant) -> Result
     let kmin = r.kept.iter().filter(|k| k.role == Role::Min).count();
     let kmax = r.kept.len() - kmin;
     if let Some(path) = &args.plot {
-        let markers: Vec<GridMarker> = result
-            .roles
-            .iter()
-            .enumerate()
-            .filter_map(|(i, r)| match r {
-                Role::Min => Some(GridMarker { index: i, is_max: false }),
-                Role::Max => Some(GridMarker { index: i, is_max: true }),
-                _ => None,
-            })
-            .collect();
+        let markers = kept_markers(&result.roles);
         let (lo, hi) = crate::domain::value_range(h);
         let options = GridPlotOptions {
             isolines: args.isolines,
@@ -205,11 +217,7 @@ pub fn smooth_grid(args: &SmoothArgs, data: GridInput, start: Instant) -> Result
         r.representative
     );
     text += &super::smooth::fit_and_solver_lines(r);
-    text += &format!(
-        "seconds: read {:.3}, persistence {:.3}, complex {:.3}, simplify {:.3}, representative {:.3}, operators {:.3}, constraints {:.3}, solve {:.3}, repair {:.3}, verify {:.3}, write {:.3}, total {:.3}\n",
-        read_seconds, s.persistence, s.complex, s.simplify, s.representative, s.operators, s.constraints, s.solve, s.repair, s.verify, write_seconds,
-        start.elapsed().as_secs_f64()
-    );
+    text += &surface_seconds_line(read_seconds, s, write_seconds, start.elapsed().as_secs_f64());
     let mut wrote = vec![args.output.display().to_string()];
     for p in [&args.complex, &args.plot, &args.report].into_iter().flatten() {
         wrote.push(p.display().to_string());

@@ -4,14 +4,14 @@
 use super::input::MeshInput;
 use super::sig6;
 use super::smooth::SmoothArgs;
-use super::smooth_grid::{complex_polydata, role_codes};
+use super::smooth_grid::{complex_polydata, kept_markers, role_codes, surface_seconds_line};
 use crate::domain::{Domain, TriMesh};
 use crate::error::{Error, Result};
 use crate::io::mesh::stage_ply;
 use crate::io::vtk::{stage_vtp, stage_vtu, PolyData};
 use crate::io::{stage_json, Staged};
 use crate::pipeline::{smooth as run_pipeline, Report, Smoothed};
-use crate::plot::{plot_mesh_fields, GridMarker, GridPanel};
+use crate::plot::{plot_mesh_fields, GridPanel};
 use crate::topology::Role;
 use std::path::Path;
 use std::time::Instant;
@@ -86,16 +86,7 @@ pub fn smooth_mesh(args: &SmoothArgs, data: MeshInput, start: Instant) -> Result
     let kmax = r.kept.len() - kmin;
     let mut hidden = 0;
     if let Some(path) = &args.plot {
-        let markers: Vec<GridMarker> = result
-            .roles
-            .iter()
-            .enumerate()
-            .filter_map(|(i, r)| match r {
-                Role::Min => Some(GridMarker { index: i, is_max: false }),
-                Role::Max => Some(GridMarker { index: i, is_max: true }),
-                _ => None,
-            })
-            .collect();
+        let markers = kept_markers(&result.roles);
         let (lo, hi) = crate::domain::value_range(h);
         let name = data.path.file_name().unwrap_or_default().to_string_lossy().to_string();
         let panels = [
@@ -165,11 +156,7 @@ pub fn smooth_mesh(args: &SmoothArgs, data: MeshInput, start: Instant) -> Result
         r.representative
     );
     text += &super::smooth::fit_and_solver_lines(r);
-    text += &format!(
-        "seconds: read {:.3}, persistence {:.3}, complex {:.3}, simplify {:.3}, representative {:.3}, operators {:.3}, constraints {:.3}, solve {:.3}, repair {:.3}, verify {:.3}, write {:.3}, total {:.3}\n",
-        read_seconds, s.persistence, s.complex, s.simplify, s.representative, s.operators, s.constraints, s.solve, s.repair, s.verify, write_seconds,
-        start.elapsed().as_secs_f64()
-    );
+    text += &surface_seconds_line(read_seconds, s, write_seconds, start.elapsed().as_secs_f64());
     let mut wrote = vec![args.output.display().to_string()];
     if args.plot.is_some() && hidden > 0 {
         text += &format!("plot: {hidden} kept extrema face away from the camera (try --view)\n");

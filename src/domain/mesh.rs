@@ -21,6 +21,7 @@
 //! # Ok::<(), toposmooth::Error>(())
 //! ```
 
+use super::vec3::{cross, norm, sub};
 use super::{Domain, PairingRule};
 use crate::error::{Error, Result};
 use std::collections::HashMap;
@@ -52,18 +53,6 @@ fn list<T: std::fmt::Display>(items: &[T]) -> String {
     } else {
         shown.join(", ")
     }
-}
-
-fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
-fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
-}
-
-fn norm(a: [f64; 3]) -> f64 {
-    (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt()
 }
 
 /// Area of a triangle given by its corner positions.

@@ -14,6 +14,7 @@ mod grid;
 mod mesh;
 mod order;
 mod series;
+pub mod vec3;
 
 pub use grid::{Grid2d, MAX_SPACING, MIN_SPACING};
 pub use mesh::{shapes, triangle_area, TriMesh};

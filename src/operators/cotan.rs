@@ -2,18 +2,12 @@
 //! positive-weight variant for harmonic fills.
 
 use super::sparse::{from_triplets, Sparse};
+use crate::domain::vec3::{cross, dot, norm, sub};
 use crate::domain::Grid2d;
 use faer::sparse::Triplet;
 
-fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
 fn cross_norm(a: [f64; 3], b: [f64; 3]) -> f64 {
-    let c = [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]];
-    dot(c, c).sqrt()
+    norm(cross(a, b))
 }
 
 /// Stiffness `K = −L` (`#V × #V`) of piecewise-linear elements on triangles:

@@ -9,6 +9,7 @@
 
 use super::grid::{draw_colour_bar_at, Scale};
 use super::{render, PlotError, FONT, MAX_C, MIN_C};
+use crate::domain::vec3::{cross, dot, sub, unit};
 use crate::plot::{GridMarker, GridPanel};
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
@@ -36,24 +37,6 @@ const PANEL_TITLE_H: u32 = 30;
 const GAP: u32 = 16;
 const BAR_W: u32 = 22;
 const BAR_ROOM: u32 = 130;
-
-fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
-}
-fn unit(a: [f64; 3]) -> [f64; 3] {
-    let l = dot(a, a).sqrt();
-    if l > 0.0 {
-        a.map(|x| x / l)
-    } else {
-        a
-    }
-}
 
 /// Screen coordinates (pixels, y down) and depth (larger: nearer) of every vertex, and the
 /// view direction towards the camera.

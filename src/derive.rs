@@ -92,6 +92,15 @@ pub fn describe_missing(grid: &Grid2d, values: &[f64], limit: usize) -> Option<S
 /// # Errors
 /// Every sample is missing.
 pub fn fill_missing(grid: &Grid2d, values: &mut [f64]) -> Result<usize> {
+    fill_missing_with(&grid_stiffness(grid), values)
+}
+
+/// [`fill_missing`] with any Laplacian `k` of non-negative weights (meshes: the
+/// positive-weight cotangent one).
+///
+/// # Errors
+/// Every value missing, or a connected part with no known value.
+pub fn fill_missing_with(k: &crate::operators::Sparse, values: &mut [f64]) -> Result<usize> {
     let fixed: Vec<Option<f64>> = values.iter().map(|&v| (!v.is_nan()).then_some(v)).collect();
     let count = fixed.iter().filter(|f| f.is_none()).count();
     if count == 0 {
@@ -106,7 +115,8 @@ pub fn fill_missing(grid: &Grid2d, values: &mut [f64]) -> Result<usize> {
         values.iter_mut().for_each(|v| *v = known.0);
         return Ok(count);
     }
-    let filled = dirichlet_solve(&grid_stiffness(grid), &fixed).map_err(|e| Error::input(format!("fill: {e}")))?;
+    let filled = dirichlet_solve(k, &fixed)
+        .map_err(|_| Error::input("fill: a connected part of the domain has no known value to fill from (all NaN)"))?;
     values.copy_from_slice(&filled);
     Ok(count)
 }

@@ -158,3 +158,35 @@ fn broken_meshes_are_input_errors_naming_the_file_and_the_elements() {
     assert!(text(&o).contains("out of range"));
     assert!(!dir.join("d.vtu").exists());
 }
+
+#[test]
+fn missing_values_on_a_mesh_are_refused_or_filled() {
+    let dir = scratch("mesh-fill");
+    let mesh = dataset("bunny.obj");
+    let n = read_mesh(Path::new(&mesh)).unwrap().positions.len();
+    // the y coordinate with three holes
+    let obj = std::fs::read_to_string(&mesh).unwrap();
+    let mut ys: Vec<String> =
+        obj.lines().filter(|l| l.starts_with("v ")).map(|l| l.split_whitespace().nth(2).unwrap().to_string()).collect();
+    assert_eq!(ys.len(), n);
+    for v in [10, 500, 2000] {
+        ys[v] = "nan".into();
+    }
+    let file = dir.join("holes.txt");
+    std::fs::write(&file, ys.join("\n")).unwrap();
+    let out = dir.join("f.vtu").display().to_string();
+    let f = file.display().to_string();
+    let o = toposmooth(&["smooth", &mesh, "--values", &f, "-o", &out]);
+    assert_eq!(o.status.code(), Some(3), "{}", text(&o));
+    assert!(text(&o).contains("holes.txt") && text(&o).contains("3 non-finite values"), "{}", text(&o));
+    let o = toposmooth(&["smooth", &mesh, "--values", &f, "--fill-missing", "--persistence", "10%", "-o", &out]);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+    let r = read_mesh(Path::new(&out)).unwrap();
+    let filled = r.array("filled").unwrap().values;
+    assert_eq!(filled.iter().filter(|&&x| x == 1.0).count(), 3);
+    assert_eq!((filled[10], filled[500], filled[2000]), (1.0, 1.0, 1.0));
+    let input = r.array("input").unwrap().values;
+    assert!(input.iter().all(|x| x.is_finite()));
+    let v = toposmooth(&["verify", &out, "--input", &mesh, "--values", &f, "--fill-missing"]);
+    assert_eq!(v.status.code(), Some(0), "{}", text(&v));
+}

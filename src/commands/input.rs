@@ -80,6 +80,8 @@ pub struct MeshInput {
     pub description: String,
     /// What reading and validation changed (polygons split, triangles flipped).
     pub notes: Vec<String>,
+    /// Vertices filled by `--fill-missing` (true), when any were.
+    pub filled: Option<Vec<bool>>,
     /// The mesh file.
     pub path: PathBuf,
 }
@@ -112,11 +114,8 @@ pub fn read_trimesh(path: &Path) -> Result<(TriMesh, MeshData)> {
 /// Input errors naming the file: unreadable or invalid mesh, no or several candidate
 /// arrays, a values file of the wrong length, non-finite values.
 pub fn read_mesh_field(path: &Path, opts: &GridOptions) -> Result<MeshInput> {
-    if opts.derive.is_some() || opts.uv.is_some() || opts.spacing.is_some() || opts.fill_missing {
-        return Err(Error::Usage(format!(
-            "{}: --derive, --u/--v, --spacing and --fill-missing are for grids",
-            path.display()
-        )));
+    if opts.derive.is_some() || opts.uv.is_some() || opts.spacing.is_some() {
+        return Err(Error::Usage(format!("{}: --derive, --u/--v and --spacing are for grids", path.display())));
     }
     let (mesh, data) = read_trimesh(path)?;
     let n = mesh.n_vertices();
@@ -176,16 +175,32 @@ pub fn read_mesh_field(path: &Path, opts: &GridOptions) -> Result<MeshInput> {
             }
         }
     };
+    let mut values = values;
     let bad: Vec<usize> = (0..n).filter(|&v| !values[v].is_finite()).collect();
+    let infinite = bad.iter().any(|&v| values[v].is_infinite());
+    let mut filled = None;
     if !bad.is_empty() {
-        let shown: Vec<String> = bad.iter().take(5).map(|v| v.to_string()).collect();
-        return Err(Error::input(format!("{} non-finite values (first at vertices {})", bad.len(), shown.join(", ")))
+        if opts.fill_missing && !infinite {
+            let k = crate::operators::positive_cotan_stiffness(mesh.positions(), mesh.faces());
+            crate::derive::fill_missing_with(&k, &mut values).map_err(|e| e.in_file(&source))?;
+            let mut mask = vec![false; n];
+            bad.iter().for_each(|&v| mask[v] = true);
+            filled = Some(mask);
+        } else {
+            let shown: Vec<String> = bad.iter().take(5).map(|v| v.to_string()).collect();
+            return Err(Error::input(format!(
+                "{} non-finite values (first at vertices {}){}",
+                bad.len(),
+                shown.join(", "),
+                if infinite { "" } else { "; --fill-missing fills NaN harmonically" }
+            ))
             .in_file(&source));
+        }
     }
     let mut notes = data.notes.clone();
     notes.extend(mesh.repairs().iter().cloned());
     notes.extend(mesh.sliver_warning());
-    Ok(MeshInput { mesh, values, description, notes, path: path.to_path_buf() })
+    Ok(MeshInput { mesh, values, description, notes, filled, path: path.to_path_buf() })
 }
 
 fn extension(path: &Path) -> String {

@@ -59,8 +59,12 @@ pub fn stage_mesh_output(path: &Path, mesh: &TriMesh, arrays: &[(&str, &[f64])])
 
 fn stage_output(path: &Path, data: &MeshInput, result: &Smoothed) -> Result<Staged> {
     let roles = role_codes(&result.roles);
-    let arrays: Vec<(&str, &[f64])> =
+    let filled: Option<Vec<f64>> = data.filled.as_ref().map(|m| m.iter().map(|&b| f64::from(u8::from(b))).collect());
+    let mut arrays: Vec<(&str, &[f64])> =
         vec![("input", &data.values), ("smoothed", &result.output), ("representative", &result.u), ("role", &roles)];
+    if let Some(f) = &filled {
+        arrays.push(("filled", f));
+    }
     stage_mesh_output(path, &data.mesh, &arrays)
 }
 
@@ -141,6 +145,9 @@ pub fn smooth_mesh(args: &SmoothArgs, data: MeshInput, start: Instant) -> Result
     }
     for n in &data.notes {
         text += &format!("note: {n}\n");
+    }
+    if let Some(f) = &data.filled {
+        text += &format!("filled {} missing (NaN) values harmonically\n", f.iter().filter(|&&b| b).count());
     }
     text += &format!(
         "{}: {} on a mesh of {} ({negative} interior edges with negative cotangent weight); {} minima and {} maxima in the input (SoS, boundary included)\n",

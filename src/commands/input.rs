@@ -102,8 +102,10 @@ pub enum FieldInput {
 /// # Errors
 /// Input errors naming the file.
 pub fn read_trimesh(path: &Path) -> Result<(TriMesh, MeshData)> {
-    let data = read_mesh(path)?;
-    let mesh = TriMesh::new(data.positions.clone(), data.triangles.clone()).map_err(|e| e.in_file(path))?;
+    let mut data = read_mesh(path)?;
+    // the triangles move into the mesh; the positions stay for `MeshData::array("x")`
+    let triangles = std::mem::take(&mut data.triangles);
+    let mesh = TriMesh::new(data.positions.clone(), triangles).map_err(|e| e.in_file(path))?;
     Ok((mesh, data))
 }
 
@@ -119,7 +121,7 @@ pub fn read_mesh_field(path: &Path, opts: &GridOptions) -> Result<MeshInput> {
     }
     let (mesh, data) = read_trimesh(path)?;
     let n = mesh.n_vertices();
-    let (values, description, source): (Vec<f64>, String, PathBuf) = match (&opts.values, &opts.array) {
+    let (mut values, description, source): (Vec<f64>, String, PathBuf) = match (&opts.values, &opts.array) {
         (Some(_), Some(_)) => return Err(Error::Usage("give --values or --array, not both".into())),
         (Some(file), None) => {
             let text = std::fs::read_to_string(file).map_err(|source| Error::Io { path: file.clone(), source })?;
@@ -175,7 +177,6 @@ pub fn read_mesh_field(path: &Path, opts: &GridOptions) -> Result<MeshInput> {
             }
         }
     };
-    let mut values = values;
     let bad: Vec<usize> = (0..n).filter(|&v| !values[v].is_finite()).collect();
     let infinite = bad.iter().any(|&v| values[v].is_infinite());
     let mut filled = None;

@@ -425,7 +425,7 @@ fn point_arrays(attrs: Vec<vtkio::model::Attribute>, n: usize) -> std::result::R
 }
 
 fn read_vtk(bytes: &[u8], ext: &str) -> std::result::Result<MeshData, String> {
-    use vtkio::model::{CellType, DataSet, Piece};
+    use vtkio::model::{CellType, DataSet};
     let parsed = std::panic::catch_unwind(|| {
         if ext == "vtk" {
             vtkio::Vtk::parse_legacy_be(bytes).map_err(|e| e.to_string())
@@ -448,76 +448,57 @@ fn read_vtk(bytes: &[u8], ext: &str) -> std::result::Result<MeshData, String> {
     let mut data = MeshData::default();
     let mut dropped = 0usize;
     let mut split = 0usize;
-    let add_points = |buf: &vtkio::IOBuffer, data: &mut MeshData| -> std::result::Result<usize, String> {
-        let p = buf.cast_into::<f64>().ok_or("the point coordinates are not numbers")?;
-        if p.len() % 3 != 0 {
-            return Err("the point coordinates are not triples".into());
+    let mut surface = |cell: &[usize], data: &mut MeshData, what: &str| -> std::result::Result<(), String> {
+        if cell.len() < 3 {
+            return Err(format!("{what} has {} corners", cell.len()));
         }
-        let base = data.positions.len();
-        data.positions.extend(p.chunks(3).map(|c| [c[0], c[1], c[2]]));
-        Ok(base)
+        if cell.len() > 3 {
+            split += 1;
+        }
+        fan(cell, &mut data.triangles);
+        Ok(())
     };
     match parsed.data {
         DataSet::UnstructuredGrid { pieces, .. } => {
-            if pieces.len() != 1 {
-                return Err(format!("{} pieces: only single-piece files are supported", pieces.len()));
+            let piece = only_piece(pieces)?;
+            data.positions = points_of(&piece.points)?;
+            let cells = cells_of(piece.cells.cell_verts, "cells")?;
+            if cells.len() != piece.cells.types.len() {
+                return Err(format!("{} cells but {} cell types", cells.len(), piece.cells.types.len()));
             }
-            for piece in pieces {
-                let Piece::Inline(piece) = piece else { return Err("the file refers to external pieces".into()) };
-                let base = add_points(&piece.points, &mut data)?;
-                let n = data.positions.len() - base;
-                let cells = cells_of(piece.cells.cell_verts, "cells")?;
-                if cells.len() != piece.cells.types.len() {
-                    return Err(format!("{} cells but {} cell types", cells.len(), piece.cells.types.len()));
-                }
-                for (c, (cell, ty)) in cells.iter().zip(&piece.cells.types).enumerate() {
-                    match ty {
-                        CellType::Triangle => fan(cell, &mut data.triangles),
-                        CellType::Quad | CellType::Polygon => {
-                            split += 1;
-                            fan(cell, &mut data.triangles)
-                        }
-                        CellType::TriangleStrip => strip(cell, &mut data.triangles),
-                        CellType::Vertex | CellType::PolyVertex | CellType::Line | CellType::PolyLine => dropped += 1,
-                        other => {
-                            return Err(format!(
-                                "cell {c} is a {other:?} cell: only surface cells (triangles, quads, polygons, strips) are supported"
-                            ))
-                        }
+            for (c, (cell, ty)) in cells.iter().zip(&piece.cells.types).enumerate() {
+                match ty {
+                    CellType::Triangle | CellType::Quad | CellType::Polygon => {
+                        surface(cell, &mut data, &format!("cell {c}"))?
+                    }
+                    CellType::TriangleStrip => strip(cell, &mut data.triangles),
+                    CellType::Vertex | CellType::PolyVertex | CellType::Line | CellType::PolyLine => dropped += 1,
+                    other => {
+                        return Err(format!(
+                            "cell {c} is a {other:?} cell: only surface cells (triangles, quads, polygons, strips) are supported"
+                        ))
                     }
                 }
-                data.arrays = point_arrays(piece.data.point, n)?;
             }
+            data.arrays = point_arrays(piece.data.point, data.positions.len())?;
         }
         DataSet::PolyData { pieces, .. } => {
-            if pieces.len() != 1 {
-                return Err(format!("{} pieces: only single-piece files are supported", pieces.len()));
+            let piece = only_piece(pieces)?;
+            data.positions = points_of(&piece.points)?;
+            if let Some(polys) = piece.polys {
+                for (c, cell) in cells_of(polys, "polygons")?.iter().enumerate() {
+                    surface(cell, &mut data, &format!("polygon {c}"))?;
+                }
             }
-            for piece in pieces {
-                let Piece::Inline(piece) = piece else { return Err("the file refers to external pieces".into()) };
-                let base = add_points(&piece.points, &mut data)?;
-                let n = data.positions.len() - base;
-                if let Some(polys) = piece.polys {
-                    for cell in cells_of(polys, "polygons")? {
-                        if cell.len() > 3 {
-                            split += 1;
-                        }
-                        if cell.len() < 3 {
-                            return Err(format!("a polygon has {} corners", cell.len()));
-                        }
-                        fan(&cell, &mut data.triangles);
-                    }
+            if let Some(strips) = piece.strips {
+                for cell in cells_of(strips, "strips")? {
+                    strip(&cell, &mut data.triangles);
                 }
-                if let Some(strips) = piece.strips {
-                    for cell in cells_of(strips, "strips")? {
-                        strip(&cell, &mut data.triangles);
-                    }
-                }
-                for v in [piece.verts, piece.lines].into_iter().flatten() {
-                    dropped += v.num_cells();
-                }
-                data.arrays = point_arrays(piece.data.point, n)?;
             }
+            for v in [piece.verts, piece.lines].into_iter().flatten() {
+                dropped += v.num_cells();
+            }
+            data.arrays = point_arrays(piece.data.point, data.positions.len())?;
         }
         _ => return Err("the data set is neither an unstructured grid nor polydata".into()),
     }
@@ -526,6 +507,26 @@ fn read_vtk(bytes: &[u8], ext: &str) -> std::result::Result<MeshData, String> {
         data.notes.push(format!("{dropped} vertex and line cells ignored"));
     }
     Ok(data)
+}
+
+/// The one inline piece of a data set (several pieces or external ones are refused).
+fn only_piece<P>(pieces: Vec<vtkio::model::Piece<P>>) -> std::result::Result<P, String> {
+    if pieces.len() != 1 {
+        return Err(format!("{} pieces: only single-piece files are supported", pieces.len()));
+    }
+    match pieces.into_iter().next() {
+        Some(vtkio::model::Piece::Inline(piece)) => Ok(*piece),
+        _ => Err("the file refers to external pieces".into()),
+    }
+}
+
+/// Point coordinates as triples.
+fn points_of(buf: &vtkio::IOBuffer) -> std::result::Result<Vec<[f64; 3]>, String> {
+    let p = buf.cast_into::<f64>().ok_or("the point coordinates are not numbers")?;
+    if p.len() % 3 != 0 {
+        return Err("the point coordinates are not triples".into());
+    }
+    Ok(p.chunks(3).map(|c| [c[0], c[1], c[2]]).collect())
 }
 
 /// Triangles of a triangle strip (alternating orientation kept consistent).

@@ -145,6 +145,10 @@ fn broken_meshes_are_input_errors_naming_the_file_and_the_elements() {
         assert_eq!(o.status.code(), Some(3), "{name}: {}", text(&o));
         assert!(text(&o).contains(name) && text(&o).contains(needle), "{name}: {}", text(&o));
     }
+    // a mesh file is not a smoothing output
+    let o = toposmooth(&["verify", &dataset("bunny.obj")]);
+    assert_eq!(o.status.code(), Some(2), "{}", text(&o));
+    assert!(text(&o).contains("bunny.obj") && text(&o).contains(".vtu"), "{}", text(&o));
     // geodesic: a source out of range
     let o = toposmooth(&[
         "geodesic",

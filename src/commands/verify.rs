@@ -29,6 +29,10 @@ pub fn verify(args: &VerifyArgs) -> Result<String> {
     match ext.as_str() {
         "vti" | "npz" => verify_grid(args, &ext),
         "vtu" | "vtp" | "ply" => verify_mesh(args),
+        "obj" | "off" | "vtk" if crate::io::mesh::is_mesh_file(&args.file) => Err(Error::Usage(format!(
+            "{}: a mesh file holds no smoothing output; verify the .vtu, .vtp or .ply that `smooth` wrote",
+            args.file.display()
+        ))),
         "npy" => Err(Error::Usage(format!(
             "{}: a .npy export holds the smoothed array only and cannot be verified alone; verify the .vti or .npz output",
             args.file.display()

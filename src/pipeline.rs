@@ -55,6 +55,11 @@ pub trait Smoothable: Domain {
     fn stiffness(&self) -> Sparse;
     /// Lumped mass (diagonal, > 0).
     fn mass(&self) -> Vec<f64>;
+    /// The Laplacian of harmonic fills: non-negative weights on the domain's own edges, so
+    /// that the maximum principle holds (the energy's stiffness where that already holds).
+    fn fill_stiffness(&self) -> Sparse {
+        self.stiffness()
+    }
     /// A function with exactly the kept extrema (checked by the pipeline), built by the
     /// first construction in the order `choice` prefers that is not `excluded` (kind and
     /// why: the pipeline excludes one whose order makes the constraints infeasible).
@@ -194,6 +199,9 @@ impl Smoothable for TriMesh {
     fn mass(&self) -> Vec<f64> {
         lumped_mass(self.positions(), self.faces())
     }
+    fn fill_stiffness(&self) -> Sparse {
+        positive_cotan_stiffness(self.positions(), self.faces())
+    }
     /// As on grids, but the harmonic fills use [`positive_cotan_stiffness`]: cotangent
     /// weights of obtuse triangles can be negative and break the maximum principle the
     /// representative relies on (paper section 5); `k` (the energy's) is not used.
@@ -205,8 +213,7 @@ impl Smoothable for TriMesh {
         _k: &Sparse,
         excluded: &[(&'static str, String)],
     ) -> Result<Representative> {
-        let fill = positive_cotan_stiffness(self.positions(), self.faces());
-        surface_representative(self, h, kept, choice, &fill, excluded)
+        surface_representative(self, h, kept, choice, &self.fill_stiffness(), excluded)
     }
 }
 

@@ -25,7 +25,7 @@ pub struct Failure {
 }
 
 /// Result of checking a field against roles.
-#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
 pub struct Certificate {
     /// All items hold.
     pub passed: bool,
@@ -146,6 +146,152 @@ pub fn certify<D: Domain>(domain: &D, f: &[f64], roles: &[Role], input: Option<&
     }
 }
 
+/// What a connected set of fixed vertices with one prescribed value must be (no-data mode).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum RegionKind {
+    /// Every vertex adjacent to the region from outside is strictly higher.
+    Min,
+    /// Every vertex adjacent to the region from outside is strictly lower.
+    Max,
+    /// Exempt (a cage boundary with values varying along it).
+    Exempt,
+}
+
+/// Connected sets of fixed vertices with equal prescribed values (SPEC.md, "Fixed regions"),
+/// each sorted, in order of their smallest vertex.
+pub fn fixed_regions<D: Domain>(domain: &D, prescribed: &[Option<f64>]) -> Vec<Vec<usize>> {
+    let n = domain.n_vertices();
+    let mut seen = vec![false; n];
+    let mut out = Vec::new();
+    for s in 0..n {
+        let Some(value) = prescribed[s] else { continue };
+        if seen[s] {
+            continue;
+        }
+        seen[s] = true;
+        let mut region = vec![s];
+        let mut k = 0;
+        while k < region.len() {
+            let v = region[k];
+            k += 1;
+            for w in domain.neighbors(v) {
+                if !seen[w] && prescribed[w].is_some_and(|x| x.to_bits() == value.to_bits()) {
+                    seen[w] = true;
+                    region.push(w);
+                }
+            }
+        }
+        region.sort_unstable();
+        out.push(region);
+    }
+    out
+}
+
+/// The no-data certificate (SPEC.md, "Fixed regions"): fixed vertices carry their prescribed
+/// values bit for bit (item 3), every free vertex is regular (item 2), every value is finite
+/// (item 4), and every region that `kind` declares a minimum or maximum is one: each vertex
+/// adjacent to it from outside is strictly higher or lower (item 1). `strict_minima` and
+/// `strict_maxima` count the regions so verified.
+pub fn certify_no_data<D: Domain>(
+    domain: &D,
+    f: &[f64],
+    prescribed: &[Option<f64>],
+    kind: impl Fn(f64) -> RegionKind,
+) -> Certificate {
+    let roles: Vec<Role> = prescribed.iter().map(|p| if p.is_some() { Role::Fixed } else { Role::Other }).collect();
+    let values: Vec<f64> = prescribed.iter().map(|p| p.unwrap_or(f64::NAN)).collect();
+    let mut c = certify(domain, f, &roles, Some(&values));
+    let mut failures = std::mem::take(&mut c.failures);
+    let (mut minima, mut maxima) = (0, 0);
+    let mut in_region = vec![usize::MAX; f.len()];
+    for (r, region) in fixed_regions(domain, prescribed).into_iter().enumerate() {
+        let value = prescribed[region[0]].expect("a region is fixed");
+        let k = kind(value);
+        if k == RegionKind::Exempt {
+            continue;
+        }
+        for &v in &region {
+            in_region[v] = r;
+        }
+        let mut ok = true;
+        for &v in &region {
+            for w in domain.neighbors(v) {
+                let bad = in_region[w] != r
+                    && match k {
+                        RegionKind::Max => !(f[w] < value),
+                        _ => !(f[w] > value),
+                    };
+                if bad {
+                    ok = false;
+                    c.failure_count += 1;
+                    failures.push(Failure {
+                        item: 1,
+                        vertex: w,
+                        reason: format!(
+                            "borders the {} region at {value} (vertex {v}) but is not strictly {} ({})",
+                            if k == RegionKind::Max { "maximum" } else { "minimum" },
+                            if k == RegionKind::Max { "lower" } else { "higher" },
+                            f[w]
+                        ),
+                    });
+                }
+            }
+        }
+        if ok {
+            match k {
+                RegionKind::Max => maxima += 1,
+                _ => minima += 1,
+            }
+        }
+    }
+    failures.truncate(20);
+    c.failures = failures;
+    c.passed = c.failure_count == 0;
+    c.strict_minima = minima;
+    c.strict_maxima = maxima;
+    c
+}
+
+/// Connected components of the free vertices (`prescribed` is `None`) that are not regular in
+/// `f`: no neighbour below `f_v − tolerance` or none above `f_v + tolerance` (tolerance 0:
+/// exact comparisons). Spurious extrema and flat spots, counted once per connected patch.
+pub fn spurious_components<D: Domain>(domain: &D, f: &[f64], prescribed: &[Option<f64>], tolerance: f64) -> usize {
+    let n = domain.n_vertices();
+    let bad: Vec<bool> = (0..n)
+        .map(|v| {
+            if prescribed[v].is_some() {
+                return false;
+            }
+            let (mut lower, mut higher) = (false, false);
+            for w in domain.neighbors(v) {
+                lower |= f[w] < f[v] - tolerance;
+                higher |= f[w] > f[v] + tolerance;
+            }
+            !(lower && higher)
+        })
+        .collect();
+    let mut seen = vec![false; n];
+    let mut count = 0;
+    for s in 0..n {
+        if !bad[s] || seen[s] {
+            continue;
+        }
+        count += 1;
+        seen[s] = true;
+        let mut stack = vec![s];
+        while let Some(v) = stack.pop() {
+            for w in domain.neighbors(v) {
+                if bad[w] && !seen[w] {
+                    seen[w] = true;
+                    stack.push(w);
+                }
+            }
+        }
+    }
+    count
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -173,5 +319,32 @@ mod tests {
         let mut nan = good;
         nan[1] = f64::NAN;
         assert!(certify(&s, &nan, &roles, None).failures.iter().any(|f| f.item == 4));
+    }
+
+    #[test]
+    fn regions_are_checked_as_one_extremum() {
+        // 0 1 2 3 4 5 6: a maximum region {2, 3} at 1, minimum regions at both ends
+        let s = Series::uniform(7);
+        let p = [Some(0.0), None, Some(1.0), Some(1.0), None, None, Some(0.0)];
+        let kind = |v: f64| if v == 1.0 { RegionKind::Max } else { RegionKind::Min };
+        assert_eq!(fixed_regions(&s, &p), vec![vec![0], vec![2, 3], vec![6]]);
+        let good = [0.0, 0.5, 1.0, 1.0, 0.7, 0.3, 0.0];
+        let c = certify_no_data(&s, &good, &p, kind);
+        assert!(c.passed, "{}", c.summary());
+        assert_eq!((c.strict_minima, c.strict_maxima), (2, 1));
+        let mut above = good;
+        above[4] = 1.0; // ties the maximum region
+        let c = certify_no_data(&s, &above, &p, kind);
+        assert!(c.failures.iter().any(|f| f.item == 1 && f.vertex == 4), "{}", c.summary());
+        let mut dip = good;
+        dip[5] = 0.8; // 4 becomes a spurious minimum, 5 a spurious maximum
+        let c = certify_no_data(&s, &dip, &p, kind);
+        assert!(c.failures.iter().any(|f| f.item == 2 && f.vertex == 4));
+        assert_eq!(spurious_components(&s, &dip, &p, 0.0), 1); // 4 (min) and 5 (max), adjacent: one patch
+        let mut moved = good;
+        moved[3] = 0.999;
+        assert!(certify_no_data(&s, &moved, &p, kind).failures.iter().any(|f| f.item == 3 && f.vertex == 3));
+        assert_eq!(spurious_components(&s, &good, &p, 0.0), 0);
+        assert_eq!(spurious_components(&s, &good, &p, 0.35), 1); // 4 and 5 look flat at that tolerance
     }
 }

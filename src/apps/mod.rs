@@ -1,3 +1,6 @@
-//! Applications built on the operators: geodesic distance (heat method).
+//! Applications built on the operators and the pipeline: geodesic distance (heat method),
+//! handles and shape-aware weights (no-data mode).
 
 pub mod geodesic;
+pub mod handles;
+pub mod weights;

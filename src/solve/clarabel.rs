@@ -102,7 +102,7 @@ pub fn solve_auxiliary(
     Ok((x[..nf].to_vec(), status, it))
 }
 
-fn run(
+pub(super) fn run(
     p: &CscMatrix<f64>,
     q: &[f64],
     a: &CscMatrix<f64>,

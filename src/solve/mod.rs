@@ -4,10 +4,12 @@
 //!
 //! This layer knows matrices, vectors and index pairs only: no domain, no mesh.
 
+mod bounded;
 mod clarabel;
 mod ipm;
 mod qp;
 mod repair;
 
+pub use bounded::solve_bounded_partition;
 pub use qp::{solve_monotone_qp, Method, MonotoneQp, QpSettings, QpSolution, ReducedQp, SolveStatus};
 pub use repair::{repair, RepairSummary};

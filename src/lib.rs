@@ -19,6 +19,7 @@ pub use error::{Error, Result};
 pub mod commands;
 pub mod constraints;
 pub mod derive;
+pub mod harmonic_order;
 pub mod io;
 pub mod linalg;
 pub mod pipeline;

@@ -2,6 +2,7 @@
 
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use std::path::PathBuf;
+use toposmooth::apps::weights::WeightMethod;
 use toposmooth::commands::input::{Derive, DomainKind, GridOptions};
 use toposmooth::commands::{self, BenchArgs, ExtremaArgs, SmoothArgs, VerifyArgs};
 use toposmooth::constraints::EdgeSet;
@@ -71,6 +72,37 @@ enum Command {
         #[arg(short, long)]
         output: PathBuf,
         /// JSON report with per-stage seconds.
+        #[arg(long, value_name = "JSON")]
+        report: Option<PathBuf>,
+    },
+    /// Weight functions for handles on a mesh (no data): 1 on a handle, 0 on the others, no
+    /// other extremum (monotone, certified), normalised to a partition of unity.
+    Weights(Box<WeightsCli>),
+    /// Colour diffusion from coloured points over an image's shape (alpha) or a mesh, with
+    /// monotone weights: no pixel leaves the per-channel box of the given colours.
+    Diffuse {
+        /// An image (PNG, TIFF; alpha ≥ 128 is the shape) or a mesh (.obj, .off, .ply, .vtu, .vtp).
+        input: PathBuf,
+        /// colors.json: {"points": [{"pixel": [col, row], "rgb": [r, g, b]}, ...]} ("vertex" or
+        /// "point" on meshes).
+        #[arg(long, value_name = "JSON")]
+        colors: PathBuf,
+        /// Output: PNG for an image; .vtu, .vtp or .ply (arrays red, green, blue) for a mesh.
+        #[arg(short, long)]
+        output: PathBuf,
+        /// Where an image's Float64 weights go (.vtu, .vtp, .ply); default <output>_weights.vtu.
+        #[arg(long, value_name = "FILE")]
+        weights: Option<PathBuf>,
+        /// Polyharmonic order k.
+        #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u8).range(1..=4))]
+        order: u8,
+        /// Weights: monotone (convex blend, certified) or unconstrained etc. for comparison.
+        #[arg(long, value_enum, default_value_t = WeightMethodCli::Monotone)]
+        method: WeightMethodCli,
+        /// Enlarged picture with the colour points drawn.
+        #[arg(long, value_name = "PNG")]
+        plot: Option<PathBuf>,
+        /// JSON report.
         #[arg(long, value_name = "JSON")]
         report: Option<PathBuf>,
     },
@@ -213,6 +245,73 @@ impl CsvArgs {
     fn options(&self) -> SeriesCsvOptions {
         SeriesCsvOptions { column: self.column.clone(), x_column: self.x_column.clone() }
     }
+}
+
+fn parse_view(view: Option<&str>) -> Result<MeshView> {
+    match view {
+        None => Ok(MeshView::default()),
+        Some(text) => {
+            let parts: Vec<f64> = text.split(',').filter_map(|p| p.trim().parse().ok()).collect();
+            match parts.as_slice() {
+                [az, el] if az.is_finite() && el.is_finite() => Ok(MeshView { azimuth: *az, elevation: *el }),
+                _ => Err(Error::Usage(format!("--view `{text}` is not two angles AZ,EL in degrees"))),
+            }
+        }
+    }
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum WeightMethodCli {
+    Monotone,
+    Bounded,
+    Unconstrained,
+    Harmonic,
+}
+
+fn weight_method(m: WeightMethodCli) -> WeightMethod {
+    match m {
+        WeightMethodCli::Monotone => WeightMethod::Monotone,
+        WeightMethodCli::Bounded => WeightMethod::Bounded,
+        WeightMethodCli::Unconstrained => WeightMethod::Unconstrained,
+        WeightMethodCli::Harmonic => WeightMethod::Harmonic,
+    }
+}
+
+#[derive(Args)]
+struct WeightsCli {
+    /// Mesh: .obj, .off, .ply, .vtu, .vtp (a planar mesh for 2D shapes).
+    input: PathBuf,
+    /// handles.json: points, bones, vertex lists (SPEC.md formats).
+    #[arg(long, value_name = "JSON")]
+    handles: PathBuf,
+    /// Output mesh (.vtu, .vtp, .ply) with weight_<name>, weight_<name>_raw, u_<name>, role_<name>.
+    #[arg(short, long)]
+    output: PathBuf,
+    /// Polyharmonic order k.
+    #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u8).range(1..=4))]
+    order: u8,
+    /// monotone: no spurious extremum (certified); bounded: BBW (0 ≤ w ≤ 1, partition of
+    /// unity); unconstrained: plain polyharmonic; harmonic: Laplace.
+    #[arg(long, value_enum, default_value_t = WeightMethodCli::Monotone)]
+    method: WeightMethodCli,
+    /// Also run the other three methods and report their spurious extrema.
+    #[arg(long)]
+    compare: bool,
+    /// Constraint set of the monotone method.
+    #[arg(long, value_enum, default_value_t = Edges::Minimal)]
+    edges: Edges,
+    /// Worker threads (the functions are independent).
+    #[arg(long, default_value_t = 2)]
+    threads: usize,
+    /// Picture: the normalised weights of up to 4 handles (with --compare: handle 0 by method).
+    #[arg(long, value_name = "PNG")]
+    plot: Option<PathBuf>,
+    /// Camera of the picture: azimuth and elevation in degrees.
+    #[arg(long, value_name = "AZ,EL")]
+    view: Option<String>,
+    /// JSON report: per function certificate, spurious extrema, iterations, seconds.
+    #[arg(long, value_name = "JSON")]
+    report: Option<PathBuf>,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -367,16 +466,7 @@ fn smooth_args(c: SmoothCli) -> Result<SmoothArgs> {
         grid: c.grid.options()?,
         complex: c.complex,
         isolines: c.isolines,
-        view: match &c.view {
-            None => MeshView::default(),
-            Some(text) => {
-                let parts: Vec<f64> = text.split(',').filter_map(|p| p.trim().parse().ok()).collect();
-                match parts.as_slice() {
-                    [az, el] if az.is_finite() && el.is_finite() => MeshView { azimuth: *az, elevation: *el },
-                    _ => return Err(Error::Usage(format!("--view `{text}` is not two angles AZ,EL in degrees"))),
-                }
-            }
-        },
+        view: parse_view(c.view.as_deref())?,
         output: c.output,
         settings,
         plot: c.plot,
@@ -402,6 +492,37 @@ fn run(cli: Cli) -> Result<String> {
             output,
             report,
         }),
+        Command::Weights(c) => commands::weights(&commands::WeightsArgs {
+            input: c.input,
+            handles: c.handles,
+            output: c.output,
+            settings: toposmooth::apps::weights::WeightSettings {
+                order: c.order,
+                method: weight_method(c.method),
+                edges: edge_set(c.edges),
+                threads: c.threads.max(1),
+                ..Default::default()
+            },
+            compare: c.compare,
+            plot: c.plot,
+            view: parse_view(c.view.as_deref())?,
+            report: c.report,
+        }),
+        Command::Diffuse { input, colors, output, weights, order, method, plot, report } => {
+            commands::diffuse(&commands::DiffuseArgs {
+                input,
+                colors,
+                output,
+                weights,
+                settings: toposmooth::apps::weights::WeightSettings {
+                    order,
+                    method: weight_method(method),
+                    ..Default::default()
+                },
+                plot,
+                report,
+            })
+        }
         Command::Verify { file, input, csv, grid } => {
             commands::verify(&VerifyArgs { file, input, csv: csv.options(), grid: grid.options()? })
         }

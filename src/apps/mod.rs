@@ -1,6 +1,7 @@
 //! Applications built on the operators and the pipeline: geodesic distance (heat method),
-//! handles and shape-aware weights (no-data mode).
+//! handles and shape-aware weights, colour diffusion (no-data mode).
 
+pub mod diffuse;
 pub mod geodesic;
 pub mod handles;
 pub mod weights;

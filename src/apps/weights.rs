@@ -18,6 +18,7 @@
 use crate::constraints::{choose_margin, constraint_edges, margin_cap, max_margin, EdgeSet};
 use crate::domain::sos_sort;
 use crate::error::{Error, Result};
+use crate::harmonic_order::ordered_harmonic;
 use crate::operators::{dirichlet_solve, polyharmonic, Energy, Sparse};
 use crate::pipeline::Smoothable;
 use crate::solve::{repair, solve_bounded_partition, solve_monotone_qp, MonotoneQp, QpSettings, SolveStatus};
@@ -92,6 +93,9 @@ pub struct WeightFunction {
     pub prescribed: Vec<Option<f64>>,
     /// Free vertices fixed by the fill rule (SPEC.md).
     pub filled: usize,
+    /// Levels of extended-precision refinement the representative needed (0: the plain
+    /// harmonic function was strictly regular; see [`crate::harmonic_order`]).
+    pub refinements: usize,
     /// The no-data certificate of `raw` (it must pass for `monotone`; reported for the others).
     pub certificate: Certificate,
     /// Spurious extrema of `raw`.
@@ -201,9 +205,12 @@ fn one_function<D: Smoothable>(
 ) -> Result<WeightFunction> {
     let t = Instant::now();
     let (fixed, filled) = prescribed_values(domain, handles, which);
-    let u = dirichlet_solve(&ops.fill, &fixed)
-        .map_err(|e| Error::input(format!("handle {which}: representative function: {e}")))?;
+    let (u, refinements) = ordered_harmonic(domain, &ops.fill, &fixed).map_err(|e| Error::Representative {
+        path: None,
+        message: format!("handle {which}: harmonic representative: {e}"),
+    })?;
     let mut out = WeightFunction {
+        refinements,
         handle: which,
         raw: Vec::new(),
         u,
@@ -381,6 +388,7 @@ fn bounded<D: Smoothable>(
         let u = dirichlet_solve(&ops.fill, &prescribed)
             .map_err(|e| Error::input(format!("handle {which}: representative function: {e}")))?;
         functions.push(WeightFunction {
+            refinements: 0,
             handle: which,
             raw: Vec::new(),
             u,

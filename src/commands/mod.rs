@@ -2,6 +2,7 @@
 //! `main.rs` only parses arguments into these option structs and maps errors to exit codes.
 
 mod bench;
+mod diffuse;
 mod extrema;
 mod geodesic;
 pub mod input;
@@ -9,12 +10,15 @@ mod smooth;
 mod smooth_grid;
 mod smooth_mesh;
 mod verify;
+mod weights;
 
 pub use bench::{bench, BenchArgs, BenchCase};
+pub use diffuse::{diffuse, DiffuseArgs};
 pub use extrema::{extrema, ExtremaArgs};
 pub use geodesic::{geodesic, GeodesicArgs};
 pub use smooth::{smooth, SmoothArgs};
 pub use verify::{verify, VerifyArgs};
+pub use weights::{weights, WeightsArgs};
 
 use crate::error::{Error, Result};
 use crate::io::series_csv::XSource;

@@ -1,0 +1,265 @@
+//! `toposmooth diffuse IMAGE_OR_MESH --colors colors.json -o out.png`: colour diffusion from
+//! coloured points with monotone weights (a convex blend: no pixel leaves the colours' box).
+
+use super::input::read_trimesh;
+use super::sig6;
+use super::weights::stage_weights;
+use crate::apps::diffuse::{blend, linear_to_srgb8, outside_box, parse_colors, pixel_mesh, ColorAt, PixelMesh};
+use crate::apps::handles::{resolve, Handle, HandleShape};
+use crate::apps::weights::{weights, WeightMethod, WeightSettings};
+use crate::domain::{Domain, TriMesh};
+use crate::error::{Error, Result};
+use crate::io::{stage_json, stage_with, Staged};
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// Options of `diffuse`.
+#[derive(Clone, Debug)]
+pub struct DiffuseArgs {
+    /// An image (PNG, TIFF: its alpha ≥ 128 is the shape) or a mesh.
+    pub input: PathBuf,
+    /// colors.json.
+    pub colors: PathBuf,
+    /// Output: PNG for an image, .vtu/.vtp/.ply (arrays red, green, blue and the weights) for a mesh.
+    pub output: PathBuf,
+    /// Where an image's Float64 weights go (.vtu, .vtp, .ply); default `<output>_weights.vtu`.
+    pub weights: Option<PathBuf>,
+    /// Method and order of the weights.
+    pub settings: WeightSettings,
+    /// Enlarged picture with the colour points marked.
+    pub plot: Option<PathBuf>,
+    /// Report JSON.
+    pub report: Option<PathBuf>,
+}
+
+fn is_image(path: &Path) -> bool {
+    let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
+    matches!(ext.as_str(), "png" | "tif" | "tiff")
+}
+
+#[derive(serde::Serialize)]
+struct DiffuseReport {
+    input_file: String,
+    colors_file: String,
+    vertices: usize,
+    method: WeightMethod,
+    order: u8,
+    certified: Vec<bool>,
+    spurious_exact: Vec<usize>,
+    outside_box: usize,
+    dropped_pixels: usize,
+    max_normalisation_change: f64,
+    seconds: f64,
+}
+
+/// Runs `diffuse`.
+pub fn diffuse(args: &DiffuseArgs) -> Result<String> {
+    let start = Instant::now();
+    let text =
+        std::fs::read_to_string(&args.colors).map_err(|source| Error::Io { path: args.colors.clone(), source })?;
+    let points = parse_colors(&text).map_err(|e| e.in_file(&args.colors))?;
+    let image = is_image(&args.input);
+    if !image && args.plot.is_some() {
+        return Err(Error::Usage("--plot draws diffused images; open a mesh output in ParaView".into()));
+    }
+    let (mesh, pm): (TriMesh, Option<PixelMesh>) = if image {
+        let img = image::ImageReader::open(&args.input)
+            .map_err(|source| Error::Io { path: args.input.clone(), source })?
+            .with_guessed_format()
+            .map_err(|source| Error::Io { path: args.input.clone(), source })?
+            .decode()
+            .map_err(|e| Error::input(format!("cannot decode the image: {e}")).in_file(&args.input))?;
+        let has_alpha = img.color().has_alpha();
+        let rgba = img.to_rgba8();
+        let (w, h) = (rgba.width() as usize, rgba.height() as usize);
+        let inside: Vec<bool> = rgba.pixels().map(|p| !has_alpha || p.0[3] >= 128).collect();
+        let pm = pixel_mesh(w, h, &inside).map_err(|e| e.in_file(&args.input))?;
+        (pm.mesh.clone(), Some(pm))
+    } else {
+        if !args.output.extension().is_some_and(|e| ["vtu", "vtp", "ply"].iter().any(|x| e.eq_ignore_ascii_case(x))) {
+            return Err(Error::Usage(format!(
+                "{}: colours diffused on a mesh are written as .vtu, .vtp or .ply (arrays red, green, blue)",
+                args.output.display()
+            )));
+        }
+        (read_trimesh(&args.input)?.0, None)
+    };
+    if image && !args.output.extension().is_some_and(|e| e.eq_ignore_ascii_case("png")) {
+        return Err(Error::Usage(format!("{}: the diffused image is written as PNG", args.output.display())));
+    }
+    // colour points → handles
+    let mut handles = Vec::with_capacity(points.len());
+    for p in &points {
+        let shape = match (p.at, &pm) {
+            (ColorAt::Pixel([c, r]), Some(pm)) => {
+                if c >= pm.width || r >= pm.height {
+                    return Err(Error::input(format!(
+                        "point `{}`: pixel [{c}, {r}] is outside the {} × {} image",
+                        p.name, pm.width, pm.height
+                    ))
+                    .in_file(&args.colors));
+                }
+                let v = pm.vertex_of_pixel[r * pm.width + c].ok_or_else(|| {
+                    Error::input(format!(
+                        "point `{}`: pixel [{c}, {r}] is outside the image's shape (alpha < 128)",
+                        p.name
+                    ))
+                    .in_file(&args.colors)
+                })?;
+                HandleShape::Vertices(vec![v])
+            }
+            (ColorAt::Pixel(_), None) => {
+                return Err(Error::input(format!(
+                    "point `{}`: a mesh takes \"vertex\" or \"point\", not \"pixel\"",
+                    p.name
+                ))
+                .in_file(&args.colors))
+            }
+            (_, Some(_)) => {
+                return Err(Error::input(format!("point `{}`: an image takes \"pixel\": [column, row]", p.name))
+                    .in_file(&args.colors))
+            }
+            (ColorAt::Vertex(v), None) => HandleShape::Vertices(vec![v]),
+            (ColorAt::Point(q), None) => HandleShape::Point(q),
+        };
+        handles.push(Handle { name: p.name.clone(), shape });
+    }
+    let sets = resolve(&mesh, &handles).map_err(|e| e.in_file(&args.colors))?;
+    let w = weights(&mesh, &sets, &args.settings).map_err(|e| e.in_file(&args.input))?;
+    let rgbs: Vec<[u8; 3]> = points.iter().map(|p| p.rgb).collect();
+    let lin = blend(&w.normalised, &rgbs);
+    let colours: Vec<[u8; 3]> = lin.iter().map(|c| c.map(linear_to_srgb8)).collect();
+    let outside = outside_box(&rgbs, &colours);
+    let names: Vec<String> = points.iter().map(|p| p.name.clone()).collect();
+
+    let mut staged: Vec<Staged> = Vec::new();
+    let mut wrote = vec![args.output.display().to_string()];
+    match &pm {
+        Some(pm) => {
+            let mut img = image::RgbaImage::new(pm.width as u32, pm.height as u32);
+            for (v, c) in colours.iter().enumerate() {
+                let p = pm.pixel_of_vertex[v];
+                img.put_pixel((p % pm.width) as u32, (p / pm.width) as u32, image::Rgba([c[0], c[1], c[2], 255]));
+            }
+            staged.push(stage_png(&args.output, &img)?);
+            let wpath = args.weights.clone().unwrap_or_else(|| {
+                let stem = args.output.file_stem().unwrap_or_default().to_string_lossy().to_string();
+                args.output.with_file_name(format!("{stem}_weights.vtu"))
+            });
+            staged.push(stage_weights(&wpath, &mesh, &names, &sets, &w)?);
+            wrote.push(wpath.display().to_string());
+            if let Some(path) = &args.plot {
+                staged.push(stage_png(path, &enlarged(&img, pm, &sets, &rgbs))?);
+                wrote.push(path.display().to_string());
+            }
+        }
+        None => {
+            let chan = |k: usize| -> Vec<f64> { colours.iter().map(|c| f64::from(c[k])).collect() };
+            let (r, g, b) = (chan(0), chan(1), chan(2));
+            let mut owned: Vec<(String, Vec<f64>)> = vec![("red".into(), r), ("green".into(), g), ("blue".into(), b)];
+            for (h, f) in w.functions.iter().enumerate() {
+                owned.push((format!("weight_{}", names[h]), w.normalised[h].clone()));
+                owned.push((format!("weight_{}_raw", names[h]), f.raw.clone()));
+                owned.push((format!("u_{}", names[h]), f.u.clone()));
+                owned.push((format!("role_{}", names[h]), super::weights::weight_roles(&f.prescribed, &sets, h)));
+            }
+            let arrays: Vec<(&str, &[f64])> = owned.iter().map(|(n, v)| (n.as_str(), v.as_slice())).collect();
+            staged.push(super::smooth_mesh::stage_mesh_output(&args.output, &mesh, &arrays)?);
+        }
+    }
+    if let Some(path) = &args.report {
+        let report = DiffuseReport {
+            input_file: args.input.display().to_string(),
+            colors_file: args.colors.display().to_string(),
+            vertices: mesh.n_vertices(),
+            method: args.settings.method,
+            order: args.settings.order,
+            certified: w.functions.iter().map(|f| f.certificate.passed).collect(),
+            spurious_exact: w.functions.iter().map(|f| f.spurious.exact).collect(),
+            outside_box: outside,
+            dropped_pixels: pm.as_ref().map_or(0, |p| p.dropped),
+            max_normalisation_change: w.max_normalisation_change,
+            seconds: start.elapsed().as_secs_f64(),
+        };
+        staged.push(stage_json(path, &report)?);
+        wrote.push(path.display().to_string());
+    }
+    for s in staged {
+        s.commit()?;
+    }
+    let certified = w.functions.iter().filter(|f| f.certificate.passed).count();
+    let spurious: usize = w.functions.iter().map(|f| f.spurious.exact).sum();
+    let mut text = format!(
+        "{}: {} colour points on {} {}; {} weights of order {}: {certified} of {} certified, {spurious} spurious extrema\n",
+        args.input.display(),
+        points.len(),
+        mesh.n_vertices(),
+        if image { "pixels" } else { "vertices" },
+        format!("{:?}", args.settings.method).to_lowercase(),
+        args.settings.order,
+        w.functions.len()
+    );
+    if let Some(pm) = &pm {
+        if pm.dropped > 0 {
+            text += &format!(
+                "note: {} shape pixels outside any 2 × 2 block of the shape were left transparent\n",
+                pm.dropped
+            );
+        }
+    }
+    text += &format!(
+        "{outside} of {} {} outside the per-channel box of the given colours (8-bit output); largest normalisation change {}; {} s\n",
+        colours.len(),
+        if image { "pixels" } else { "vertices" },
+        sig6(w.max_normalisation_change),
+        sig6(start.elapsed().as_secs_f64())
+    );
+    text += &format!("wrote {}\n", wrote.join(", "));
+    Ok(text)
+}
+
+fn stage_png(path: &Path, img: &image::RgbaImage) -> Result<Staged> {
+    stage_with(path, |tmp| {
+        img.save_with_format(tmp, image::ImageFormat::Png).map_err(|e| std::io::Error::other(e.to_string()))
+    })
+}
+
+/// The image enlarged (nearest neighbour, at least 600 pixels wide) on a checkerboard, with
+/// each colour point drawn as a ring.
+fn enlarged(img: &image::RgbaImage, pm: &PixelMesh, sets: &[Vec<usize>], rgbs: &[[u8; 3]]) -> image::RgbaImage {
+    let s = (600 / pm.width.max(1)).clamp(1, 16) as u32;
+    let (w, h) = (img.width() * s, img.height() * s);
+    let mut out = image::RgbaImage::from_fn(w, h, |x, y| {
+        let p = img.get_pixel(x / s, y / s);
+        if p.0[3] == 0 {
+            let g = if ((x / 8) + (y / 8)) % 2 == 0 { 235 } else { 250 };
+            image::Rgba([g, g, g, 255])
+        } else {
+            *p
+        }
+    });
+    let radius = (3 * s).max(6) as i64;
+    for (set, rgb) in sets.iter().zip(rgbs) {
+        let p = pm.pixel_of_vertex[set[0]];
+        let (cx, cy) =
+            (((p % pm.width) as i64) * s as i64 + s as i64 / 2, ((p / pm.width) as i64) * s as i64 + s as i64 / 2);
+        for dy in -radius - 2..=radius + 2 {
+            for dx in -radius - 2..=radius + 2 {
+                let d = ((dx * dx + dy * dy) as f64).sqrt();
+                let (x, y) = (cx + dx, cy + dy);
+                if x < 0 || y < 0 || x >= w as i64 || y >= h as i64 {
+                    continue;
+                }
+                let c = if d <= radius as f64 - 1.5 {
+                    image::Rgba([rgb[0], rgb[1], rgb[2], 255])
+                } else if d <= radius as f64 + 1.5 {
+                    image::Rgba([0, 0, 0, 255])
+                } else {
+                    continue;
+                };
+                out.put_pixel(x as u32, y as u32, c);
+            }
+        }
+    }
+    out
+}

@@ -1,0 +1,294 @@
+//! `toposmooth weights MESH --handles handles.json -o weights.vtu`: one weight function per
+//! handle, certified (monotone), normalised, written with u and roles; `--compare` adds the
+//! spurious-extremum counts of the other three methods.
+
+use super::input::read_trimesh;
+use super::sig6;
+use crate::apps::handles::{parse_handles, resolve, HandleFile};
+use crate::apps::weights::{weights as compute, WeightMethod, WeightSettings, Weights};
+use crate::domain::{Domain, TriMesh};
+use crate::error::{Error, Result};
+use crate::io::{stage_json, Staged};
+use crate::plot::{plot_mesh_fields, GridMarker, GridPanel, MeshView};
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// Options of `weights`.
+#[derive(Clone, Debug)]
+pub struct WeightsArgs {
+    /// The mesh.
+    pub input: PathBuf,
+    /// handles.json.
+    pub handles: PathBuf,
+    /// Output .vtu, .vtp or .ply.
+    pub output: PathBuf,
+    /// Order, method, solver, threads.
+    pub settings: WeightSettings,
+    /// Also run the other three methods and count their spurious extrema.
+    pub compare: bool,
+    /// Picture of the weights.
+    pub plot: Option<PathBuf>,
+    /// Camera of the picture.
+    pub view: MeshView,
+    /// Report JSON.
+    pub report: Option<PathBuf>,
+}
+
+#[derive(serde::Serialize)]
+struct FunctionReport<'a> {
+    name: &'a str,
+    handle_vertices: usize,
+    #[serde(flatten)]
+    function: &'a crate::apps::weights::WeightFunction,
+}
+
+#[derive(serde::Serialize)]
+struct MethodSummary {
+    method: WeightMethod,
+    spurious_exact: Vec<usize>,
+    spurious_tolerance_1e9: Vec<usize>,
+    certified: Vec<bool>,
+    below_zero: usize,
+    above_one: usize,
+    seconds_per_function: f64,
+}
+
+#[derive(serde::Serialize)]
+struct WeightsReport<'a> {
+    input_file: String,
+    handles_file: String,
+    vertices: usize,
+    triangles: usize,
+    settings: &'a WeightSettings,
+    functions: Vec<FunctionReport<'a>>,
+    max_normalisation_change: f64,
+    raw_sum_range: [f64; 2],
+    operator_seconds: f64,
+    function_seconds: f64,
+    total_seconds: f64,
+    comparison: Vec<MethodSummary>,
+}
+
+fn summary(method: WeightMethod, w: &Weights) -> MethodSummary {
+    let count = |pred: &dyn Fn(f64) -> bool| -> usize {
+        w.functions.iter().map(|f| f.raw.iter().filter(|&&x| pred(x)).count()).sum()
+    };
+    MethodSummary {
+        method,
+        spurious_exact: w.functions.iter().map(|f| f.spurious.exact).collect(),
+        spurious_tolerance_1e9: w.functions.iter().map(|f| f.spurious.tolerance_1e9).collect(),
+        certified: w.functions.iter().map(|f| f.certificate.passed).collect(),
+        below_zero: count(&|x| x < 0.0),
+        above_one: count(&|x| x > 1.0),
+        seconds_per_function: w.functions.iter().map(|f| f.seconds).sum::<f64>() / w.functions.len() as f64,
+    }
+}
+
+/// Role codes of one function (SPEC.md): a single-vertex handle is a kept maximum (its own
+/// function) or minimum (the others'), every other prescribed vertex a fixed region member.
+pub fn weight_roles(prescribed: &[Option<f64>], handles: &[Vec<usize>], which: usize) -> Vec<f64> {
+    let mut r: Vec<f64> = prescribed.iter().map(|p| if p.is_some() { 2.0 } else { 0.0 }).collect();
+    for (k, set) in handles.iter().enumerate() {
+        if set.len() == 1 && r[set[0]] == 2.0 {
+            r[set[0]] = if k == which { 1.0 } else { -1.0 };
+        }
+    }
+    r
+}
+
+/// Stages a weights file: per handle `weight_<name>`, `weight_<name>_raw`, `u_<name>`,
+/// `role_<name>` (SPEC.md formats).
+pub fn stage_weights(
+    path: &Path,
+    mesh: &TriMesh,
+    names: &[String],
+    handles: &[Vec<usize>],
+    w: &Weights,
+) -> Result<Staged> {
+    let mut owned: Vec<(String, Vec<f64>)> = Vec::new();
+    for (h, f) in w.functions.iter().enumerate() {
+        let name = &names[h];
+        owned.push((format!("weight_{name}"), w.normalised[h].clone()));
+        owned.push((format!("weight_{name}_raw"), f.raw.clone()));
+        owned.push((format!("u_{name}"), f.u.clone()));
+        owned.push((format!("role_{name}"), weight_roles(&f.prescribed, handles, h)));
+    }
+    let arrays: Vec<(&str, &[f64])> = owned.iter().map(|(n, v)| (n.as_str(), v.as_slice())).collect();
+    super::smooth_mesh::stage_mesh_output(path, mesh, &arrays)
+}
+
+/// Runs `weights`.
+pub fn weights(args: &WeightsArgs) -> Result<String> {
+    let start = Instant::now();
+    let (mesh, _) = read_trimesh(&args.input)?;
+    let text =
+        std::fs::read_to_string(&args.handles).map_err(|source| Error::Io { path: args.handles.clone(), source })?;
+    let file = parse_handles(&text).map_err(|e| e.in_file(&args.handles))?;
+    let HandleFile::Handles(list) = file else {
+        return Err(Error::Usage(format!(
+            "{}: a cage is solved on the cage's own triangulation: use `toposmooth weights SHAPE --handles cage.json` with a planar shape (cages: see docs/weights.md)",
+            args.handles.display()
+        )));
+    };
+    let sets = resolve(&mesh, &list).map_err(|e| e.in_file(&args.handles))?;
+    let names: Vec<String> = list.iter().map(|h| h.name.clone()).collect();
+    run_weights(args, &mesh, &names, &sets, start)
+}
+
+/// The weights of resolved handles on a mesh, written as `args` asks.
+pub fn run_weights(
+    args: &WeightsArgs,
+    mesh: &TriMesh,
+    names: &[String],
+    sets: &[Vec<usize>],
+    start: Instant,
+) -> Result<String> {
+    let w = compute(mesh, sets, &args.settings).map_err(|e| e.in_file(&args.input))?;
+    let mut comparison = vec![summary(args.settings.method, &w)];
+    let mut others: Vec<(WeightMethod, Weights)> = Vec::new();
+    if args.compare {
+        for method in
+            [WeightMethod::Monotone, WeightMethod::Bounded, WeightMethod::Unconstrained, WeightMethod::Harmonic]
+        {
+            if method != args.settings.method {
+                let o = compute(mesh, sets, &WeightSettings { method, ..args.settings.clone() })
+                    .map_err(|e| e.in_file(&args.input))?;
+                comparison.push(summary(method, &o));
+                others.push((method, o));
+            }
+        }
+    }
+    let mut staged = vec![stage_weights(&args.output, mesh, names, sets, &w)?];
+    if let Some(path) = &args.plot {
+        let markers: Vec<GridMarker> =
+            sets.iter().flat_map(|s| s.iter().map(|&v| GridMarker { index: v, is_max: true })).collect();
+        let (panels, title): (Vec<GridPanel>, String) = if others.is_empty() {
+            let shown = names.len().min(4);
+            (
+                (0..shown)
+                    .map(|h| GridPanel {
+                        title: format!("weight_{} ({:?})", names[h], args.settings.method).to_lowercase(),
+                        values: &w.normalised[h],
+                    })
+                    .collect(),
+                format!(
+                    "{} weights, order {}{}",
+                    format!("{:?}", args.settings.method).to_lowercase(),
+                    args.settings.order,
+                    if names.len() > 4 { format!(" (first 4 of {} handles)", names.len()) } else { String::new() }
+                ),
+            )
+        } else {
+            let mut p = vec![GridPanel {
+                title: format!("{:?}: {} spurious", args.settings.method, w.functions[0].spurious.exact).to_lowercase(),
+                values: &w.functions[0].raw,
+            }];
+            for (m, o) in &others {
+                p.push(GridPanel {
+                    title: format!("{m:?}: {} spurious", o.functions[0].spurious.exact).to_lowercase(),
+                    values: &o.functions[0].raw,
+                });
+            }
+            (p, format!("raw weight of handle `{}`, order {}, by method", names[0], args.settings.order))
+        };
+        staged.push(super::stage_plot(path, |p| {
+            plot_mesh_fields(p, mesh.positions(), mesh.faces(), &panels, &markers, &title, args.view, false)?;
+            Ok(())
+        })?);
+    }
+    if let Some(path) = &args.report {
+        let report = WeightsReport {
+            input_file: args.input.display().to_string(),
+            handles_file: args.handles.display().to_string(),
+            vertices: mesh.n_vertices(),
+            triangles: mesh.faces().len(),
+            settings: &args.settings,
+            functions: w
+                .functions
+                .iter()
+                .enumerate()
+                .map(|(h, f)| FunctionReport { name: &names[h], handle_vertices: sets[h].len(), function: f })
+                .collect(),
+            max_normalisation_change: w.max_normalisation_change,
+            raw_sum_range: w.raw_sum_range,
+            operator_seconds: w.operator_seconds,
+            function_seconds: w.function_seconds,
+            total_seconds: start.elapsed().as_secs_f64(),
+            comparison,
+        };
+        staged.push(stage_json(path, &report)?);
+    }
+    finish(args, mesh, names, sets, &w, &others, staged, start)
+}
+
+#[allow(clippy::too_many_arguments)]
+fn finish(
+    args: &WeightsArgs,
+    mesh: &TriMesh,
+    names: &[String],
+    sets: &[Vec<usize>],
+    w: &Weights,
+    others: &[(WeightMethod, Weights)],
+    staged: Vec<Staged>,
+    start: Instant,
+) -> Result<String> {
+    for s in staged {
+        s.commit()?;
+    }
+    let method = format!("{:?}", args.settings.method).to_lowercase();
+    let mut text = format!(
+        "{}: {} handles on a mesh of {}; {method} weights of order {}\n",
+        args.input.display(),
+        names.len(),
+        mesh.describe(),
+        args.settings.order
+    );
+    for (h, f) in w.functions.iter().enumerate() {
+        text += &format!(
+            "  {:<12} {:>5} handle vertices, {:>5} filled: {}; {} spurious (exact), {} (1e-9); {} iterations, {} s\n",
+            names[h],
+            sets[h].len(),
+            f.filled,
+            if f.certificate.passed {
+                "certified".to_string()
+            } else {
+                format!("NOT certified ({})", f.certificate.failure_count)
+            },
+            f.spurious.exact,
+            f.spurious.tolerance_1e9,
+            f.solver_iterations,
+            sig6(f.seconds)
+        );
+    }
+    text += &format!(
+        "normalised to a partition of unity: raw sums in [{}, {}], largest change {}\n",
+        sig6(w.raw_sum_range[0]),
+        sig6(w.raw_sum_range[1]),
+        sig6(w.max_normalisation_change)
+    );
+    for (m, o) in others {
+        let exact: Vec<String> = o.functions.iter().map(|f| f.spurious.exact.to_string()).collect();
+        let tol: Vec<String> = o.functions.iter().map(|f| f.spurious.tolerance_1e9.to_string()).collect();
+        text += &format!(
+            "compare {:<13} spurious extrema per function: exact [{}], 1e-9 [{}]; {} s per function\n",
+            format!("{m:?}").to_lowercase(),
+            exact.join(", "),
+            tol.join(", "),
+            sig6(o.functions.iter().map(|f| f.seconds).sum::<f64>() / o.functions.len() as f64)
+        );
+    }
+    text += &format!(
+        "seconds: operators {}, functions {} ({} threads), total {}\n",
+        sig6(w.operator_seconds),
+        sig6(w.function_seconds),
+        args.settings.threads,
+        sig6(start.elapsed().as_secs_f64())
+    );
+    let wrote: Vec<String> = [Some(&args.output), args.plot.as_ref(), args.report.as_ref()]
+        .into_iter()
+        .flatten()
+        .map(|p| p.display().to_string())
+        .collect();
+    text += &format!("wrote {}\n", wrote.join(", "));
+    Ok(text)
+}

@@ -1,3 +1,5 @@
-//! Applications built on the operators: geodesic distance (heat method).
+//! Applications built on the operators: geodesic distance (heat method) and skinning (posing a
+//! mesh from handle weights and transforms, linear or dual-quaternion blending).
 
 pub mod geodesic;
+pub mod skinning;

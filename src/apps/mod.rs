@@ -1,7 +1,8 @@
 //! Applications built on the operators and the pipeline: geodesic distance (heat method),
-//! handles and shape-aware weights, colour diffusion (no-data mode).
+//! handles and shape-aware weights, skinning and colour diffusion (no-data mode).
 
 pub mod diffuse;
 pub mod geodesic;
 pub mod handles;
+pub mod skinning;
 pub mod weights;

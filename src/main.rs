@@ -78,6 +78,29 @@ enum Command {
     /// Weight functions for handles on a mesh (no data): 1 on a handle, 0 on the others, no
     /// other extremum (monotone, certified), normalised to a partition of unity.
     Weights(Box<WeightsCli>),
+    /// Pose a mesh with its weights: linear blend (lbs) or dual-quaternion (dqs) skinning.
+    Deform {
+        /// The rest mesh.
+        input: PathBuf,
+        /// Weights file written by `weights` (arrays weight_<name>).
+        #[arg(long, value_name = "FILE")]
+        weights: PathBuf,
+        /// pose.json: {"transforms": {"name": [[a,b,c,tx],[d,e,f,ty],[g,h,i,tz]], ...}}.
+        #[arg(long, value_name = "JSON")]
+        transforms: PathBuf,
+        /// Posed mesh: .obj, .off, .ply, .vtu, .vtp.
+        #[arg(short, long)]
+        output: PathBuf,
+        /// Skinning method.
+        #[arg(long, value_enum, default_value_t = SkinningCli::Lbs)]
+        skinning: SkinningCli,
+        /// Rest and posed shapes side by side.
+        #[arg(long, value_name = "PNG")]
+        plot: Option<PathBuf>,
+        /// Camera of the picture: azimuth and elevation in degrees.
+        #[arg(long, value_name = "AZ,EL")]
+        view: Option<String>,
+    },
     /// Colour diffusion from coloured points over an image's shape (alpha) or a mesh, with
     /// monotone weights: no pixel leaves the per-channel box of the given colours.
     Diffuse {
@@ -258,6 +281,12 @@ fn parse_view(view: Option<&str>) -> Result<MeshView> {
             }
         }
     }
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum SkinningCli {
+    Lbs,
+    Dqs,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -508,6 +537,20 @@ fn run(cli: Cli) -> Result<String> {
             view: parse_view(c.view.as_deref())?,
             report: c.report,
         }),
+        Command::Deform { input, weights, transforms, output, skinning, plot, view } => {
+            commands::deform(&commands::DeformArgs {
+                input,
+                weights,
+                transforms,
+                output,
+                skinning: match skinning {
+                    SkinningCli::Lbs => toposmooth::apps::skinning::Skinning::Lbs,
+                    SkinningCli::Dqs => toposmooth::apps::skinning::Skinning::Dqs,
+                },
+                plot,
+                view: parse_view(view.as_deref())?,
+            })
+        }
         Command::Diffuse { input, colors, output, weights, order, method, plot, report } => {
             commands::diffuse(&commands::DiffuseArgs {
                 input,

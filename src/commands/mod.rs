@@ -2,6 +2,7 @@
 //! `main.rs` only parses arguments into these option structs and maps errors to exit codes.
 
 mod bench;
+mod deform;
 mod diffuse;
 mod extrema;
 mod geodesic;
@@ -13,6 +14,7 @@ mod verify;
 mod weights;
 
 pub use bench::{bench, BenchArgs, BenchCase};
+pub use deform::{deform, DeformArgs};
 pub use diffuse::{diffuse, DiffuseArgs};
 pub use extrema::{extrema, ExtremaArgs};
 pub use geodesic::{geodesic, GeodesicArgs};

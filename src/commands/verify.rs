@@ -214,6 +214,9 @@ fn verify_series(args: &VerifyArgs) -> Result<String> {
 
 fn verify_mesh(args: &VerifyArgs) -> Result<String> {
     let (mesh, data) = read_trimesh(&args.file)?;
+    if data.arrays.iter().any(|a| a.name.starts_with("weight_") && a.name.ends_with("_raw")) {
+        return verify_weights(args, &mesh, &data);
+    }
     let n = mesh.n_vertices();
     let take = |name: &str| -> Result<Vec<f64>> {
         let a = data.array(name).map_err(|m| {
@@ -280,5 +283,90 @@ fn verify_mesh(args: &VerifyArgs) -> Result<String> {
         cert.summary(),
         mesh.describe(),
         if args.input.is_some() { ", input array matches" } else { "" }
+    ))
+}
+
+/// A weights file (SPEC.md formats): per handle `weight_<name>_raw` certified against
+/// `role_<name>` (prescribed vertices: roles −1, 1, 2; a region at the largest prescribed value
+/// is a maximum, at the smallest a minimum, others exempt), `u_<name>` likewise, and the
+/// normalised `weight_<name>` summing to 1.
+fn verify_weights(args: &VerifyArgs, mesh: &crate::domain::TriMesh, data: &crate::io::mesh::MeshData) -> Result<String> {
+    use crate::verify::{certify_no_data, RegionKind};
+    let n = mesh.n_vertices();
+    let bad = |m: String| Error::input(m).in_file(&args.file);
+    let take = |name: &str| -> Result<Vec<f64>> {
+        let a = data.array(name).map_err(|m| bad(format!("{m} (a weights file holds weight_<name>, weight_<name>_raw, u_<name>, role_<name>)")))?;
+        if a.components != 1 || a.values.len() != n {
+            return Err(bad(format!("array `{name}` is not one scalar per vertex")));
+        }
+        Ok(a.values)
+    };
+    let names: Vec<String> = data
+        .arrays
+        .iter()
+        .filter_map(|a| a.name.strip_prefix("weight_").and_then(|r| r.strip_suffix("_raw")).map(str::to_string))
+        .collect();
+    let mut problems = Vec::new();
+    let mut sums = vec![0.0; n];
+    let mut lines = Vec::new();
+    for name in &names {
+        let raw = take(&format!("weight_{name}_raw"))?;
+        let u = take(&format!("u_{name}"))?;
+        let role = take(&format!("role_{name}"))?;
+        let normalised = take(&format!("weight_{name}"))?;
+        for (s, w) in sums.iter_mut().zip(&normalised) {
+            *s += w;
+        }
+        let mut prescribed = vec![None; n];
+        for v in 0..n {
+            match Role::from_code(role[v]) {
+                Some(Role::Min | Role::Max | Role::Fixed) => prescribed[v] = Some(raw[v]),
+                Some(Role::Other) => {}
+                _ => return Err(bad(format!("role_{name}: {} at vertex {v} is not one of −1, 0, 1, 2", role[v]))),
+            }
+        }
+        let vals: Vec<f64> = prescribed.iter().flatten().copied().collect();
+        if vals.is_empty() {
+            problems.push(format!("{name}: no prescribed vertex"));
+            continue;
+        }
+        let (lo, hi) = vals.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &x| (a.min(x), b.max(x)));
+        for v in 0..n {
+            let r = role[v];
+            if (r == 1.0 && raw[v] != hi) || (r == -1.0 && raw[v] != lo) {
+                problems.push(format!("{name}: vertex {v} has role {r} but value {}", raw[v]));
+                break;
+            }
+        }
+        let kind = |x: f64| {
+            if x == hi {
+                RegionKind::Max
+            } else if x == lo {
+                RegionKind::Min
+            } else {
+                RegionKind::Exempt
+            }
+        };
+        let c = certify_no_data(mesh, &raw, &prescribed, kind);
+        if !c.passed {
+            problems.push(format!("weight_{name}_raw: {}", c.summary()));
+        }
+        let cu = certify_no_data(mesh, &u, &prescribed, kind);
+        if !cu.passed {
+            problems.push(format!("u_{name}: {}", cu.summary()));
+        }
+        lines.push(format!("{name}: {} minimum and {} maximum regions", c.strict_minima, c.strict_maxima));
+    }
+    if let Some(v) = (0..n).find(|&v| (sums[v] - 1.0).abs() > 1e-9) {
+        problems.push(format!("the normalised weights sum to {} at vertex {v}, not 1", sums[v]));
+    }
+    if !problems.is_empty() {
+        return Err(Error::Uncertified { path: Some(args.file.clone()), message: problems.join("; ") });
+    }
+    Ok(format!(
+        "{}: certified: {} weight functions, every free vertex regular, every handle region a strict extremum at its prescribed value; normalised weights sum to 1 ({})\n",
+        args.file.display(),
+        names.len(),
+        lines.join("; ")
     ))
 }

@@ -5,6 +5,7 @@ mod bench;
 mod extrema;
 mod geodesic;
 pub mod input;
+mod mesh_outline;
 mod smooth;
 mod smooth_grid;
 mod smooth_mesh;
@@ -13,6 +14,7 @@ mod verify;
 pub use bench::{bench, BenchArgs, BenchCase};
 pub use extrema::{extrema, ExtremaArgs};
 pub use geodesic::{geodesic, GeodesicArgs};
+pub use mesh_outline::{mesh_outline, MeshOutlineArgs};
 pub use smooth::{smooth, SmoothArgs};
 pub use verify::{verify, VerifyArgs};
 

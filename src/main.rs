@@ -129,6 +129,27 @@ enum Command {
         #[arg(long, value_name = "JSON")]
         report: Option<PathBuf>,
     },
+    /// Triangulate the inside of a 2D outline (constrained Delaunay refinement): a polygon with
+    /// holes from JSON, the shapes of an SVG, or the largest region of a PNG mask.
+    Mesh {
+        /// Outline: .json (`{"outline": [[x, y], ...], "holes": [[[x, y], ...], ...]}`), .svg
+        /// (polygon, polyline, path, rect, circle, ellipse: the first is the outer boundary, later
+        /// ones holes; y negated) or .png (inside: alpha ≥ 50 %, or dark pixels without alpha;
+        /// pixel-corner coordinates, y up).
+        input: PathBuf,
+        /// Output mesh: .obj, .off, .ply, .vtu or .vtp (z = 0).
+        #[arg(short, long)]
+        output: PathBuf,
+        /// Largest triangle area [default: the outline's bounding-box area / 2000].
+        #[arg(long, value_name = "A")]
+        max_area: Option<f64>,
+        /// Smallest angle in degrees (0 to 34; sharper corners of the outline itself stay).
+        #[arg(long, value_name = "DEG", default_value_t = 25.0, allow_hyphen_values = true)]
+        min_angle: f64,
+        /// Picture of the triangulation (PNG).
+        #[arg(long, value_name = "PNG")]
+        plot: Option<PathBuf>,
+    },
     /// Benchmark on random-walk series, noisy grids and meshes: seconds per stage and peak memory.
     Bench {
         /// Series lengths `N`, grid sizes `NXxNY` (grids keep 7 minima and 6 maxima) and mesh files
@@ -565,6 +586,9 @@ fn run(cli: Cli) -> Result<String> {
                 plot,
                 report,
             })
+        }
+        Command::Mesh { input, output, max_area, min_angle, plot } => {
+            commands::mesh_outline(&commands::MeshOutlineArgs { input, output, max_area, min_angle, plot })
         }
         Command::Verify { file, input, csv, grid } => {
             commands::verify(&VerifyArgs { file, input, csv: csv.options(), grid: grid.options()? })

@@ -1,8 +1,10 @@
 //! Applications built on the operators and the pipeline: geodesic distance (heat method),
-//! handles and shape-aware weights, skinning and colour diffusion (no-data mode).
+//! handles and shape-aware weights, skinning and colour diffusion (no-data mode), and the
+//! triangulation of 2D outlines.
 
 pub mod diffuse;
 pub mod geodesic;
 pub mod handles;
+pub mod outline;
 pub mod skinning;
 pub mod weights;

@@ -8,7 +8,6 @@ use crate::domain::TriMesh;
 use crate::error::{Error, Result};
 use crate::io::Staged;
 use crate::plot::{plot_mesh_fields, GridPanel, MeshView};
-use std::io::Write;
 use std::path::PathBuf;
 
 /// Options of `deform`.
@@ -160,20 +159,7 @@ pub fn deform(args: &DeformArgs) -> Result<String> {
 
 /// Stages a mesh without arrays in the format its extension names.
 fn stage_geometry(path: &std::path::Path, positions: &[[f64; 3]], triangles: &[[usize; 3]]) -> Result<Staged> {
-    use crate::io::mesh::stage_ply;
-    // TEMP until the outline branch lands its writers
-    let stage_obj = |path: &std::path::Path, p: &[[f64; 3]], t: &[[usize; 3]]| {
-        crate::io::stage(path, |w| {
-            for q in p {
-                writeln!(w, "v {} {} {}", q[0], q[1], q[2])?;
-            }
-            for f in t {
-                writeln!(w, "f {} {} {}", f[0] + 1, f[1] + 1, f[2] + 1)?;
-            }
-            Ok(())
-        })
-    };
-    let stage_off = stage_obj;
+    use crate::io::mesh::{stage_obj, stage_off, stage_ply};
     use crate::io::vtk::{stage_vtp, stage_vtu, PolyData};
     let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
     match ext.as_str() {

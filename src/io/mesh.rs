@@ -1,13 +1,13 @@
 //! Triangle meshes: OBJ, OFF, PLY ascii and binary (ply-rs-bw), VTK XML `.vtu`/`.vtp`
 //! and legacy `.vtk` unstructured grids and polydata (vtkio); written as `.vtu`, `.vtp` (see
-//! [`super::vtk`]) and binary PLY with Float64 vertex properties.
+//! [`super::vtk`]), binary PLY with Float64 vertex properties, and (geometry only) OBJ and OFF.
 //!
 //! Polygons with more than three corners are split into fans (reported). Per-vertex data comes
 //! back as [`PointArray`]s: PLY vertex properties other than x, y, z; VTK point data. The
 //! topology is validated by [`crate::domain::TriMesh::new`], not here.
 
 use super::vtk::PointArray;
-use super::{stage, Staged};
+use super::{format_f64, stage, Staged};
 use crate::error::{Error, Result};
 use std::io::Write;
 use std::path::Path;
@@ -540,6 +540,51 @@ fn strip(cell: &[usize], out: &mut Vec<[usize; 3]>) {
     }
 }
 
+fn check_indices(path: &Path, n: usize, triangles: &[[usize; 3]]) -> Result<()> {
+    match triangles.iter().position(|t| t.iter().any(|&v| v >= n)) {
+        Some(t) => Err(input(path, format!("triangle {t} refers to a vertex beyond the {n} vertices"))),
+        None => Ok(()),
+    }
+}
+
+/// Stages a Wavefront OBJ file: one `v x y z` line per vertex, in the shortest decimal text
+/// that reads back to the same doubles, and one `f a b c` line per triangle (1-based).
+///
+/// # Errors
+/// An input error naming the file for a vertex index out of range; I/O errors.
+pub fn stage_obj(path: &Path, positions: &[[f64; 3]], triangles: &[[usize; 3]]) -> Result<Staged> {
+    check_indices(path, positions.len(), triangles)?;
+    stage(path, |w: &mut dyn Write| {
+        writeln!(w, "# written by toposmooth: {} vertices, {} triangles", positions.len(), triangles.len())?;
+        for p in positions {
+            writeln!(w, "v {} {} {}", format_f64(p[0]), format_f64(p[1]), format_f64(p[2]))?;
+        }
+        for t in triangles {
+            writeln!(w, "f {} {} {}", t[0] + 1, t[1] + 1, t[2] + 1)?;
+        }
+        Ok(())
+    })
+}
+
+/// Stages an OFF file (ascii): counts, vertices in shortest round-trip decimals, triangles
+/// as `3 a b c` (0-based).
+///
+/// # Errors
+/// An input error naming the file for a vertex index out of range; I/O errors.
+pub fn stage_off(path: &Path, positions: &[[f64; 3]], triangles: &[[usize; 3]]) -> Result<Staged> {
+    check_indices(path, positions.len(), triangles)?;
+    stage(path, |w: &mut dyn Write| {
+        writeln!(w, "OFF\n{} {} 0", positions.len(), triangles.len())?;
+        for p in positions {
+            writeln!(w, "{} {} {}", format_f64(p[0]), format_f64(p[1]), format_f64(p[2]))?;
+        }
+        for t in triangles {
+            writeln!(w, "3 {} {} {}", t[0], t[1], t[2])?;
+        }
+        Ok(())
+    })
+}
+
 /// Stages a binary little-endian PLY file: vertices with `x`, `y`, `z` and one `double`
 /// property per array, faces as `uchar`/`int` lists. Values round-trip bit for bit.
 ///
@@ -662,6 +707,27 @@ mod tests {
         assert_eq!(m.triangles, vec![[0, 1, 2]]);
         let got = m.array("smoothed").unwrap().values;
         assert!(got.iter().zip(&vals).all(|(a, b)| a.to_bits() == b.to_bits()));
+    }
+
+    #[test]
+    fn written_obj_and_off_read_back_bit_for_bit() {
+        let d = std::env::temp_dir().join(format!("toposmooth-mesh-io-{}", std::process::id()));
+        std::fs::create_dir_all(&d).unwrap();
+        let pos = [[0.1, 1.0 / 3.0, 0.0], [1e-300, -2.5e17, 0.0], [-0.0, 1.0, 7.0]];
+        for name in ["out.obj", "out.off"] {
+            let path = d.join(name);
+            let staged = if name.ends_with("obj") {
+                stage_obj(&path, &pos, &[[0, 1, 2]])
+            } else {
+                stage_off(&path, &pos, &[[0, 1, 2]])
+            };
+            assert!(!path.exists(), "staged, not yet committed");
+            staged.unwrap().commit().unwrap();
+            let m = read_mesh(&path).unwrap();
+            assert_eq!(m.triangles, vec![[0, 1, 2]]);
+            assert!(m.positions.iter().flatten().zip(pos.iter().flatten()).all(|(a, b)| a.to_bits() == b.to_bits()));
+        }
+        assert!(stage_obj(&d.join("bad.obj"), &pos, &[[0, 1, 3]]).is_err());
     }
 
     #[test]

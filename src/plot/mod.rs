@@ -1,4 +1,5 @@
-//! PNG plots: smoothed series, persistence diagrams and grid heat maps ([`grid`]).
+//! PNG plots: smoothed series, persistence diagrams, grid heat maps ([`grid`]), fields on
+//! meshes and plane triangulations.
 //!
 //! Drawing uses plotters' bitmap backend into an in-memory RGB buffer, written as PNG by the
 //! `image` crate.
@@ -15,8 +16,10 @@ use std::sync::OnceLock;
 
 mod grid;
 mod mesh;
+mod triangulation;
 pub use grid::{plot_grid_fields, GridMarker, GridPanel, GridPlotOptions};
 pub use mesh::{plot_mesh_fields, MeshView};
+pub use triangulation::plot_triangulation;
 
 /// Error of a plot: carries a message.
 #[derive(Debug, thiserror::Error)]

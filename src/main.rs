@@ -362,6 +362,12 @@ struct WeightsCli {
     /// JSON report: per function certificate, spurious extrema, iterations, seconds.
     #[arg(long, value_name = "JSON")]
     report: Option<PathBuf>,
+    /// Cages: the certified functions on the cage's triangulation [default: <output>_cage.vtu].
+    #[arg(long, value_name = "FILE")]
+    cage_output: Option<PathBuf>,
+    /// Cages: largest triangle area of the cage's triangulation [default: the shape's mean].
+    #[arg(long, value_name = "A")]
+    cage_max_area: Option<f64>,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -557,6 +563,8 @@ fn run(cli: Cli) -> Result<String> {
             plot: c.plot,
             view: parse_view(c.view.as_deref())?,
             report: c.report,
+            cage_output: c.cage_output,
+            cage_max_area: c.cage_max_area,
         }),
         Command::Deform { input, weights, transforms, output, skinning, plot, view } => {
             commands::deform(&commands::DeformArgs {

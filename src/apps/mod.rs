@@ -2,6 +2,7 @@
 //! handles and shape-aware weights, skinning and colour diffusion (no-data mode), and the
 //! triangulation of 2D outlines.
 
+pub mod cage;
 pub mod diffuse;
 pub mod geodesic;
 pub mod handles;

@@ -132,16 +132,23 @@ pub struct Weights {
 }
 
 /// The fixed values of handle `which`'s function: 1 on its vertices, 0 on the other handles,
-/// then the fill rule (a connected part of free vertices whose fixed neighbours all carry one
-/// value takes that value). Returns the values and the number of filled vertices.
+/// then the fill rule ([`fill_rule`]). Returns the values and the number of filled vertices.
 pub fn prescribed_values<D: Smoothable>(domain: &D, handles: &[Vec<usize>], which: usize) -> (Vec<Option<f64>>, usize) {
-    let n = domain.n_vertices();
-    let mut fixed = vec![None; n];
+    let mut fixed = vec![None; domain.n_vertices()];
     for (k, set) in handles.iter().enumerate() {
         for &v in set {
             fixed[v] = Some(if k == which { 1.0 } else { 0.0 });
         }
     }
+    let filled = fill_rule(domain, &mut fixed);
+    (fixed, filled)
+}
+
+/// SPEC's fill rule: a connected part of free vertices whose fixed neighbours all carry one
+/// value takes that value (no strict function could fill it otherwise). Returns the number of
+/// vertices filled.
+pub fn fill_rule<D: Smoothable>(domain: &D, fixed: &mut [Option<f64>]) -> usize {
+    let n = domain.n_vertices();
     let mut seen = vec![false; n];
     let mut filled = 0;
     for s in 0..n {
@@ -177,7 +184,7 @@ pub fn prescribed_values<D: Smoothable>(domain: &D, handles: &[Vec<usize>], whic
             filled += part.len();
         }
     }
-    (fixed, filled)
+    filled
 }
 
 /// Operators shared by all functions of a run.
@@ -187,24 +194,28 @@ struct Operators {
     stiffness: Sparse,
 }
 
-fn region_kind(v: f64) -> RegionKind {
+/// Regions at 1 are maxima, at 0 minima; other prescribed values (a cage boundary) are exempt.
+pub fn region_kind(v: f64) -> RegionKind {
     if v == 1.0 {
         RegionKind::Max
-    } else {
+    } else if v == 0.0 {
         RegionKind::Min
+    } else {
+        RegionKind::Exempt
     }
 }
 
 /// One function by the monotone method, or the unconstrained / harmonic solve.
 fn one_function<D: Smoothable>(
     domain: &D,
-    handles: &[Vec<usize>],
+    prescribed: &[Option<f64>],
     which: usize,
     ops: &Operators,
     settings: &WeightSettings,
 ) -> Result<WeightFunction> {
     let t = Instant::now();
-    let (fixed, filled) = prescribed_values(domain, handles, which);
+    let mut fixed = prescribed.to_vec();
+    let filled = fill_rule(domain, &mut fixed);
     let (u, refinements) = ordered_harmonic(domain, &ops.fill, &fixed).map_err(|e| Error::Representative {
         path: None,
         message: format!("handle {which}: harmonic representative: {e}"),
@@ -304,6 +315,32 @@ pub fn weights<D: Smoothable + Sync>(domain: &D, handles: &[Vec<usize>], setting
             owner[v] = k;
         }
     }
+    let prescribed: Vec<Vec<Option<f64>>> = (0..handles.len())
+        .map(|which| {
+            let mut fixed = vec![None; n];
+            for (k, set) in handles.iter().enumerate() {
+                for &v in set {
+                    fixed[v] = Some(if k == which { 1.0 } else { 0.0 });
+                }
+            }
+            fixed
+        })
+        .collect();
+    weights_prescribed(domain, &prescribed, settings)
+}
+
+/// Weight functions with given fixed values (`prescribed[h][v]`; the fill rule is applied to
+/// each): regions at 1 must be maxima, at 0 minima, other fixed values are exempt (a cage's
+/// boundary). Functions run in parallel on `settings.threads` workers.
+///
+/// # Errors
+/// As [`weights`].
+pub fn weights_prescribed<D: Smoothable + Sync>(
+    domain: &D,
+    prescribed: &[Vec<Option<f64>>],
+    settings: &WeightSettings,
+) -> Result<Weights> {
+    let n = domain.n_vertices();
     let t = Instant::now();
     let k = domain.stiffness();
     let m = domain.mass();
@@ -312,12 +349,13 @@ pub fn weights<D: Smoothable + Sync>(domain: &D, handles: &[Vec<usize>], setting
     let operator_seconds = t.elapsed().as_secs_f64();
 
     let t = Instant::now();
+    let count = prescribed.len();
     let functions: Vec<WeightFunction> = if settings.method == WeightMethod::Bounded {
-        bounded(domain, handles, &ops, settings)?
+        bounded(domain, prescribed, &ops, settings)?
     } else {
         let next = AtomicUsize::new(0);
-        let threads = settings.threads.clamp(1, handles.len());
-        let mut results: Vec<Option<Result<WeightFunction>>> = (0..handles.len()).map(|_| None).collect();
+        let threads = settings.threads.clamp(1, count);
+        let mut results: Vec<Option<Result<WeightFunction>>> = (0..count).map(|_| None).collect();
         std::thread::scope(|s| {
             let workers: Vec<_> = (0..threads)
                 .map(|_| {
@@ -325,10 +363,10 @@ pub fn weights<D: Smoothable + Sync>(domain: &D, handles: &[Vec<usize>], setting
                         let mut mine = Vec::new();
                         loop {
                             let h = next.fetch_add(1, Ordering::Relaxed);
-                            if h >= handles.len() {
+                            if h >= count {
                                 break;
                             }
-                            mine.push((h, one_function(domain, handles, h, &ops, settings)));
+                            mine.push((h, one_function(domain, &prescribed[h], h, &ops, settings)));
                         }
                         mine
                     })
@@ -352,7 +390,7 @@ pub fn weights<D: Smoothable + Sync>(domain: &D, handles: &[Vec<usize>], setting
         }
     }
 
-    let mut normalised: Vec<Vec<f64>> = vec![vec![0.0; n]; handles.len()];
+    let mut normalised: Vec<Vec<f64>> = vec![vec![0.0; n]; count];
     let mut change = 0.0f64;
     let mut range = [f64::INFINITY, f64::NEG_INFINITY];
     for v in 0..n {
@@ -377,14 +415,15 @@ pub fn weights<D: Smoothable + Sync>(domain: &D, handles: &[Vec<usize>], setting
 /// The bounded biharmonic weights, all functions in one problem.
 fn bounded<D: Smoothable>(
     domain: &D,
-    handles: &[Vec<usize>],
+    given: &[Vec<Option<f64>>],
     ops: &Operators,
     settings: &WeightSettings,
 ) -> Result<Vec<WeightFunction>> {
     let t = Instant::now();
-    let mut functions = Vec::with_capacity(handles.len());
-    for which in 0..handles.len() {
-        let (prescribed, filled) = prescribed_values(domain, handles, which);
+    let mut functions = Vec::with_capacity(given.len());
+    for (which, g) in given.iter().enumerate() {
+        let mut prescribed = g.clone();
+        let filled = fill_rule(domain, &mut prescribed);
         let u = dirichlet_solve(&ops.fill, &prescribed)
             .map_err(|e| Error::input(format!("handle {which}: representative function: {e}")))?;
         functions.push(WeightFunction {
@@ -406,7 +445,7 @@ fn bounded<D: Smoothable>(
     }
     let fixed: Vec<Vec<Option<f64>>> = functions.iter().map(|f| f.prescribed.clone()).collect();
     let (w, status, it) = solve_bounded_partition(&ops.energy, &fixed, &settings.qp)?;
-    let each = t.elapsed().as_secs_f64() / handles.len() as f64;
+    let each = t.elapsed().as_secs_f64() / given.len() as f64;
     for (f, raw) in functions.iter_mut().zip(w) {
         f.raw = raw;
         f.solver_status = Some(status);

@@ -48,7 +48,7 @@ fn read_weights(args: &DeformArgs, mesh: &TriMesh) -> Result<Vec<(String, Vec<f6
         .iter()
         .filter_map(|a| {
             let name = a.name.strip_prefix("weight_")?;
-            (!name.ends_with("_raw") && a.components == 1).then(|| (name.to_string(), a.values.clone()))
+            (!name.ends_with("_raw") && !name.ends_with("_interpolated") && a.components == 1).then(|| (name.to_string(), a.values.clone()))
         })
         .collect();
     if out.len() < 2 {

@@ -32,6 +32,10 @@ pub struct WeightsArgs {
     pub view: MeshView,
     /// Report JSON.
     pub report: Option<PathBuf>,
+    /// Cages: where the certified functions on the cage's triangulation go.
+    pub cage_output: Option<PathBuf>,
+    /// Cages: largest triangle area of the cage's triangulation (default: the shape's mean).
+    pub cage_max_area: Option<f64>,
 }
 
 #[derive(serde::Serialize)]
@@ -124,15 +128,74 @@ pub fn weights(args: &WeightsArgs) -> Result<String> {
     let text =
         std::fs::read_to_string(&args.handles).map_err(|source| Error::Io { path: args.handles.clone(), source })?;
     let file = parse_handles(&text).map_err(|e| e.in_file(&args.handles))?;
-    let HandleFile::Handles(list) = file else {
-        return Err(Error::Usage(format!(
-            "{}: a cage is solved on the cage's own triangulation: use `toposmooth weights SHAPE --handles cage.json` with a planar shape (cages: see docs/weights.md)",
-            args.handles.display()
-        )));
+    let list = match file {
+        HandleFile::Handles(list) => list,
+        HandleFile::Cage(cage) => return run_cage(args, &mesh, &cage, start),
     };
     let sets = resolve(&mesh, &list).map_err(|e| e.in_file(&args.handles))?;
     let names: Vec<String> = list.iter().map(|h| h.name.clone()).collect();
     run_weights(args, &mesh, &names, &sets, start)
+}
+
+/// Cage weights: certified on the cage's triangulation (written to `--cage-output`, default
+/// `<output>_cage.vtu`, verifiable), interpolated onto the shape (`weight_<j>` normalised,
+/// `weight_<j>_interpolated` raw; reported, not certified).
+fn run_cage(args: &WeightsArgs, shape: &TriMesh, cage: &[[f64; 2]], start: Instant) -> Result<String> {
+    if args.compare {
+        return Err(Error::Usage("--compare is for handles; a cage's weights are compared on its own triangulation".into()));
+    }
+    let c = crate::apps::cage::cage_weights(shape, cage, args.cage_max_area, &args.settings)
+        .map_err(|e| e.in_file(&args.handles))?;
+    let names: Vec<String> = (0..cage.len()).map(|j| j.to_string()).collect();
+    let cage_path = args.cage_output.clone().unwrap_or_else(|| {
+        let stem = args.output.file_stem().unwrap_or_default().to_string_lossy().to_string();
+        args.output.with_file_name(format!("{stem}_cage.vtu"))
+    });
+    let cage_mesh = &c.cage_mesh;
+    let m = cage.len();
+    let sets: Vec<Vec<usize>> = (0..m).map(|j| vec![j]).collect();
+    let mut staged = vec![stage_weights(&cage_path, cage_mesh, &names, &sets, &c.weights)?];
+    let mut owned: Vec<(String, Vec<f64>)> = Vec::new();
+    for j in 0..m {
+        owned.push((format!("weight_{j}"), c.normalised_on_shape[j].clone()));
+        owned.push((format!("weight_{j}_interpolated"), c.raw_on_shape[j].clone()));
+    }
+    let arrays: Vec<(&str, &[f64])> = owned.iter().map(|(n, v)| (n.as_str(), v.as_slice())).collect();
+    staged.push(super::smooth_mesh::stage_mesh_output(&args.output, shape, &arrays)?);
+    if let Some(path) = &args.plot {
+        let shown = m.min(4);
+        let panels: Vec<GridPanel> = (0..shown)
+            .map(|j| GridPanel { title: format!("weight_{j} (cage vertex {j})"), values: &c.normalised_on_shape[j] })
+            .collect();
+        let title = format!("cage weights on {}, order {}", args.input.display(), args.settings.order);
+        staged.push(super::stage_plot(path, |p| {
+            plot_mesh_fields(p, shape.positions(), shape.faces(), &panels, &[], &title, MeshView { azimuth: 0.0, elevation: 90.0 }, false)?;
+            Ok(())
+        })?);
+    }
+    for s in staged {
+        s.commit()?;
+    }
+    let w = &c.weights;
+    let certified = w.functions.iter().filter(|f| f.certificate.passed).count();
+    let spurious: usize = w.functions.iter().map(|f| f.spurious.exact).sum();
+    let mut text = format!(
+        "{}: cage of {m} vertices around a shape of {}; cage interior triangulated: {}\n",
+        args.handles.display(),
+        shape.describe(),
+        cage_mesh.describe()
+    );
+    text += &format!(
+        "{certified} of {m} {} functions of order {} certified on the cage triangulation, {spurious} spurious extrema; largest normalisation change {}; linear reproduction error on the shape {}\n",
+        format!("{:?}", args.settings.method).to_lowercase(),
+        args.settings.order,
+        sig6(w.max_normalisation_change),
+        sig6(c.reproduction_error)
+    );
+    text += &format!("seconds: {}\n", sig6(start.elapsed().as_secs_f64()));
+    let wrote: Vec<String> = [Some(&args.output), Some(&cage_path), args.plot.as_ref()].into_iter().flatten().map(|p| p.display().to_string()).collect();
+    text += &format!("wrote {}\n", wrote.join(", "));
+    Ok(text)
 }
 
 /// The weights of resolved handles on a mesh, written as `args` asks.

@@ -1,0 +1,246 @@
+//! The no-data mode from the command line: `weights` (four methods, the certificate, the
+//! spurious-extremum counts, partition of unity, cages), `deform`, `diffuse`, and every error
+//! path the issue names.
+
+mod common;
+
+use common::{mesh_extrema, scratch};
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+use toposmooth::io::mesh::read_mesh;
+
+fn toposmooth(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_toposmooth")).args(args).output().expect("runs")
+}
+
+fn dataset(name: &str) -> String {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("datasets").join(name).display().to_string()
+}
+
+fn text(o: &Output) -> String {
+    format!("{}{}", String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr))
+}
+
+fn write(dir: &Path, name: &str, content: &str) -> String {
+    let p = dir.join(name);
+    std::fs::write(&p, content).unwrap();
+    p.display().to_string()
+}
+
+/// A 2D bar [0, 10] × [0, 1] triangulated with `nx × ny` quads, as OBJ.
+fn bar_obj(dir: &Path, nx: usize, ny: usize) -> String {
+    let mut s = String::new();
+    for j in 0..=ny {
+        for i in 0..=nx {
+            s += &format!("v {} {} 0\n", 10.0 * i as f64 / nx as f64, j as f64 / ny as f64);
+        }
+    }
+    let id = |i: usize, j: usize| j * (nx + 1) + i + 1;
+    for j in 0..ny {
+        for i in 0..nx {
+            s += &format!("f {} {} {}\nf {} {} {}\n", id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j), id(i + 1, j + 1), id(i, j + 1));
+        }
+    }
+    write(dir, "bar.obj", &s)
+}
+
+fn out(dir: &Path, name: &str) -> String {
+    dir.join(name).display().to_string()
+}
+
+#[test]
+fn four_methods_on_a_bar_with_two_point_handles() {
+    let dir = scratch("nodata_bar");
+    let bar = bar_obj(&dir, 60, 6);
+    let handles = write(&dir, "h.json", r#"{"handles": [{"name": "a", "point": [2.5, 0.5]}, {"name": "b", "point": [7.5, 0.5]}]}"#);
+    let w = out(&dir, "w.vtu");
+    let report = out(&dir, "r.json");
+    let o = toposmooth(&["weights", &bar, "--handles", &handles, "-o", &w, "--compare", "--report", &report, "--plot", &out(&dir, "w.png")]);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+    let r: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    let cmp = r["comparison"].as_array().unwrap();
+    let get = |m: &str| cmp.iter().find(|c| c["method"] == m).unwrap_or_else(|| panic!("{m} missing"));
+    assert_eq!(get("monotone")["spurious_exact"], serde_json::json!([0, 0]));
+    assert_eq!(get("monotone")["certified"], serde_json::json!([true, true]));
+    // the biharmonic functions overshoot beyond the handles: one spurious extremum at least
+    let unconstrained: Vec<u64> =
+        get("unconstrained")["spurious_exact"].as_array().unwrap().iter().map(|x| x.as_u64().unwrap()).collect();
+    assert!(unconstrained.iter().all(|&c| c >= 1), "{unconstrained:?}");
+    assert!(get("unconstrained")["below_zero"].as_u64().unwrap() > 0);
+    assert_eq!(get("bounded")["below_zero"], 0);
+    for m in ["bounded", "harmonic"] {
+        assert!(get(m)["spurious_tolerance_1e9"].is_array());
+    }
+    // the file: certified by verify, extrema counted independently, partition of unity
+    let o = toposmooth(&["verify", &w]);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+    let d = read_mesh(Path::new(&w)).unwrap();
+    for name in ["a", "b"] {
+        let raw = d.array(&format!("weight_{name}_raw")).unwrap().values;
+        let (minima, maxima, flat) = mesh_extrema(d.positions.len(), &d.triangles, &raw);
+        assert_eq!((minima.len(), maxima.len(), flat.len()), (1, 1, 0), "{name}");
+        assert_eq!(raw[maxima[0]], 1.0);
+    }
+    let (a, b) = (d.array("weight_a").unwrap().values, d.array("weight_b").unwrap().values);
+    assert!(a.iter().zip(&b).all(|(x, y)| (x + y - 1.0).abs() < 1e-12));
+    // tampering is caught
+    let mut tampered = d.clone();
+    let k = tampered.arrays.iter().position(|x| x.name == "weight_a_raw").unwrap();
+    tampered.arrays[k].values[100] = 2.0;
+    let bad = out(&dir, "tampered.vtu");
+    let arrays: Vec<(&str, &[f64])> = tampered.arrays.iter().map(|x| (x.name.as_str(), x.values.as_slice())).collect();
+    toposmooth::io::vtk::stage_vtu(Path::new(&bad), &tampered.positions, &tampered.triangles, &arrays).unwrap().commit().unwrap();
+    let o = toposmooth(&["verify", &bad]);
+    assert_eq!(o.status.code(), Some(1), "{}", text(&o));
+}
+
+#[test]
+fn penguin_weights_pose_and_identity_pose() {
+    let dir = scratch("nodata_penguin");
+    let penguin = dataset("penguin.obj");
+    let handles = dataset("penguin_handles.json");
+    let w = out(&dir, "w.vtu");
+    let o = toposmooth(&["weights", &penguin, "--handles", &handles, "-o", &w, "--order", "3"]);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+    assert!(text(&o).matches("certified;").count() >= 4, "{}", text(&o));
+    // identity transforms reproduce the rest pose, both skinning methods
+    let identity = write(&dir, "id.json", r#"{"transforms": {"head": [[1,0,0,0],[0,1,0,0],[0,0,1,0]]}}"#);
+    let rest = read_mesh(Path::new(&penguin)).unwrap();
+    for s in ["lbs", "dqs"] {
+        let posed = out(&dir, &format!("id_{s}.obj"));
+        let o = toposmooth(&["deform", &penguin, "--weights", &w, "--transforms", &identity, "-o", &posed, "--skinning", s]);
+        assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+        let p = read_mesh(Path::new(&posed)).unwrap();
+        assert_eq!(p.triangles, rest.triangles);
+        let err = p.positions.iter().zip(&rest.positions).flat_map(|(a, b)| (0..3).map(move |k| (a[k] - b[k]).abs())).fold(0.0, f64::max);
+        assert!(err < 1e-12, "{s}: {err}");
+    }
+    // the bundled pose moves the flippers and not the feet
+    let posed = out(&dir, "posed.obj");
+    let o = toposmooth(&["deform", &penguin, "--weights", &w, "--transforms", &dataset("penguin_pose.json"), "-o", &posed, "--skinning", "dqs", "--plot", &out(&dir, "posed.png")]);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+    let p = read_mesh(Path::new(&posed)).unwrap();
+    let moved = |v: usize| (0..3).map(|k| (p.positions[v][k] - rest.positions[v][k]).powi(2)).sum::<f64>().sqrt();
+    assert!(moved(927) > 0.3, "left flipper tip moved {}", moved(927));
+    assert!(moved(1126) < 0.05, "foot moved {}", moved(1126));
+}
+
+#[test]
+fn diffusion_stays_in_the_colour_box_and_the_biharmonic_one_does_not() {
+    let dir = scratch("nodata_diffuse");
+    let colors = dataset("horse_colors.json");
+    let png = out(&dir, "horse.png");
+    let o = toposmooth(&["diffuse", &dataset("horse_mask.png"), "--colors", &colors, "-o", &png, "--plot", &out(&dir, "plot.png")]);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+    let c: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&colors).unwrap()).unwrap();
+    let rgbs: Vec<[u8; 3]> = c["points"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|p| {
+            let v: Vec<u8> = p["rgb"].as_array().unwrap().iter().map(|x| x.as_u64().unwrap() as u8).collect();
+            [v[0], v[1], v[2]]
+        })
+        .collect();
+    let outside = |path: &str| -> (usize, usize) {
+        let img = image::open(path).unwrap().to_rgba8();
+        let mut opaque = 0;
+        let mut out = 0;
+        for p in img.pixels() {
+            if p.0[3] == 0 {
+                continue;
+            }
+            opaque += 1;
+            if (0..3).any(|ch| p.0[ch] < rgbs.iter().map(|c| c[ch]).min().unwrap() || p.0[ch] > rgbs.iter().map(|c| c[ch]).max().unwrap()) {
+                out += 1;
+            }
+        }
+        (opaque, out)
+    };
+    let (opaque, out_box) = outside(&png);
+    assert!(opaque > 10_000);
+    assert_eq!(out_box, 0);
+    // the colours are where they were put
+    let img = image::open(&png).unwrap().to_rgba8();
+    let p0 = &c["points"][0]["pixel"];
+    let px = img.get_pixel(p0[0].as_u64().unwrap() as u32, p0[1].as_u64().unwrap() as u32);
+    assert_eq!([px.0[0], px.0[1], px.0[2]], rgbs[0]);
+    // the weights file is verifiable
+    let o = toposmooth(&["verify", &out(&dir, "horse_weights.vtu")]);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+    let bih = out(&dir, "bih.png");
+    let o = toposmooth(&["diffuse", &dataset("horse_mask.png"), "--colors", &colors, "-o", &bih, "--method", "unconstrained"]);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+    let (_, out_bih) = outside(&bih);
+    assert!(out_bih > 100, "{out_bih}");
+    assert!(text(&o).contains(&format!("{out_bih} of")), "{}", text(&o));
+}
+
+#[test]
+fn cage_weights_on_the_horse() {
+    let dir = scratch("nodata_cage");
+    let horse = dataset("horse_silhouette_2d.obj");
+    let w = out(&dir, "w.vtu");
+    let o = toposmooth(&["weights", &horse, "--handles", &dataset("horse_cage.json"), "-o", &w, "--order", "1"]);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+    assert!(text(&o).contains("7 of 7 monotone functions"), "{}", text(&o));
+    let o = toposmooth(&["verify", &out(&dir, "w_cage.vtu")]);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+    let d = read_mesh(Path::new(&w)).unwrap();
+    let n = d.positions.len();
+    let sums: Vec<f64> = (0..n).map(|v| (0..7).map(|j| d.array(&format!("weight_{j}")).unwrap().values[v]).sum()).collect();
+    assert!(sums.iter().all(|s| (s - 1.0).abs() < 1e-9));
+}
+
+#[test]
+fn every_no_data_error_path_names_its_file() {
+    let dir = scratch("nodata_errors");
+    let bar = bar_obj(&dir, 20, 2);
+    let w = out(&dir, "w.vtu");
+    let cases: Vec<(&str, &str)> = vec![
+        (r#"{"handles": [{"name": "a", "point": [2.5, 5]}, {"name": "b", "point": [7.5, 0.5]}]}"#, "outside"),
+        (r#"{"handles": [{"name": "a", "point": [2.5, 0.5]}, {"name": "b", "point": [2.52, 0.5]}]}"#, "both select vertex"),
+        (r#"{"handles": [{"name": "a", "point": [2.5, 0.5]}]}"#, "at least two handles"),
+        (r#"{"cage": [[1, -1], [3, -1], [3, 2], [1, 2]]}"#, "does not enclose"),
+        (r#"{"handles": [{"name": "a", "vertices": [0, 1]}, {"name": "b", "vertices": [1]}]}"#, "both select vertex 1"),
+    ];
+    for (k, (json, expect)) in cases.iter().enumerate() {
+        let h = write(&dir, &format!("h{k}.json"), json);
+        let o = toposmooth(&["weights", &bar, "--handles", &h, "-o", &w]);
+        assert_eq!(o.status.code(), Some(3), "{json}: {}", text(&o));
+        assert!(text(&o).contains(expect) && text(&o).contains(&format!("h{k}.json")), "{json}: {}", text(&o));
+        assert!(!Path::new(&w).exists());
+    }
+    // a component with no handle: two bars side by side
+    let mut two = std::fs::read_to_string(&bar).unwrap();
+    let nv = two.lines().filter(|l| l.starts_with("v ")).count();
+    let extra: String = two
+        .lines()
+        .map(|l| {
+            let p: Vec<&str> = l.split_whitespace().collect();
+            match p[0] {
+                "v" => format!("v {} {} 0\n", p[1], p[2].parse::<f64>().unwrap() + 5.0),
+                _ => format!("f {} {} {}\n", p[1].parse::<usize>().unwrap() + nv, p[2].parse::<usize>().unwrap() + nv, p[3].parse::<usize>().unwrap() + nv),
+            }
+        })
+        .collect();
+    two += &extra;
+    let two_path = write(&dir, "two.obj", &two);
+    let h = write(&dir, "h_two.json", r#"{"handles": [{"name": "a", "point": [2.5, 0.5]}, {"name": "b", "point": [7.5, 0.5]}]}"#);
+    let o = toposmooth(&["weights", &two_path, "--handles", &h, "-o", &w]);
+    assert_eq!(o.status.code(), Some(3), "{}", text(&o));
+    assert!(text(&o).contains("has no handle"), "{}", text(&o));
+    // deform: a transform naming no handle; diffuse: a colour outside the shape
+    let hw = write(&dir, "ok.json", r#"{"handles": [{"name": "a", "point": [2.5, 0.5]}, {"name": "b", "point": [7.5, 0.5]}]}"#);
+    let o = toposmooth(&["weights", &bar, "--handles", &hw, "-o", &w]);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+    let pose = write(&dir, "pose.json", r#"{"transforms": {"c": [[1,0,0,0],[0,1,0,0],[0,0,1,0]]}}"#);
+    let o = toposmooth(&["deform", &bar, "--weights", &w, "--transforms", &pose, "-o", &out(&dir, "p.obj")]);
+    assert_eq!(o.status.code(), Some(3), "{}", text(&o));
+    assert!(text(&o).contains("pose.json") && text(&o).contains("`c`"), "{}", text(&o));
+    let colors = write(&dir, "c.json", r#"{"points": [{"pixel": [0, 0], "rgb": [255, 0, 0]}, {"pixel": [100, 80], "rgb": [0, 0, 255]}]}"#);
+    let o = toposmooth(&["diffuse", &dataset("horse_mask.png"), "--colors", &colors, "-o", &out(&dir, "d.png")]);
+    assert_eq!(o.status.code(), Some(3), "{}", text(&o));
+    assert!(text(&o).contains("outside the image's shape") && text(&o).contains("c.json"), "{}", text(&o));
+    let _: PathBuf = dir;
+}

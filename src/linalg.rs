@@ -411,9 +411,9 @@ pub fn parallelism_for(s: &SymbolicCholesky<usize>) -> Par {
 /// ordering costs more than it saves. `Err` if `A` is not numerically positive definite.
 pub fn solve_spd_once(a: SparseColMatRef<'_, usize, f64>, b: &mut [f64]) -> Result<(), String> {
     let n = a.ncols();
-    let s = factorize_symbolic_cholesky(a.symbolic(), Side::Upper, SymmetricOrdering::Amd, Default::default())
-        .map_err(|e| format!("symbolic Cholesky: {e:?}"))?;
-    let par = parallelism_for(&s);
+    let s = cached_amd(a.symbolic())?;
+    let s: &SymbolicCholesky<usize> = &s;
+    let par = parallelism_for(s);
     let mut l = vec![0.0f64; s.len_val()];
     let mut mem = MemBuffer::try_new(StackReq::any_of(&[
         s.factorize_numeric_llt_scratch::<f64>(par, Spec::default()),
@@ -423,8 +423,34 @@ pub fn solve_spd_once(a: SparseColMatRef<'_, usize, f64>, b: &mut [f64]) -> Resu
     s.factorize_numeric_llt(&mut l, a, Side::Upper, Default::default(), par, MemStack::new(&mut mem), Spec::default())
         .map_err(|e| format!("{e:?}"))?;
     let rhs = faer::MatMut::from_column_major_slice_mut(b, n, 1);
-    LltRef::new(&s, &l).solve_in_place_with_conj(Conj::No, rhs, par, MemStack::new(&mut mem));
+    LltRef::new(s, &l).solve_in_place_with_conj(Conj::No, rhs, par, MemStack::new(&mut mem));
     Ok(())
+}
+
+/// A pattern and its symbolic Cholesky factorisation.
+pub type CachedSymbolic = Option<(SymbolicSparseColMat<usize>, std::rc::Rc<SymbolicCholesky<usize>>)>;
+
+thread_local! {
+    /// The last pattern [`solve_spd_once`] analysed on this thread: repeated solves on one
+    /// pattern (the representatives of the weight functions of a run) order it once.
+    static LAST_AMD: std::cell::RefCell<CachedSymbolic> =
+        const { std::cell::RefCell::new(None) };
+}
+
+fn cached_amd(p: SymbolicSparseColMatRef<'_, usize>) -> Result<std::rc::Rc<SymbolicCholesky<usize>>, String> {
+    let same = |a: &SymbolicSparseColMat<usize>| {
+        a.nrows() == p.nrows() && a.col_ptr() == p.col_ptr() && a.row_idx() == p.row_idx()
+    };
+    if let Some(s) = LAST_AMD.with(|c| c.borrow().as_ref().filter(|(q, _)| same(q)).map(|(_, s)| s.clone())) {
+        return Ok(s);
+    }
+    let s = std::rc::Rc::new(
+        factorize_symbolic_cholesky(p, Side::Upper, SymmetricOrdering::Amd, Default::default())
+            .map_err(|e| format!("symbolic Cholesky: {e:?}"))?,
+    );
+    let owned = p.to_owned().map_err(|e| format!("{e:?}"))?;
+    LAST_AMD.with(|c| *c.borrow_mut() = Some((owned, s.clone())));
+    Ok(s)
 }
 
 /// The pattern (upper triangle with diagonal) of a matrix given by triplets; for tests and

@@ -156,6 +156,13 @@ enum Command {
         /// `MESH[@levels]` (midpoint-subdivided; geodesic from vertex 0, every maximum kept).
         #[arg(long, value_delimiter = ',', default_value = "1000,10000,100000,1000000")]
         sizes: Vec<String>,
+        /// Benchmark weight functions instead: mesh files `MESH[@levels]` (4 point handles by
+        /// farthest-point sampling; orders from --weight-orders).
+        #[arg(long, value_delimiter = ',', value_name = "MESH[@LEVELS]")]
+        weights: Vec<String>,
+        /// Orders for --weights.
+        #[arg(long, value_delimiter = ',', default_value = "2,3,4")]
+        weight_orders: Vec<u8>,
         /// Energy order or blend.
         #[arg(long, default_value = "2")]
         order: String,
@@ -601,7 +608,10 @@ fn run(cli: Cli) -> Result<String> {
         Command::Verify { file, input, csv, grid } => {
             commands::verify(&VerifyArgs { file, input, csv: csv.options(), grid: grid.options()? })
         }
-        Command::Bench { sizes, order, persistence, edges, seed, single, solver } => {
+        Command::Bench { weights, weight_orders, .. } if !weights.is_empty() => {
+            commands::bench_weights(&weights, &weight_orders, 4)
+        }
+        Command::Bench { sizes, order, persistence, edges, seed, single, solver, .. } => {
             let persistence = match commands::parse_persistence(&persistence)? {
                 Selection::Relative(r) => r,
                 _ => return Err(Error::Usage("bench takes --persistence as a percentage".into())),

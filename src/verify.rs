@@ -219,8 +219,8 @@ pub fn certify_no_data<D: Domain>(
             for w in domain.neighbors(v) {
                 let bad = in_region[w] != r
                     && match k {
-                        RegionKind::Max => !(f[w] < value),
-                        _ => !(f[w] > value),
+                        RegionKind::Max => f[w].partial_cmp(&value) != Some(std::cmp::Ordering::Less),
+                        _ => f[w].partial_cmp(&value) != Some(std::cmp::Ordering::Greater),
                     };
                 if bad {
                     ok = false;

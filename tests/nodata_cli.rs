@@ -38,7 +38,15 @@ fn bar_obj(dir: &Path, nx: usize, ny: usize) -> String {
     let id = |i: usize, j: usize| j * (nx + 1) + i + 1;
     for j in 0..ny {
         for i in 0..nx {
-            s += &format!("f {} {} {}\nf {} {} {}\n", id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j), id(i + 1, j + 1), id(i, j + 1));
+            s += &format!(
+                "f {} {} {}\nf {} {} {}\n",
+                id(i, j),
+                id(i + 1, j),
+                id(i + 1, j + 1),
+                id(i, j),
+                id(i + 1, j + 1),
+                id(i, j + 1)
+            );
         }
     }
     write(dir, "bar.obj", &s)
@@ -52,10 +60,26 @@ fn out(dir: &Path, name: &str) -> String {
 fn four_methods_on_a_bar_with_two_point_handles() {
     let dir = scratch("nodata_bar");
     let bar = bar_obj(&dir, 60, 6);
-    let handles = write(&dir, "h.json", r#"{"handles": [{"name": "a", "point": [2.5, 0.5]}, {"name": "b", "point": [7.5, 0.5]}]}"#);
+    let handles = write(
+        &dir,
+        "h.json",
+        r#"{"handles": [{"name": "a", "point": [2.5, 0.5]}, {"name": "b", "point": [7.5, 0.5]}]}"#,
+    );
     let w = out(&dir, "w.vtu");
     let report = out(&dir, "r.json");
-    let o = toposmooth(&["weights", &bar, "--handles", &handles, "-o", &w, "--compare", "--report", &report, "--plot", &out(&dir, "w.png")]);
+    let o = toposmooth(&[
+        "weights",
+        &bar,
+        "--handles",
+        &handles,
+        "-o",
+        &w,
+        "--compare",
+        "--report",
+        &report,
+        "--plot",
+        &out(&dir, "w.png"),
+    ]);
     assert_eq!(o.status.code(), Some(0), "{}", text(&o));
     let r: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
     let cmp = r["comparison"].as_array().unwrap();
@@ -89,7 +113,10 @@ fn four_methods_on_a_bar_with_two_point_handles() {
     tampered.arrays[k].values[100] = 2.0;
     let bad = out(&dir, "tampered.vtu");
     let arrays: Vec<(&str, &[f64])> = tampered.arrays.iter().map(|x| (x.name.as_str(), x.values.as_slice())).collect();
-    toposmooth::io::vtk::stage_vtu(Path::new(&bad), &tampered.positions, &tampered.triangles, &arrays).unwrap().commit().unwrap();
+    toposmooth::io::vtk::stage_vtu(Path::new(&bad), &tampered.positions, &tampered.triangles, &arrays)
+        .unwrap()
+        .commit()
+        .unwrap();
     let o = toposmooth(&["verify", &bad]);
     assert_eq!(o.status.code(), Some(1), "{}", text(&o));
 }
@@ -108,16 +135,45 @@ fn penguin_weights_pose_and_identity_pose() {
     let rest = read_mesh(Path::new(&penguin)).unwrap();
     for s in ["lbs", "dqs"] {
         let posed = out(&dir, &format!("id_{s}.obj"));
-        let o = toposmooth(&["deform", &penguin, "--weights", &w, "--transforms", &identity, "-o", &posed, "--skinning", s]);
+        let o = toposmooth(&[
+            "deform",
+            &penguin,
+            "--weights",
+            &w,
+            "--transforms",
+            &identity,
+            "-o",
+            &posed,
+            "--skinning",
+            s,
+        ]);
         assert_eq!(o.status.code(), Some(0), "{}", text(&o));
         let p = read_mesh(Path::new(&posed)).unwrap();
         assert_eq!(p.triangles, rest.triangles);
-        let err = p.positions.iter().zip(&rest.positions).flat_map(|(a, b)| (0..3).map(move |k| (a[k] - b[k]).abs())).fold(0.0, f64::max);
+        let err = p
+            .positions
+            .iter()
+            .zip(&rest.positions)
+            .flat_map(|(a, b)| (0..3).map(move |k| (a[k] - b[k]).abs()))
+            .fold(0.0, f64::max);
         assert!(err < 1e-12, "{s}: {err}");
     }
     // the bundled pose moves the flippers and not the feet
     let posed = out(&dir, "posed.obj");
-    let o = toposmooth(&["deform", &penguin, "--weights", &w, "--transforms", &dataset("penguin_pose.json"), "-o", &posed, "--skinning", "dqs", "--plot", &out(&dir, "posed.png")]);
+    let o = toposmooth(&[
+        "deform",
+        &penguin,
+        "--weights",
+        &w,
+        "--transforms",
+        &dataset("penguin_pose.json"),
+        "-o",
+        &posed,
+        "--skinning",
+        "dqs",
+        "--plot",
+        &out(&dir, "posed.png"),
+    ]);
     assert_eq!(o.status.code(), Some(0), "{}", text(&o));
     let p = read_mesh(Path::new(&posed)).unwrap();
     let moved = |v: usize| (0..3).map(|k| (p.positions[v][k] - rest.positions[v][k]).powi(2)).sum::<f64>().sqrt();
@@ -130,7 +186,16 @@ fn diffusion_stays_in_the_colour_box_and_the_biharmonic_one_does_not() {
     let dir = scratch("nodata_diffuse");
     let colors = dataset("horse_colors.json");
     let png = out(&dir, "horse.png");
-    let o = toposmooth(&["diffuse", &dataset("horse_mask.png"), "--colors", &colors, "-o", &png, "--plot", &out(&dir, "plot.png")]);
+    let o = toposmooth(&[
+        "diffuse",
+        &dataset("horse_mask.png"),
+        "--colors",
+        &colors,
+        "-o",
+        &png,
+        "--plot",
+        &out(&dir, "plot.png"),
+    ]);
     assert_eq!(o.status.code(), Some(0), "{}", text(&o));
     let c: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&colors).unwrap()).unwrap();
     let rgbs: Vec<[u8; 3]> = c["points"]
@@ -151,7 +216,10 @@ fn diffusion_stays_in_the_colour_box_and_the_biharmonic_one_does_not() {
                 continue;
             }
             opaque += 1;
-            if (0..3).any(|ch| p.0[ch] < rgbs.iter().map(|c| c[ch]).min().unwrap() || p.0[ch] > rgbs.iter().map(|c| c[ch]).max().unwrap()) {
+            if (0..3).any(|ch| {
+                p.0[ch] < rgbs.iter().map(|c| c[ch]).min().unwrap()
+                    || p.0[ch] > rgbs.iter().map(|c| c[ch]).max().unwrap()
+            }) {
                 out += 1;
             }
         }
@@ -169,7 +237,16 @@ fn diffusion_stays_in_the_colour_box_and_the_biharmonic_one_does_not() {
     let o = toposmooth(&["verify", &out(&dir, "horse_weights.vtu")]);
     assert_eq!(o.status.code(), Some(0), "{}", text(&o));
     let bih = out(&dir, "bih.png");
-    let o = toposmooth(&["diffuse", &dataset("horse_mask.png"), "--colors", &colors, "-o", &bih, "--method", "unconstrained"]);
+    let o = toposmooth(&[
+        "diffuse",
+        &dataset("horse_mask.png"),
+        "--colors",
+        &colors,
+        "-o",
+        &bih,
+        "--method",
+        "unconstrained",
+    ]);
     assert_eq!(o.status.code(), Some(0), "{}", text(&o));
     let (_, out_bih) = outside(&bih);
     assert!(out_bih > 100, "{out_bih}");
@@ -188,7 +265,8 @@ fn cage_weights_on_the_horse() {
     assert_eq!(o.status.code(), Some(0), "{}", text(&o));
     let d = read_mesh(Path::new(&w)).unwrap();
     let n = d.positions.len();
-    let sums: Vec<f64> = (0..n).map(|v| (0..7).map(|j| d.array(&format!("weight_{j}")).unwrap().values[v]).sum()).collect();
+    let sums: Vec<f64> =
+        (0..n).map(|v| (0..7).map(|j| d.array(&format!("weight_{j}")).unwrap().values[v]).sum()).collect();
     assert!(sums.iter().all(|s| (s - 1.0).abs() < 1e-9));
 }
 
@@ -199,7 +277,10 @@ fn every_no_data_error_path_names_its_file() {
     let w = out(&dir, "w.vtu");
     let cases: Vec<(&str, &str)> = vec![
         (r#"{"handles": [{"name": "a", "point": [2.5, 5]}, {"name": "b", "point": [7.5, 0.5]}]}"#, "outside"),
-        (r#"{"handles": [{"name": "a", "point": [2.5, 0.5]}, {"name": "b", "point": [2.52, 0.5]}]}"#, "both select vertex"),
+        (
+            r#"{"handles": [{"name": "a", "point": [2.5, 0.5]}, {"name": "b", "point": [2.52, 0.5]}]}"#,
+            "both select vertex",
+        ),
         (r#"{"handles": [{"name": "a", "point": [2.5, 0.5]}]}"#, "at least two handles"),
         (r#"{"cage": [[1, -1], [3, -1], [3, 2], [1, 2]]}"#, "does not enclose"),
         (r#"{"handles": [{"name": "a", "vertices": [0, 1]}, {"name": "b", "vertices": [1]}]}"#, "both select vertex 1"),
@@ -220,25 +301,42 @@ fn every_no_data_error_path_names_its_file() {
             let p: Vec<&str> = l.split_whitespace().collect();
             match p[0] {
                 "v" => format!("v {} {} 0\n", p[1], p[2].parse::<f64>().unwrap() + 5.0),
-                _ => format!("f {} {} {}\n", p[1].parse::<usize>().unwrap() + nv, p[2].parse::<usize>().unwrap() + nv, p[3].parse::<usize>().unwrap() + nv),
+                _ => format!(
+                    "f {} {} {}\n",
+                    p[1].parse::<usize>().unwrap() + nv,
+                    p[2].parse::<usize>().unwrap() + nv,
+                    p[3].parse::<usize>().unwrap() + nv
+                ),
             }
         })
         .collect();
     two += &extra;
     let two_path = write(&dir, "two.obj", &two);
-    let h = write(&dir, "h_two.json", r#"{"handles": [{"name": "a", "point": [2.5, 0.5]}, {"name": "b", "point": [7.5, 0.5]}]}"#);
+    let h = write(
+        &dir,
+        "h_two.json",
+        r#"{"handles": [{"name": "a", "point": [2.5, 0.5]}, {"name": "b", "point": [7.5, 0.5]}]}"#,
+    );
     let o = toposmooth(&["weights", &two_path, "--handles", &h, "-o", &w]);
     assert_eq!(o.status.code(), Some(3), "{}", text(&o));
     assert!(text(&o).contains("has no handle"), "{}", text(&o));
     // deform: a transform naming no handle; diffuse: a colour outside the shape
-    let hw = write(&dir, "ok.json", r#"{"handles": [{"name": "a", "point": [2.5, 0.5]}, {"name": "b", "point": [7.5, 0.5]}]}"#);
+    let hw = write(
+        &dir,
+        "ok.json",
+        r#"{"handles": [{"name": "a", "point": [2.5, 0.5]}, {"name": "b", "point": [7.5, 0.5]}]}"#,
+    );
     let o = toposmooth(&["weights", &bar, "--handles", &hw, "-o", &w]);
     assert_eq!(o.status.code(), Some(0), "{}", text(&o));
     let pose = write(&dir, "pose.json", r#"{"transforms": {"c": [[1,0,0,0],[0,1,0,0],[0,0,1,0]]}}"#);
     let o = toposmooth(&["deform", &bar, "--weights", &w, "--transforms", &pose, "-o", &out(&dir, "p.obj")]);
     assert_eq!(o.status.code(), Some(3), "{}", text(&o));
     assert!(text(&o).contains("pose.json") && text(&o).contains("`c`"), "{}", text(&o));
-    let colors = write(&dir, "c.json", r#"{"points": [{"pixel": [0, 0], "rgb": [255, 0, 0]}, {"pixel": [100, 80], "rgb": [0, 0, 255]}]}"#);
+    let colors = write(
+        &dir,
+        "c.json",
+        r#"{"points": [{"pixel": [0, 0], "rgb": [255, 0, 0]}, {"pixel": [100, 80], "rgb": [0, 0, 255]}]}"#,
+    );
     let o = toposmooth(&["diffuse", &dataset("horse_mask.png"), "--colors", &colors, "-o", &out(&dir, "d.png")]);
     assert_eq!(o.status.code(), Some(3), "{}", text(&o));
     assert!(text(&o).contains("outside the image's shape") && text(&o).contains("c.json"), "{}", text(&o));

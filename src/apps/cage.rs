@@ -76,8 +76,14 @@ fn interpolate(mesh: &TriMesh, fields: &[Vec<f64>], points: &[[f64; 3]]) -> Resu
     for (t, tri) in tris.iter().enumerate() {
         let xs = tri.map(|v| pos[v][0]);
         let ys = tri.map(|v| pos[v][1]);
-        let (c0, c1) = (cell_of(xs.iter().copied().fold(f64::INFINITY, f64::min), 0), cell_of(xs.iter().copied().fold(f64::NEG_INFINITY, f64::max), 0));
-        let (r0, r1) = (cell_of(ys.iter().copied().fold(f64::INFINITY, f64::min), 1), cell_of(ys.iter().copied().fold(f64::NEG_INFINITY, f64::max), 1));
+        let (c0, c1) = (
+            cell_of(xs.iter().copied().fold(f64::INFINITY, f64::min), 0),
+            cell_of(xs.iter().copied().fold(f64::NEG_INFINITY, f64::max), 0),
+        );
+        let (r0, r1) = (
+            cell_of(ys.iter().copied().fold(f64::INFINITY, f64::min), 1),
+            cell_of(ys.iter().copied().fold(f64::NEG_INFINITY, f64::max), 1),
+        );
         for r in r0..=r1 {
             for c in c0..=c1 {
                 grid[r * cells + c].push(t);
@@ -100,7 +106,10 @@ fn interpolate(mesh: &TriMesh, fields: &[Vec<f64>], points: &[[f64; 3]]) -> Resu
             }
         }
         let Some((worst, t, l)) = best.filter(|b| b.0 > -1e-9) else {
-            return Err(Error::input(format!("shape vertex {i} at ({}, {}) lies outside the cage's triangulation", p[0], p[1])));
+            return Err(Error::input(format!(
+                "shape vertex {i} at ({}, {}) lies outside the cage's triangulation",
+                p[0], p[1]
+            )));
         };
         let _ = worst;
         let l = l.map(|x| x.max(0.0));
@@ -118,7 +127,12 @@ fn interpolate(mesh: &TriMesh, fields: &[Vec<f64>], points: &[[f64; 3]]) -> Resu
 /// A shape that is not planar, a cage that is not a simple polygon or does not enclose every
 /// shape vertex (input errors naming the first vertex outside), and the errors of
 /// [`weights_prescribed`].
-pub fn cage_weights(shape: &TriMesh, cage: &[[f64; 2]], max_area: Option<f64>, settings: &WeightSettings) -> Result<CageWeights> {
+pub fn cage_weights(
+    shape: &TriMesh,
+    cage: &[[f64; 2]],
+    max_area: Option<f64>,
+    settings: &WeightSettings,
+) -> Result<CageWeights> {
     if !shape.is_planar() {
         return Err(Error::input("cages are 2D: the shape must lie in the plane z = 0"));
     }
@@ -134,7 +148,13 @@ pub fn cage_weights(shape: &TriMesh, cage: &[[f64; 2]], max_area: Option<f64>, s
             p[0], p[1]
         )));
     }
-    let mean_area = shape.faces().iter().map(|t| crate::domain::triangle_area(shape.positions()[t[0]], shape.positions()[t[1]], shape.positions()[t[2]])).sum::<f64>()
+    let mean_area = shape
+        .faces()
+        .iter()
+        .map(|t| {
+            crate::domain::triangle_area(shape.positions()[t[0]], shape.positions()[t[1]], shape.positions()[t[2]])
+        })
+        .sum::<f64>()
         / shape.faces().len() as f64;
     let cage_mesh = triangulate(&outline, Some(max_area.unwrap_or(mean_area)), 25.0)?;
     let params = boundary_parameters(&cage_mesh, cage);
@@ -197,7 +217,11 @@ mod tests {
             assert!(c.raw_on_shape.iter().all(|w| (0.0..=1.0).contains(&w[i])));
         }
         // by symmetry the centre is weighted nearly equally (the triangulation is not symmetric)
-        assert!(c.normalised_on_shape.iter().all(|w| (w[0] - 0.25).abs() < 1e-2), "{:?}", c.normalised_on_shape.iter().map(|w| w[0]).collect::<Vec<_>>());
+        assert!(
+            c.normalised_on_shape.iter().all(|w| (w[0] - 0.25).abs() < 1e-2),
+            "{:?}",
+            c.normalised_on_shape.iter().map(|w| w[0]).collect::<Vec<_>>()
+        );
         // biharmonic functions with hat boundary values do not reproduce linear functions...
         assert!(c.reproduction_error > 0.05, "{}", c.reproduction_error);
         // ...harmonic ones (order 1: DeRose & Meyer's harmonic coordinates) do

@@ -279,8 +279,8 @@ pub fn resolve(mesh: &TriMesh, handles: &[Handle]) -> Result<Vec<Vec<usize>>> {
             }
         }
     }
-    for v in 0..n {
-        if let Some(k) = owner[v] {
+    for (v, o) in owner.iter().enumerate() {
+        if let Some(k) = *o {
             sets[k].push(v);
         }
     }

@@ -164,11 +164,8 @@ pub fn fill_rule<D: Smoothable>(domain: &D, fixed: &mut [Option<f64>]) -> usize 
             k += 1;
             for w in domain.neighbors(v) {
                 match fixed[w] {
-                    Some(x) => {
-                        if !values.contains(&x) {
-                            values.push(x);
-                        }
-                    }
+                    Some(x) if !values.contains(&x) => values.push(x),
+                    Some(_) => {}
                     None if !seen[w] => {
                         seen[w] = true;
                         part.push(w);
@@ -393,6 +390,7 @@ pub fn weights_prescribed<D: Smoothable + Sync>(
     let mut normalised: Vec<Vec<f64>> = vec![vec![0.0; n]; count];
     let mut change = 0.0f64;
     let mut range = [f64::INFINITY, f64::NEG_INFINITY];
+    #[allow(clippy::needless_range_loop)] // v indexes every function
     for v in 0..n {
         let sum: f64 = functions.iter().map(|f| f.raw[v]).sum();
         range = [range[0].min(sum), range[1].max(sum)];

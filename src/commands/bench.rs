@@ -270,3 +270,59 @@ pub fn bench(args: &BenchArgs) -> Result<String> {
     }
     Ok(out)
 }
+
+/// `toposmooth bench --weights MESH[@levels],...`: seconds per weight function (monotone,
+/// minimal edge set) for each order, with `handles` point handles placed by farthest-point
+/// sampling: one thread per function as the paper measured, and the wall time of all
+/// functions on 2 threads.
+pub fn bench_weights(cases: &[String], orders: &[u8], handles: usize) -> Result<String> {
+    use crate::apps::weights::{weights, WeightSettings};
+    use crate::domain::Domain;
+    let mut out = String::from(
+        "| mesh | vertices | triangles | k | handles | s per function (1 thread) | iterations per function | all functions, 2 threads s | certified |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|\n",
+    );
+    for case in cases {
+        let (file, levels) = match case.rsplit_once('@') {
+            Some((f, l)) => {
+                (f, l.parse::<usize>().map_err(|_| Error::Usage(format!("bench `{case}`: levels after @")))?)
+            }
+            None => (case.as_str(), 0),
+        };
+        let (mut mesh, _) = super::input::read_trimesh(std::path::Path::new(file))?;
+        for _ in 0..levels {
+            mesh = mesh.subdivide()?;
+        }
+        let n = mesh.n_vertices();
+        // farthest-point sampling, from the vertex farthest from the centroid
+        let p = mesh.positions();
+        let c = p.iter().fold([0.0; 3], |a, q| [a[0] + q[0], a[1] + q[1], a[2] + q[2]]).map(|x| x / n as f64);
+        let d2 = |a: [f64; 3], b: [f64; 3]| (0..3).map(|k| (a[k] - b[k]).powi(2)).sum::<f64>();
+        let first = (0..n).max_by(|&a, &b| d2(p[a], c).total_cmp(&d2(p[b], c))).unwrap_or(0);
+        let mut chosen = vec![first];
+        let mut dist: Vec<f64> = (0..n).map(|v| d2(p[v], p[first])).collect();
+        while chosen.len() < handles.max(2) {
+            let next = (0..n).max_by(|&a, &b| dist[a].total_cmp(&dist[b])).unwrap_or(0);
+            chosen.push(next);
+            for v in 0..n {
+                dist[v] = dist[v].min(d2(p[v], p[next]));
+            }
+        }
+        let sets: Vec<Vec<usize>> = chosen.iter().map(|&v| vec![v]).collect();
+        for &k in orders {
+            let one = weights(&mesh, &sets, &WeightSettings { order: k, threads: 1, ..Default::default() })?;
+            let two = weights(&mesh, &sets, &WeightSettings { order: k, threads: 2, ..Default::default() })?;
+            let m = one.functions.len() as f64;
+            let per = one.functions.iter().map(|f| f.seconds).sum::<f64>() / m;
+            let its = one.functions.iter().map(|f| f.solver_iterations as f64).sum::<f64>() / m;
+            let certified = one.functions.iter().chain(&two.functions).all(|f| f.certificate.passed);
+            out += &format!(
+                "| {case} | {n} | {} | {k} | {} | {per:.4} | {its:.1} | {:.4} | {} |\n",
+                mesh.faces().len(),
+                sets.len(),
+                two.function_seconds,
+                if certified { "all" } else { "NO" }
+            );
+        }
+    }
+    Ok(out)
+}

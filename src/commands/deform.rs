@@ -48,7 +48,8 @@ fn read_weights(args: &DeformArgs, mesh: &TriMesh) -> Result<Vec<(String, Vec<f6
         .iter()
         .filter_map(|a| {
             let name = a.name.strip_prefix("weight_")?;
-            (!name.ends_with("_raw") && !name.ends_with("_interpolated") && a.components == 1).then(|| (name.to_string(), a.values.clone()))
+            (!name.ends_with("_raw") && !name.ends_with("_interpolated") && a.components == 1)
+                .then(|| (name.to_string(), a.values.clone()))
         })
         .collect();
     if out.len() < 2 {
@@ -99,10 +100,13 @@ pub fn deform(args: &DeformArgs) -> Result<String> {
         .iter()
         .enumerate()
         .map(|(h, t)| {
-            let d: f64 = (0..3).flat_map(|r| (0..4).map(move |c| (r, c))).map(|(r, c)| {
-                let id = if r == c { 1.0 } else { 0.0 };
-                (t.0[r][c] - id).powi(2)
-            }).sum();
+            let d: f64 = (0..3)
+                .flat_map(|r| (0..4).map(move |c| (r, c)))
+                .map(|(r, c)| {
+                    let id = if r == c { 1.0 } else { 0.0 };
+                    (t.0[r][c] - id).powi(2)
+                })
+                .sum();
             (h, d)
         })
         .max_by(|a, b| a.1.total_cmp(&b.1))
@@ -120,8 +124,15 @@ pub fn deform(args: &DeformArgs) -> Result<String> {
         tris.extend(mesh.faces().iter().map(|t| t.map(|v| v + nv)));
         let mut values = w[moved].clone();
         values.extend_from_slice(&w[moved]);
-        let panel = [GridPanel { title: format!("rest | posed ({:?}), coloured by weight_{}", args.skinning, names[moved]), values: &values }];
-        let title = format!("{} posed by {}", args.input.file_name().unwrap_or_default().to_string_lossy(), args.transforms.display());
+        let panel = [GridPanel {
+            title: format!("rest | posed ({:?}), coloured by weight_{}", args.skinning, names[moved]),
+            values: &values,
+        }];
+        let title = format!(
+            "{} posed by {}",
+            args.input.file_name().unwrap_or_default().to_string_lossy(),
+            args.transforms.display()
+        );
         staged.push(super::stage_plot(path, |p| {
             plot_mesh_fields(p, &positions, &tris, &panel, &[], &title, args.view, false)?;
             Ok(())
@@ -167,11 +178,12 @@ fn stage_geometry(path: &std::path::Path, positions: &[[f64; 3]], triangles: &[[
         "off" => stage_off(path, positions, triangles),
         "ply" => stage_ply(path, positions, triangles, &[]),
         "vtu" => stage_vtu(path, positions, triangles, &[]),
-        "vtp" => stage_vtp(
-            path,
-            &PolyData { points: positions.to_vec(), polys: triangles.to_vec(), ..Default::default() },
-        ),
-        _ => Err(Error::Usage(format!("{}: a posed mesh is written as .obj, .off, .ply, .vtu or .vtp", path.display()))),
+        "vtp" => {
+            stage_vtp(path, &PolyData { points: positions.to_vec(), polys: triangles.to_vec(), ..Default::default() })
+        }
+        _ => {
+            Err(Error::Usage(format!("{}: a posed mesh is written as .obj, .off, .ply, .vtu or .vtp", path.display())))
+        }
     }
 }
 

@@ -14,7 +14,7 @@ mod smooth_mesh;
 mod verify;
 mod weights;
 
-pub use bench::{bench, BenchArgs, BenchCase};
+pub use bench::{bench, bench_weights, BenchArgs, BenchCase};
 pub use deform::{deform, DeformArgs};
 pub use diffuse::{diffuse, DiffuseArgs};
 pub use extrema::{extrema, ExtremaArgs};

@@ -290,12 +290,18 @@ fn verify_mesh(args: &VerifyArgs) -> Result<String> {
 /// `role_<name>` (prescribed vertices: roles −1, 1, 2; a region at the largest prescribed value
 /// is a maximum, at the smallest a minimum, others exempt), `u_<name>` likewise, and the
 /// normalised `weight_<name>` summing to 1.
-fn verify_weights(args: &VerifyArgs, mesh: &crate::domain::TriMesh, data: &crate::io::mesh::MeshData) -> Result<String> {
+fn verify_weights(
+    args: &VerifyArgs,
+    mesh: &crate::domain::TriMesh,
+    data: &crate::io::mesh::MeshData,
+) -> Result<String> {
     use crate::verify::{certify_no_data, RegionKind};
     let n = mesh.n_vertices();
     let bad = |m: String| Error::input(m).in_file(&args.file);
     let take = |name: &str| -> Result<Vec<f64>> {
-        let a = data.array(name).map_err(|m| bad(format!("{m} (a weights file holds weight_<name>, weight_<name>_raw, u_<name>, role_<name>)")))?;
+        let a = data.array(name).map_err(|m| {
+            bad(format!("{m} (a weights file holds weight_<name>, weight_<name>_raw, u_<name>, role_<name>)"))
+        })?;
         if a.components != 1 || a.values.len() != n {
             return Err(bad(format!("array `{name}` is not one scalar per vertex")));
         }

@@ -142,7 +142,9 @@ pub fn weights(args: &WeightsArgs) -> Result<String> {
 /// `weight_<j>_interpolated` raw; reported, not certified).
 fn run_cage(args: &WeightsArgs, shape: &TriMesh, cage: &[[f64; 2]], start: Instant) -> Result<String> {
     if args.compare {
-        return Err(Error::Usage("--compare is for handles; a cage's weights are compared on its own triangulation".into()));
+        return Err(Error::Usage(
+            "--compare is for handles; a cage's weights are compared on its own triangulation".into(),
+        ));
     }
     let c = crate::apps::cage::cage_weights(shape, cage, args.cage_max_area, &args.settings)
         .map_err(|e| e.in_file(&args.handles))?;
@@ -169,7 +171,16 @@ fn run_cage(args: &WeightsArgs, shape: &TriMesh, cage: &[[f64; 2]], start: Insta
             .collect();
         let title = format!("cage weights on {}, order {}", args.input.display(), args.settings.order);
         staged.push(super::stage_plot(path, |p| {
-            plot_mesh_fields(p, shape.positions(), shape.faces(), &panels, &[], &title, MeshView { azimuth: 0.0, elevation: 90.0 }, false)?;
+            plot_mesh_fields(
+                p,
+                shape.positions(),
+                shape.faces(),
+                &panels,
+                &[],
+                &title,
+                MeshView { azimuth: 0.0, elevation: 90.0 },
+                false,
+            )?;
             Ok(())
         })?);
     }
@@ -193,7 +204,11 @@ fn run_cage(args: &WeightsArgs, shape: &TriMesh, cage: &[[f64; 2]], start: Insta
         sig6(c.reproduction_error)
     );
     text += &format!("seconds: {}\n", sig6(start.elapsed().as_secs_f64()));
-    let wrote: Vec<String> = [Some(&args.output), Some(&cage_path), args.plot.as_ref()].into_iter().flatten().map(|p| p.display().to_string()).collect();
+    let wrote: Vec<String> = [Some(&args.output), Some(&cage_path), args.plot.as_ref()]
+        .into_iter()
+        .flatten()
+        .map(|p| p.display().to_string())
+        .collect();
     text += &format!("wrote {}\n", wrote.join(", "));
     Ok(text)
 }

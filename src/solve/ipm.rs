@@ -14,9 +14,10 @@ use super::qp::{QpSettings, ReducedQp, SolveStatus};
 use crate::linalg as ordering;
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::llt::factor::LltRegularization;
-use faer::sparse::linalg::cholesky::LltRef;
+use faer::sparse::linalg::cholesky::{LltRef, SymbolicCholesky};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
 use faer::{Conj, Side, Spec};
+use std::rc::Rc;
 
 /// Upper-triangular pattern of `N` and where each contribution lands in its value array.
 struct Normal {
@@ -105,6 +106,26 @@ impl Normal {
     }
 }
 
+thread_local! {
+    /// The last pattern analysed on this thread and its symbolic factorisation: independent
+    /// problems on one domain (the weight functions of a run) share the normal-equation
+    /// pattern, and the ordering (nested dissection and AMD) is then done once per thread.
+    static LAST: std::cell::RefCell<ordering::CachedSymbolic> =
+        const { std::cell::RefCell::new(None) };
+}
+
+fn cached_symbolic(pattern: &SymbolicSparseColMat<usize>) -> Result<Rc<SymbolicCholesky<usize>>, String> {
+    let same = |a: &SymbolicSparseColMat<usize>| {
+        a.nrows() == pattern.nrows() && a.col_ptr() == pattern.col_ptr() && a.row_idx() == pattern.row_idx()
+    };
+    if let Some(s) = LAST.with(|c| c.borrow().as_ref().filter(|(p, _)| same(p)).map(|(_, s)| s.clone())) {
+        return Ok(s);
+    }
+    let s = Rc::new(ordering::symbolic_cholesky(pattern.as_ref(), Side::Upper)?);
+    LAST.with(|c| *c.borrow_mut() = Some((pattern.clone(), s.clone())));
+    Ok(s)
+}
+
 /// Solves the reduced QP; `Err(reason)` when it cannot (the caller falls back to Clarabel).
 pub fn solve(
     r: &ReducedQp,
@@ -155,8 +176,9 @@ pub fn solve(
     };
 
     let normal = Normal::new(r, &row_cols, &row_len);
-    let symbolic = ordering::symbolic_cholesky(normal.symbolic.as_ref(), Side::Upper)?;
-    let par = ordering::parallelism_for(&symbolic);
+    let symbolic_rc = cached_symbolic(&normal.symbolic)?;
+    let symbolic: &SymbolicCholesky<usize> = &symbolic_rc;
+    let par = ordering::parallelism_for(symbolic);
     let mut mem = MemBuffer::try_new(symbolic.factorize_numeric_llt_scratch::<f64>(par, Spec::default()))
         .map_err(|_| "out of memory for the Cholesky workspace".to_string())?;
     let nnz = normal.symbolic.row_idx().len();
@@ -204,7 +226,7 @@ pub fn solve(
         .map_err(|_| "out of memory for the Cholesky workspace".to_string())?;
     let mut solve_with = |l_vals: &[f64], rhs: &mut [f64]| {
         let rhs_mat = faer::MatMut::from_column_major_slice_mut(rhs, n, 1);
-        LltRef::new(&symbolic, l_vals).solve_in_place_with_conj(Conj::No, rhs_mat, par, MemStack::new(&mut solve_mem));
+        LltRef::new(symbolic, l_vals).solve_in_place_with_conj(Conj::No, rhs_mat, par, MemStack::new(&mut solve_mem));
     };
 
     let mut x: Vec<f64> = hint.map(|h| h.to_vec()).unwrap_or_else(|| vec![0.0; n]);

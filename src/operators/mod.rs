@@ -17,6 +17,7 @@
 //! ```
 
 mod cotan;
+mod gradient;
 mod harmonic;
 mod polyharmonic;
 mod series;
@@ -25,6 +26,7 @@ mod sparse;
 pub use cotan::{
     cotan_stiffness, grid_mass, grid_stiffness, lumped_mass, negative_cotan_edges, positive_cotan_stiffness,
 };
+pub use gradient::gradient_operator;
 pub use harmonic::{dirichlet_solve, Dirichlet};
 pub use polyharmonic::{polyharmonic, Energy};
 pub use series::{series_mass, series_stiffness};

@@ -342,3 +342,64 @@ fn every_no_data_error_path_names_its_file() {
     assert!(text(&o).contains("outside the image's shape") && text(&o).contains("c.json"), "{}", text(&o));
     let _: PathBuf = dir;
 }
+
+#[test]
+fn a_bone_across_a_bar_fills_the_part_beyond_it() {
+    let dir = scratch("nodata_bone");
+    let bar = bar_obj(&dir, 40, 4);
+    let h = write(
+        &dir,
+        "h.json",
+        r#"{"handles": [{"name": "tip", "point": [1, 0.5]}, {"name": "wrist", "bone": [[7, -1, 0], [7, 2, 0]], "radius": 0.2}]}"#,
+    );
+    let w = out(&dir, "w.vtu");
+    let report = out(&dir, "r.json");
+    let o = toposmooth(&["weights", &bar, "--handles", &h, "-o", &w, "--report", &report]);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+    let r: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    // the bone takes the columns at x = 7 (±0.2 reaches only that column of vertices: spacing 0.25);
+    // the 12 columns beyond (x = 7.25 … 10) are filled, 5 vertices each
+    assert_eq!(r["functions"][1]["handle_vertices"], 5);
+    assert_eq!(r["functions"][0]["filled"], 60);
+    assert_eq!(r["functions"][1]["filled"], 60);
+    let d = read_mesh(Path::new(&w)).unwrap();
+    let tip = d.array("weight_tip_raw").unwrap().values;
+    let wrist = d.array("weight_wrist_raw").unwrap().values;
+    for (v, p) in d.positions.iter().enumerate() {
+        if p[0] > 7.1 {
+            assert_eq!((tip[v], wrist[v]), (0.0, 1.0), "vertex {v} beyond the bone");
+        }
+    }
+    let o = toposmooth(&["verify", &w]);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+}
+
+#[test]
+fn diffusion_on_a_mesh_writes_colour_arrays() {
+    let dir = scratch("nodata_diffuse_mesh");
+    let bar = bar_obj(&dir, 40, 4);
+    let colors = write(
+        &dir,
+        "c.json",
+        r#"{"points": [{"point": [0, 0], "rgb": [255, 0, 0]}, {"vertex": 40, "rgb": [0, 0, 255]}, {"point": [5, 1], "rgb": [0, 200, 0]}]}"#,
+    );
+    let o_path = out(&dir, "bar_colours.ply");
+    let o = toposmooth(&["diffuse", &bar, "--colors", &colors, "-o", &o_path]);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+    assert!(text(&o).contains("0 of 205 vertices outside"), "{}", text(&o));
+    let d = read_mesh(Path::new(&o_path)).unwrap();
+    let (r, g, b) = (d.array("red").unwrap().values, d.array("green").unwrap().values, d.array("blue").unwrap().values);
+    assert_eq!((r[0], g[0], b[0]), (255.0, 0.0, 0.0));
+    assert_eq!((r[40], g[40], b[40]), (0.0, 0.0, 255.0));
+    assert!(g.iter().all(|&x| x <= 200.0));
+    let o = toposmooth(&["verify", &o_path]);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+    // an image-only field on a mesh is refused
+    let bad = write(
+        &dir,
+        "bad.json",
+        r#"{"points": [{"pixel": [0, 0], "rgb": [255, 0, 0]}, {"vertex": 40, "rgb": [0, 0, 255]}]}"#,
+    );
+    let o = toposmooth(&["diffuse", &bar, "--colors", &bad, "-o", &o_path]);
+    assert_eq!(o.status.code(), Some(3), "{}", text(&o));
+}

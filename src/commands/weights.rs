@@ -323,7 +323,7 @@ fn finish(
     );
     for (h, f) in w.functions.iter().enumerate() {
         text += &format!(
-            "  {:<12} {:>5} handle vertices, {:>5} filled: {}; {} spurious (exact), {} (1e-9); {} iterations, {} s\n",
+            "  {:<14} {:>5} handle vertices, {:>5} filled: {}; {} spurious (exact), {} (1e-9); {} iterations, {} s\n",
             names[h],
             sets[h].len(),
             f.filled,

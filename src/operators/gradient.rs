@@ -56,7 +56,8 @@ mod tests {
         let (k, m) = (cotan_stiffness(p, t), lumped_mass(p, t));
         let weighted = |v: &[f64]| -> f64 { v.iter().enumerate().map(|(r, x)| areas[r / 3] * x * x).sum() };
         for seed in 0..3u64 {
-            let f: Vec<f64> = p.iter().map(|q| (q[0] * (seed + 1) as f64).sin() + q[1] * q[2] + 0.1 * seed as f64).collect();
+            let f: Vec<f64> =
+                p.iter().map(|q| (q[0] * (seed + 1) as f64).sin() + q[1] * q[2] + 0.1 * seed as f64).collect();
             let e1 = weighted(&apply(&g, &f));
             assert!((e1 - quadratic_form(&k, &f)).abs() <= 1e-10 * e1.abs(), "{e1}");
             let lap: Vec<f64> = apply(&k, &f).iter().zip(&m).map(|(x, mi)| x / mi).collect();

@@ -358,8 +358,8 @@ struct WeightsCli {
     #[arg(long, value_enum, default_value_t = Edges::Minimal)]
     edges: Edges,
     /// Worker threads (the functions are independent).
-    #[arg(long, default_value_t = 2)]
-    threads: usize,
+    #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u16).range(1..=256))]
+    threads: u16,
     /// Picture: the normalised weights of up to 4 handles (with --compare: handle 0 by method).
     #[arg(long, value_name = "PNG")]
     plot: Option<PathBuf>,
@@ -563,7 +563,7 @@ fn run(cli: Cli) -> Result<String> {
                 order: c.order,
                 method: weight_method(c.method),
                 edges: edge_set(c.edges),
-                threads: c.threads.max(1),
+                threads: usize::from(c.threads),
                 ..Default::default()
             },
             compare: c.compare,

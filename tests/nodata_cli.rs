@@ -403,3 +403,102 @@ fn diffusion_on_a_mesh_writes_colour_arrays() {
     let o = toposmooth(&["diffuse", &bar, "--colors", &bad, "-o", &o_path]);
     assert_eq!(o.status.code(), Some(3), "{}", text(&o));
 }
+
+#[test]
+fn outputs_never_overwrite_inputs_or_each_other() {
+    let dir = scratch("nodata_paths");
+    let bar = bar_obj(&dir, 20, 2);
+    let h = write(
+        &dir,
+        "h.json",
+        r#"{"handles": [{"name": "a", "point": [2.5, 0.5]}, {"name": "b", "point": [7.5, 0.5]}]}"#,
+    );
+    let before = std::fs::read(&bar).unwrap();
+    let w = out(&dir, "w.vtu");
+    for args in [
+        vec!["weights", &bar, "--handles", &h, "-o", &bar],
+        vec!["weights", &bar, "--handles", &h, "-o", &h],
+        vec!["weights", &bar, "--handles", &h, "-o", &w, "--report", &w],
+        vec!["weights", &bar, "--handles", &h, "-o", &w, "--cage-output", &w],
+    ] {
+        let o = toposmooth(&args);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {}", text(&o));
+        assert!(!Path::new(&w).exists());
+    }
+    assert_eq!(std::fs::read(&bar).unwrap(), before);
+    let o = toposmooth(&["weights", &bar, "--handles", &h, "-o", &w]);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+    let pose = write(&dir, "pose.json", r#"{"transforms": {"a": [[1,0,0,1],[0,1,0,0],[0,0,1,0]]}}"#);
+    for target in [&bar, &w, &pose] {
+        let o = toposmooth(&["deform", &bar, "--weights", &w, "--transforms", &pose, "-o", target]);
+        assert_eq!(o.status.code(), Some(2), "{}", text(&o));
+    }
+    assert_eq!(std::fs::read(&bar).unwrap(), before);
+    let o = toposmooth(&["verify", &w]);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+}
+
+#[test]
+fn adjacent_handles_form_one_region_and_tampered_weights_fail_verify() {
+    let dir = scratch("nodata_regions");
+    let bar = bar_obj(&dir, 20, 2);
+    // vertices 0 and 1 are adjacent: both 0 in c's function, one minimum region (role 2)
+    let h = write(
+        &dir,
+        "h.json",
+        r#"{"handles": [{"name": "a", "vertices": [0]}, {"name": "b", "vertices": [1]}, {"name": "c", "vertices": [40]}]}"#,
+    );
+    let w = out(&dir, "w.vtu");
+    let o = toposmooth(&["weights", &bar, "--handles", &h, "-o", &w]);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+    let d = read_mesh(Path::new(&w)).unwrap();
+    let role_c = d.array("role_c").unwrap().values;
+    assert_eq!((role_c[0], role_c[1], role_c[40]), (2.0, 2.0, 1.0));
+    let role_a = d.array("role_a").unwrap().values;
+    assert_eq!((role_a[0], role_a[1], role_a[40]), (1.0, -1.0, -1.0)); // different values: separate regions
+    let o = toposmooth(&["verify", &w]);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+    let tamper = |name: &str, f: &dyn Fn(&mut toposmooth::io::mesh::MeshData)| {
+        let mut t = d.clone();
+        f(&mut t);
+        let path = out(&dir, name);
+        let arrays: Vec<(&str, &[f64])> = t.arrays.iter().map(|x| (x.name.as_str(), x.values.as_slice())).collect();
+        toposmooth::io::vtk::stage_vtu(Path::new(&path), &t.positions, &t.triangles, &arrays)
+            .unwrap()
+            .commit()
+            .unwrap();
+        let o = toposmooth(&["verify", &path]);
+        assert_eq!(o.status.code(), Some(1), "{name}: {}", text(&o));
+    };
+    let scale = |t: &mut toposmooth::io::mesh::MeshData| {
+        for a in t.arrays.iter_mut().filter(|a| a.name == "weight_c_raw" || a.name == "u_c") {
+            a.values.iter_mut().for_each(|x| *x *= 0.5);
+        }
+    };
+    tamper("halved.vtu", &scale);
+    tamper("nan.vtu", &|t| {
+        let a = t.arrays.iter_mut().find(|a| a.name == "weight_a").unwrap();
+        a.values[7] = f64::NAN;
+    });
+    tamper("swapped.vtu", &|t| {
+        let i = t.arrays.iter().position(|a| a.name == "weight_a").unwrap();
+        let j = t.arrays.iter().position(|a| a.name == "weight_c").unwrap();
+        let (x, y) = (t.arrays[i].values.clone(), t.arrays[j].values.clone());
+        t.arrays[i].values = y;
+        t.arrays[j].values = x;
+    });
+    // names that would break array or PLY property names, two identical bones
+    for (json, expect) in [
+        (r#"{"handles": [{"name": "arm.l", "vertices": [0]}, {"name": "b", "vertices": [40]}]}"#, "ASCII"),
+        (r#"{"handles": [{"name": "a", "vertices": [0]}, {"name": "b_raw", "vertices": [40]}]}"#, "_raw"),
+        (
+            r#"{"handles": [{"name": "a", "bone": [[5,0,0],[5,1,0]], "radius": 0.3}, {"name": "b", "bone": [[5,0,0],[5,1,0]], "radius": 0.3}, {"name": "c", "vertices": [0]}]}"#,
+            "handle `b`",
+        ),
+    ] {
+        let hp = write(&dir, "bad.json", json);
+        let o = toposmooth(&["weights", &bar, "--handles", &hp, "-o", &out(&dir, "x.ply")]);
+        assert_eq!(o.status.code(), Some(3), "{json}: {}", text(&o));
+        assert!(text(&o).contains(expect) && text(&o).contains("bad.json"), "{json}: {}", text(&o));
+    }
+}

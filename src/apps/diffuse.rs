@@ -53,6 +53,7 @@ pub fn parse_colors(text: &str) -> Result<Vec<ColorPoint>> {
             }
             None => format!("c{k}"),
         };
+        crate::apps::handles::check_name(&name).map_err(|e| Error::input(format!("point {k}: {e}")))?;
         if out.iter().any(|o| o.name == name) {
             return Err(Error::input(format!("two colour points are named `{name}`")));
         }

@@ -72,6 +72,9 @@ fn point_of(v: &serde_json::Value, what: &str) -> Result<[f64; 3]> {
 /// than two handles (cages: fewer than three vertices).
 pub fn parse_handles(text: &str) -> Result<HandleFile> {
     let v: serde_json::Value = serde_json::from_str(text).map_err(|e| Error::input(format!("not valid JSON: {e}")))?;
+    if v.get("cage").is_some() && v.get("handles").is_some() {
+        return Err(Error::input("the file has both \"cage\" and \"handles\": give one"));
+    }
     if let Some(cage) = v.get("cage") {
         let pts = cage.as_array().ok_or_else(|| Error::input("\"cage\" must be an array of [x, y] points"))?;
         let mut out = Vec::with_capacity(pts.len());
@@ -98,11 +101,7 @@ pub fn parse_handles(text: &str) -> Result<HandleFile> {
             .and_then(|n| n.as_str())
             .ok_or_else(|| Error::input(format!("handle {k} has no \"name\"")))?
             .to_string();
-        if name.is_empty() || !name.chars().all(|c| c.is_alphanumeric() || c == '_' || c == '-' || c == '.') {
-            return Err(Error::input(format!(
-                "handle {k}: name `{name}` must be non-empty letters, digits, `_`, `-` or `.` (it names arrays)"
-            )));
-        }
+        check_name(&name).map_err(|e| Error::input(format!("handle {k}: {e}")))?;
         if handles.iter().any(|o| o.name == name) {
             return Err(Error::input(format!("two handles are named `{name}`")));
         }
@@ -154,6 +153,22 @@ pub fn parse_handles(text: &str) -> Result<HandleFile> {
         )));
     }
     Ok(HandleFile::Handles(handles))
+}
+
+/// A handle (or colour point) name becomes part of array names (`weight_<name>_raw`, PLY
+/// properties): ASCII letters, digits, `_` and `-`, not ending in `_raw` or `_interpolated`
+/// (the suffixes of the other arrays).
+///
+/// # Errors
+/// A message saying what is wrong with the name.
+pub fn check_name(name: &str) -> std::result::Result<(), String> {
+    if name.is_empty() || !name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-') {
+        return Err(format!("name `{name}` must be non-empty ASCII letters, digits, `_` or `-` (it names arrays)"));
+    }
+    if name.ends_with("_raw") || name.ends_with("_interpolated") {
+        return Err(format!("name `{name}` must not end in `_raw` or `_interpolated` (suffixes of other arrays)"));
+    }
+    Ok(())
 }
 
 /// Squared distance from `p` to the segment `a b`.
@@ -283,6 +298,12 @@ pub fn resolve(mesh: &TriMesh, handles: &[Handle]) -> Result<Vec<Vec<usize>>> {
         if let Some(k) = *o {
             sets[k].push(v);
         }
+    }
+    if let Some(k) = sets.iter().position(|s| s.is_empty()) {
+        return Err(Error::input(format!(
+            "handle `{}`: every vertex within its reach is nearer to another bone (or is another handle's)",
+            handles[k].name
+        )));
     }
     // every component needs a handle
     let comp = mesh.components();

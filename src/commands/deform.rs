@@ -64,6 +64,10 @@ fn read_weights(args: &DeformArgs, mesh: &TriMesh) -> Result<Vec<(String, Vec<f6
 
 /// Runs `deform`.
 pub fn deform(args: &DeformArgs) -> Result<String> {
+    super::check_distinct(
+        &[args.input.as_path(), args.weights.as_path(), args.transforms.as_path()],
+        &[("-o", Some(&args.output)), ("--plot", args.plot.as_deref())],
+    )?;
     let (mesh, _) = read_trimesh(&args.input)?;
     let weights = read_weights(args, &mesh)?;
     let text = std::fs::read_to_string(&args.transforms)
@@ -91,8 +95,11 @@ pub fn deform(args: &DeformArgs) -> Result<String> {
         .collect();
     let names: Vec<&str> = weights.iter().map(|(n, _)| n.as_str()).collect();
     let w: Vec<Vec<f64>> = weights.iter().map(|(_, v)| v.clone()).collect();
-    let (posed, warnings) =
-        skin_named(mesh.positions(), &w, &transforms, &names, args.skinning).map_err(|e| e.in_file(&args.weights))?;
+    let (posed, warnings) = skin_named(mesh.positions(), &w, &transforms, &names, args.skinning).map_err(|e| {
+        // problems of a transform belong to the pose file, of the weights to the weights file
+        let about_pose = ["transform", "reflection", "singular", "rotation"].iter().any(|k| e.to_string().contains(k));
+        e.in_file(if about_pose { &args.transforms } else { &args.weights })
+    })?;
     let posed_mesh = TriMesh::new(posed.clone(), mesh.faces().to_vec());
     let mut staged: Vec<Staged> = vec![stage_geometry(&args.output, &posed, mesh.faces())?];
     // the most moved handle colours the picture

@@ -55,6 +55,19 @@ struct DiffuseReport {
 /// Runs `diffuse`.
 pub fn diffuse(args: &DiffuseArgs) -> Result<String> {
     let start = Instant::now();
+    let weights_path = args.weights.clone().unwrap_or_else(|| {
+        let stem = args.output.file_stem().unwrap_or_default().to_string_lossy().to_string();
+        args.output.with_file_name(format!("{stem}_weights.vtu"))
+    });
+    super::check_distinct(
+        &[args.input.as_path(), args.colors.as_path()],
+        &[
+            ("-o", Some(&args.output)),
+            ("--weights", is_image(&args.input).then_some(weights_path.as_path())),
+            ("--plot", args.plot.as_deref()),
+            ("--report", args.report.as_deref()),
+        ],
+    )?;
     let text =
         std::fs::read_to_string(&args.colors).map_err(|source| Error::Io { path: args.colors.clone(), source })?;
     let points = parse_colors(&text).map_err(|e| e.in_file(&args.colors))?;
@@ -142,11 +155,8 @@ pub fn diffuse(args: &DiffuseArgs) -> Result<String> {
                 img.put_pixel((p % pm.width) as u32, (p / pm.width) as u32, image::Rgba([c[0], c[1], c[2], 255]));
             }
             staged.push(stage_png(&args.output, &img)?);
-            let wpath = args.weights.clone().unwrap_or_else(|| {
-                let stem = args.output.file_stem().unwrap_or_default().to_string_lossy().to_string();
-                args.output.with_file_name(format!("{stem}_weights.vtu"))
-            });
-            staged.push(stage_weights(&wpath, &mesh, &names, &sets, &w)?);
+            let wpath = weights_path.clone();
+            staged.push(stage_weights(&wpath, &mesh, &names, &w)?);
             wrote.push(wpath.display().to_string());
             if let Some(path) = &args.plot {
                 staged.push(stage_png(path, &enlarged(&img, pm, &sets, &rgbs))?);
@@ -161,7 +171,7 @@ pub fn diffuse(args: &DiffuseArgs) -> Result<String> {
                 owned.push((format!("weight_{}", names[h]), w.normalised[h].clone()));
                 owned.push((format!("weight_{}_raw", names[h]), f.raw.clone()));
                 owned.push((format!("u_{}", names[h]), f.u.clone()));
-                owned.push((format!("role_{}", names[h]), super::weights::weight_roles(&f.prescribed, &sets, h)));
+                owned.push((format!("role_{}", names[h]), super::weights::weight_roles(&mesh, &f.prescribed)));
             }
             let arrays: Vec<(&str, &[f64])> = owned.iter().map(|(n, v)| (n.as_str(), v.as_slice())).collect();
             staged.push(super::smooth_mesh::stage_mesh_output(&args.output, &mesh, &arrays)?);

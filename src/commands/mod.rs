@@ -47,6 +47,9 @@ pub fn parse_persistence(s: &str) -> Result<Selection> {
 
 /// A number rounded to 6 significant digits, printed in its shortest form (for tables).
 pub fn sig6(v: f64) -> String {
+    if v != 0.0 && v.abs() < 1e-4 {
+        return format!("{:.5e}", v).parse::<f64>().map(|r| format!("{r:e}")).unwrap_or_else(|_| v.to_string());
+    }
     format!("{:.5e}", v).parse::<f64>().map(|r| format!("{r}")).unwrap_or_else(|_| v.to_string())
 }
 

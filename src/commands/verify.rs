@@ -314,15 +314,19 @@ fn verify_weights(
         .collect();
     let mut problems = Vec::new();
     let mut sums = vec![0.0; n];
+    let mut raw_sums = vec![0.0; n];
+    let mut pairs: Vec<(String, Vec<f64>, Vec<f64>)> = Vec::new();
     let mut lines = Vec::new();
     for name in &names {
         let raw = take(&format!("weight_{name}_raw"))?;
         let u = take(&format!("u_{name}"))?;
         let role = take(&format!("role_{name}"))?;
         let normalised = take(&format!("weight_{name}"))?;
-        for (s, w) in sums.iter_mut().zip(&normalised) {
-            *s += w;
+        for v in 0..n {
+            sums[v] += normalised[v];
+            raw_sums[v] += raw[v];
         }
+        pairs.push((name.clone(), raw.clone(), normalised.clone()));
         let mut prescribed = vec![None; n];
         for v in 0..n {
             match Role::from_code(role[v]) {
@@ -337,6 +341,9 @@ fn verify_weights(
             continue;
         }
         let (lo, hi) = vals.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &x| (a.min(x), b.max(x)));
+        if lo != 0.0 || hi != 1.0 {
+            problems.push(format!("{name}: the prescribed values span [{lo}, {hi}]; a weight function is 1 on its handle and 0 on the others"));
+        }
         for v in 0..n {
             let r = role[v];
             if (r == 1.0 && raw[v] != hi) || (r == -1.0 && raw[v] != lo) {
@@ -363,8 +370,17 @@ fn verify_weights(
         }
         lines.push(format!("{name}: {} minimum and {} maximum regions", c.strict_minima, c.strict_maxima));
     }
-    if let Some(v) = (0..n).find(|&v| (sums[v] - 1.0).abs() > 1e-9) {
+    if let Some(v) = (0..n).find(|&v| !((sums[v] - 1.0).abs() <= 1e-9)) {
         problems.push(format!("the normalised weights sum to {} at vertex {v}, not 1", sums[v]));
+    }
+    for (name, raw, normalised) in &pairs {
+        if let Some(v) = (0..n).find(|&v| !((normalised[v] - raw[v] / raw_sums[v]).abs() <= 1e-12)) {
+            problems.push(format!(
+                "weight_{name} at vertex {v} is {}, not weight_{name}_raw divided by the sum of the raw weights ({})",
+                normalised[v],
+                raw[v] / raw_sums[v]
+            ));
+        }
     }
     if !problems.is_empty() {
         return Err(Error::Uncertified { path: Some(args.file.clone()), message: problems.join("; ") });

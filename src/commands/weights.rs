@@ -88,13 +88,18 @@ fn summary(method: WeightMethod, w: &Weights) -> MethodSummary {
     }
 }
 
-/// Role codes of one function (SPEC.md): a single-vertex handle is a kept maximum (its own
-/// function) or minimum (the others'), every other prescribed vertex a fixed region member.
-pub fn weight_roles(prescribed: &[Option<f64>], handles: &[Vec<usize>], which: usize) -> Vec<f64> {
+/// Role codes of one function (SPEC.md): a prescribed vertex that is a region on its own is a
+/// kept maximum (value 1) or minimum (value 0); every other prescribed vertex is a fixed region
+/// member (2), as are single vertices at other values (a cage's boundary).
+pub fn weight_roles<D: crate::domain::Domain>(domain: &D, prescribed: &[Option<f64>]) -> Vec<f64> {
     let mut r: Vec<f64> = prescribed.iter().map(|p| if p.is_some() { 2.0 } else { 0.0 }).collect();
-    for (k, set) in handles.iter().enumerate() {
-        if set.len() == 1 && r[set[0]] == 2.0 {
-            r[set[0]] = if k == which { 1.0 } else { -1.0 };
+    for region in crate::verify::fixed_regions(domain, prescribed) {
+        if let [v] = region[..] {
+            match prescribed[v] {
+                Some(x) if x == 1.0 => r[v] = 1.0,
+                Some(x) if x == 0.0 => r[v] = -1.0,
+                _ => {}
+            }
         }
     }
     r
@@ -102,20 +107,14 @@ pub fn weight_roles(prescribed: &[Option<f64>], handles: &[Vec<usize>], which: u
 
 /// Stages a weights file: per handle `weight_<name>`, `weight_<name>_raw`, `u_<name>`,
 /// `role_<name>` (SPEC.md formats).
-pub fn stage_weights(
-    path: &Path,
-    mesh: &TriMesh,
-    names: &[String],
-    handles: &[Vec<usize>],
-    w: &Weights,
-) -> Result<Staged> {
+pub fn stage_weights(path: &Path, mesh: &TriMesh, names: &[String], w: &Weights) -> Result<Staged> {
     let mut owned: Vec<(String, Vec<f64>)> = Vec::new();
     for (h, f) in w.functions.iter().enumerate() {
         let name = &names[h];
         owned.push((format!("weight_{name}"), w.normalised[h].clone()));
         owned.push((format!("weight_{name}_raw"), f.raw.clone()));
         owned.push((format!("u_{name}"), f.u.clone()));
-        owned.push((format!("role_{name}"), weight_roles(&f.prescribed, handles, h)));
+        owned.push((format!("role_{name}"), weight_roles(mesh, &f.prescribed)));
     }
     let arrays: Vec<(&str, &[f64])> = owned.iter().map(|(n, v)| (n.as_str(), v.as_slice())).collect();
     super::smooth_mesh::stage_mesh_output(path, mesh, &arrays)
@@ -124,6 +123,21 @@ pub fn stage_weights(
 /// Runs `weights`.
 pub fn weights(args: &WeightsArgs) -> Result<String> {
     let start = Instant::now();
+    let cage_path = cage_output_path(args);
+    super::check_distinct(
+        &[args.input.as_path(), args.handles.as_path()],
+        &[
+            ("-o", Some(&args.output)),
+            ("--plot", args.plot.as_deref()),
+            ("--report", args.report.as_deref()),
+            ("--cage-output", Some(&cage_path)),
+        ],
+    )?;
+    if let Some(a) = args.cage_max_area {
+        if !(a.is_finite() && a > 0.0) {
+            return Err(Error::Usage(format!("--cage-max-area must be finite and > 0, got {a}")));
+        }
+    }
     let (mesh, _) = read_trimesh(&args.input)?;
     let text =
         std::fs::read_to_string(&args.handles).map_err(|source| Error::Io { path: args.handles.clone(), source })?;
@@ -137,6 +151,14 @@ pub fn weights(args: &WeightsArgs) -> Result<String> {
     run_weights(args, &mesh, &names, &sets, start)
 }
 
+/// Where a cage's certified functions go: `--cage-output` or `<output>_cage.vtu`.
+fn cage_output_path(args: &WeightsArgs) -> PathBuf {
+    args.cage_output.clone().unwrap_or_else(|| {
+        let stem = args.output.file_stem().unwrap_or_default().to_string_lossy().to_string();
+        args.output.with_file_name(format!("{stem}_cage.vtu"))
+    })
+}
+
 /// Cage weights: certified on the cage's triangulation (written to `--cage-output`, default
 /// `<output>_cage.vtu`, verifiable), interpolated onto the shape (`weight_<j>` normalised,
 /// `weight_<j>_interpolated` raw; reported, not certified).
@@ -146,17 +168,16 @@ fn run_cage(args: &WeightsArgs, shape: &TriMesh, cage: &[[f64; 2]], start: Insta
             "--compare is for handles; a cage's weights are compared on its own triangulation".into(),
         ));
     }
+    if !shape.is_planar() {
+        return Err(Error::input("a cage needs a planar shape (every vertex at z = 0)").in_file(&args.input));
+    }
     let c = crate::apps::cage::cage_weights(shape, cage, args.cage_max_area, &args.settings)
         .map_err(|e| e.in_file(&args.handles))?;
     let names: Vec<String> = (0..cage.len()).map(|j| j.to_string()).collect();
-    let cage_path = args.cage_output.clone().unwrap_or_else(|| {
-        let stem = args.output.file_stem().unwrap_or_default().to_string_lossy().to_string();
-        args.output.with_file_name(format!("{stem}_cage.vtu"))
-    });
+    let cage_path = cage_output_path(args);
     let cage_mesh = &c.cage_mesh;
     let m = cage.len();
-    let sets: Vec<Vec<usize>> = (0..m).map(|j| vec![j]).collect();
-    let mut staged = vec![stage_weights(&cage_path, cage_mesh, &names, &sets, &c.weights)?];
+    let mut staged = vec![stage_weights(&cage_path, cage_mesh, &names, &c.weights)?];
     let mut owned: Vec<(String, Vec<f64>)> = Vec::new();
     for j in 0..m {
         owned.push((format!("weight_{j}"), c.normalised_on_shape[j].clone()));
@@ -236,7 +257,7 @@ pub fn run_weights(
             }
         }
     }
-    let mut staged = vec![stage_weights(&args.output, mesh, names, sets, &w)?];
+    let mut staged = vec![stage_weights(&args.output, mesh, names, &w)?];
     if let Some(path) = &args.plot {
         let markers: Vec<GridMarker> =
             sets.iter().flat_map(|s| s.iter().map(|&v| GridMarker { index: v, is_max: true })).collect();

@@ -370,11 +370,14 @@ fn verify_weights(
         }
         lines.push(format!("{name}: {} minimum and {} maximum regions", c.strict_minima, c.strict_maxima));
     }
-    if let Some(v) = (0..n).find(|&v| !((sums[v] - 1.0).abs() <= 1e-9)) {
+    if let Some(v) = (0..n).find(|&v| (sums[v] - 1.0).abs().is_nan() || (sums[v] - 1.0).abs() > 1e-9) {
         problems.push(format!("the normalised weights sum to {} at vertex {v}, not 1", sums[v]));
     }
     for (name, raw, normalised) in &pairs {
-        if let Some(v) = (0..n).find(|&v| !((normalised[v] - raw[v] / raw_sums[v]).abs() <= 1e-12)) {
+        if let Some(v) = (0..n).find(|&v| {
+            let d = (normalised[v] - raw[v] / raw_sums[v]).abs();
+            d.is_nan() || d > 1e-12
+        }) {
             problems.push(format!(
                 "weight_{name} at vertex {v} is {}, not weight_{name}_raw divided by the sum of the raw weights ({})",
                 normalised[v],

@@ -96,8 +96,8 @@ pub fn weight_roles<D: crate::domain::Domain>(domain: &D, prescribed: &[Option<f
     for region in crate::verify::fixed_regions(domain, prescribed) {
         if let [v] = region[..] {
             match prescribed[v] {
-                Some(x) if x == 1.0 => r[v] = 1.0,
-                Some(x) if x == 0.0 => r[v] = -1.0,
+                Some(1.0) => r[v] = 1.0,
+                Some(0.0) => r[v] = -1.0,
                 _ => {}
             }
         }

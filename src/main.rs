@@ -122,9 +122,12 @@ enum Command {
         /// Weights: monotone (convex blend, certified) or unconstrained etc. for comparison.
         #[arg(long, value_enum, default_value_t = WeightMethodCli::Monotone)]
         method: WeightMethodCli,
-        /// Enlarged picture with the colour points drawn.
+        /// Picture: the image enlarged with the colour points drawn, or the coloured mesh.
         #[arg(long, value_name = "PNG")]
         plot: Option<PathBuf>,
+        /// Camera of a mesh picture: azimuth and elevation in degrees.
+        #[arg(long, value_name = "AZ,EL")]
+        view: Option<String>,
         /// JSON report.
         #[arg(long, value_name = "JSON")]
         report: Option<PathBuf>,
@@ -587,7 +590,7 @@ fn run(cli: Cli) -> Result<String> {
                 view: parse_view(view.as_deref())?,
             })
         }
-        Command::Diffuse { input, colors, output, weights, order, method, plot, report } => {
+        Command::Diffuse { input, colors, output, weights, order, method, plot, view, report } => {
             commands::diffuse(&commands::DiffuseArgs {
                 input,
                 colors,
@@ -600,6 +603,7 @@ fn run(cli: Cli) -> Result<String> {
                 },
                 plot,
                 report,
+                view: parse_view(view.as_deref())?,
             })
         }
         Command::Mesh { input, output, max_area, min_angle, plot } => {

@@ -384,9 +384,11 @@ fn diffusion_on_a_mesh_writes_colour_arrays() {
         r#"{"points": [{"point": [0, 0], "rgb": [255, 0, 0]}, {"vertex": 40, "rgb": [0, 0, 255]}, {"point": [5, 1], "rgb": [0, 200, 0]}]}"#,
     );
     let o_path = out(&dir, "bar_colours.ply");
-    let o = toposmooth(&["diffuse", &bar, "--colors", &colors, "-o", &o_path]);
+    let png = out(&dir, "bar.png");
+    let o = toposmooth(&["diffuse", &bar, "--colors", &colors, "-o", &o_path, "--plot", &png]);
     assert_eq!(o.status.code(), Some(0), "{}", text(&o));
     assert!(text(&o).contains("0 of 205 vertices outside"), "{}", text(&o));
+    assert!(image::open(&png).unwrap().width() > 300);
     let d = read_mesh(Path::new(&o_path)).unwrap();
     let (r, g, b) = (d.array("red").unwrap().values, d.array("green").unwrap().values, d.array("blue").unwrap().values);
     assert_eq!((r[0], g[0], b[0]), (255.0, 0.0, 0.0));

@@ -10,6 +10,7 @@ use crate::apps::weights::{weights, WeightMethod, WeightSettings};
 use crate::domain::{Domain, TriMesh};
 use crate::error::{Error, Result};
 use crate::io::{stage_json, stage_with, Staged};
+use crate::plot::{plot_mesh_colours, MeshView};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -30,6 +31,8 @@ pub struct DiffuseArgs {
     pub plot: Option<PathBuf>,
     /// Report JSON.
     pub report: Option<PathBuf>,
+    /// Camera of a mesh picture.
+    pub view: MeshView,
 }
 
 fn is_image(path: &Path) -> bool {
@@ -72,9 +75,6 @@ pub fn diffuse(args: &DiffuseArgs) -> Result<String> {
         std::fs::read_to_string(&args.colors).map_err(|source| Error::Io { path: args.colors.clone(), source })?;
     let points = parse_colors(&text).map_err(|e| e.in_file(&args.colors))?;
     let image = is_image(&args.input);
-    if !image && args.plot.is_some() {
-        return Err(Error::Usage("--plot draws diffused images; open a mesh output in ParaView".into()));
-    }
     let (mesh, pm): (TriMesh, Option<PixelMesh>) = if image {
         let img = image::ImageReader::open(&args.input)
             .map_err(|source| Error::Io { path: args.input.clone(), source })?
@@ -175,6 +175,13 @@ pub fn diffuse(args: &DiffuseArgs) -> Result<String> {
             }
             let arrays: Vec<(&str, &[f64])> = owned.iter().map(|(n, v)| (n.as_str(), v.as_slice())).collect();
             staged.push(super::smooth_mesh::stage_mesh_output(&args.output, &mesh, &arrays)?);
+            if let Some(path) = &args.plot {
+                let name = |p: &Path| p.file_name().unwrap_or_default().to_string_lossy().to_string();
+                let title = format!("{} coloured by {}", name(&args.input), name(&args.colors));
+                let view = if mesh.is_planar() { MeshView { azimuth: 0.0, elevation: 90.0 } } else { args.view };
+                staged.push(super::stage_plot(path, |p| plot_mesh_colours(p, mesh.positions(), mesh.faces(), &colours, &title, view))?);
+                wrote.push(path.display().to_string());
+            }
         }
     }
     if let Some(path) = &args.report {

@@ -86,8 +86,7 @@ fn raster(
     screen: &[[f64; 3]],
     towards: [f64; 3],
     triangles: &[[usize; 3]],
-    values: &[f64],
-    scale: &Scale,
+    colour_at: &dyn Fn(&[usize; 3], [f64; 3]) -> [u8; 3],
 ) -> (Vec<u8>, Vec<f64>) {
     let size = PANEL as usize;
     let mut rgb = vec![255u8; size * size * 3];
@@ -119,9 +118,8 @@ fn raster(
                     continue;
                 }
                 depth[k] = z;
-                let value = w0 * values[t[0]] + w1 * values[t[1]] + w2 * values[t[2]];
-                let RGBColor(r, g, bl) = scale.colour(value);
-                rgb[3 * k..3 * k + 3].copy_from_slice(&[r, g, bl].map(|ch| (ch as f64 * shade).round() as u8));
+                let colour = colour_at(t, [w0, w1, w2]);
+                rgb[3 * k..3 * k + 3].copy_from_slice(&colour.map(|ch| (ch as f64 * shade).round() as u8));
             }
         }
     }
@@ -173,7 +171,12 @@ pub fn plot_mesh_fields(
                 (x0 + PANEL as i32 / 2, y0 - PANEL_TITLE_H as i32 / 2),
                 centred(17.0),
             ))?;
-            let (rgb, depth) = raster(positions, &screen, towards, triangles, panel.values, &scale);
+            let values = panel.values;
+            let colour_at = |t: &[usize; 3], w: [f64; 3]| {
+                let RGBColor(r, g, b) = scale.colour(w[0] * values[t[0]] + w[1] * values[t[1]] + w[2] * values[t[2]]);
+                [r, g, b]
+            };
+            let (rgb, depth) = raster(positions, &screen, towards, triangles, &colour_at);
             root.draw(&BitMapElement::with_owned_buffer((x0, y0), (PANEL, PANEL), rgb).ok_or("panel buffer")?)?;
             let r = if markers.len() > 100 { 3 } else { 5 };
             for m in markers.iter().filter(|m| m.index < n) {
@@ -209,6 +212,37 @@ pub fn plot_mesh_fields(
         draw_colour_bar_at(root, ((bx, (TITLE_H + PANEL_TITLE_H) as i32), (BAR_W, PANEL)), &scale, false)
     })?;
     Ok(hidden)
+}
+
+/// Draws a mesh with per-vertex 8-bit colours (interpolated inside triangles; a view, not a
+/// certified array): the picture of a colour diffusion on a mesh.
+///
+/// # Errors
+/// A colour array of the wrong length, or a drawing or writing failure.
+pub fn plot_mesh_colours(
+    path: &Path,
+    positions: &[[f64; 3]],
+    triangles: &[[usize; 3]],
+    colours: &[[u8; 3]],
+    title: &str,
+    view: MeshView,
+) -> Result<(), PlotError> {
+    if colours.len() != positions.len() {
+        return Err(PlotError(format!("plot {}: {} colours for {} vertices", path.display(), colours.len(), positions.len())));
+    }
+    let (screen, towards) = project(positions, view);
+    let size = (2 * MARGIN + PANEL, TITLE_H + PANEL + MARGIN);
+    render(path, size, |root, _| {
+        let centred = TextStyle::from((FONT, 20.0).into_font()).pos(Pos::new(HPos::Center, VPos::Center));
+        root.draw(&Text::new(title, (size.0 as i32 / 2, TITLE_H as i32 / 2 + 2), centred))?;
+        let colour_at = |t: &[usize; 3], w: [f64; 3]| {
+            std::array::from_fn(|ch| (0..3).map(|k| w[k] * f64::from(colours[t[k]][ch])).sum::<f64>().round().clamp(0.0, 255.0) as u8)
+        };
+        let (rgb, _) = raster(positions, &screen, towards, triangles, &colour_at);
+        root.draw(&BitMapElement::with_owned_buffer((MARGIN as i32, TITLE_H as i32), (PANEL, PANEL), rgb).ok_or("panel buffer")?)?;
+        Ok(())
+    })?;
+    Ok(())
 }
 
 #[cfg(test)]

@@ -18,7 +18,7 @@ mod grid;
 mod mesh;
 mod triangulation;
 pub use grid::{plot_grid_fields, GridMarker, GridPanel, GridPlotOptions};
-pub use mesh::{plot_mesh_fields, MeshView};
+pub use mesh::{plot_mesh_colours, plot_mesh_fields, MeshView};
 pub use triangulation::plot_triangulation;
 
 /// Error of a plot: carries a message.

@@ -52,6 +52,15 @@ fn bar_obj(dir: &Path, nx: usize, ny: usize) -> String {
     write(dir, "bar.obj", &s)
 }
 
+/// Writes `data` (positions, triangles, arrays) as .vtu to `path`.
+fn write_vtu(path: &str, data: &toposmooth::io::mesh::MeshData) {
+    let arrays: Vec<(&str, &[f64])> = data.arrays.iter().map(|x| (x.name.as_str(), x.values.as_slice())).collect();
+    toposmooth::io::vtk::stage_vtu(Path::new(path), &data.positions, &data.triangles, &arrays)
+        .unwrap()
+        .commit()
+        .unwrap();
+}
+
 fn out(dir: &Path, name: &str) -> String {
     dir.join(name).display().to_string()
 }

@@ -114,6 +114,28 @@ pub struct WeightFunction {
     pub seconds: f64,
 }
 
+impl WeightFunction {
+    /// A function not computed yet: its representative and prescribed values.
+    fn new(handle: usize, u: Vec<f64>, prescribed: Vec<Option<f64>>, filled: usize, refinements: usize) -> Self {
+        WeightFunction {
+            handle,
+            raw: Vec::new(),
+            u,
+            prescribed,
+            filled,
+            refinements,
+            certificate: Certificate::default(),
+            spurious: Spurious::default(),
+            constraints: 0,
+            margin: 0.0,
+            solver_status: None,
+            solver_iterations: 0,
+            repaired: 0,
+            seconds: 0.0,
+        }
+    }
+}
+
 /// All weight functions of a run.
 #[derive(Clone, Debug)]
 pub struct Weights {
@@ -217,22 +239,7 @@ fn one_function<D: Smoothable>(
         path: None,
         message: format!("handle {which}: harmonic representative: {e}"),
     })?;
-    let mut out = WeightFunction {
-        refinements,
-        handle: which,
-        raw: Vec::new(),
-        u,
-        prescribed: fixed,
-        filled,
-        certificate: Certificate::default(),
-        spurious: Spurious::default(),
-        constraints: 0,
-        margin: 0.0,
-        solver_status: None,
-        solver_iterations: 0,
-        repaired: 0,
-        seconds: 0.0,
-    };
+    let mut out = WeightFunction::new(which, u, fixed, filled, refinements);
     let fixed = &out.prescribed;
     out.raw = match settings.method {
         WeightMethod::Monotone => {
@@ -422,24 +429,11 @@ fn bounded<D: Smoothable>(
     for (which, g) in given.iter().enumerate() {
         let mut prescribed = g.clone();
         let filled = fill_rule(domain, &mut prescribed);
-        let u = dirichlet_solve(&ops.fill, &prescribed)
-            .map_err(|e| Error::input(format!("handle {which}: representative function: {e}")))?;
-        functions.push(WeightFunction {
-            refinements: 0,
-            handle: which,
-            raw: Vec::new(),
-            u,
-            prescribed,
-            filled,
-            certificate: Certificate::default(),
-            spurious: Spurious::default(),
-            constraints: 0,
-            margin: 0.0,
-            solver_status: None,
-            solver_iterations: 0,
-            repaired: 0,
-            seconds: 0.0,
-        });
+        let (u, refinements) = ordered_harmonic(domain, &ops.fill, &prescribed).map_err(|e| Error::Representative {
+            path: None,
+            message: format!("handle {which}: harmonic representative: {e}"),
+        })?;
+        functions.push(WeightFunction::new(which, u, prescribed, filled, refinements));
     }
     let fixed: Vec<Vec<Option<f64>>> = functions.iter().map(|f| f.prescribed.clone()).collect();
     let (w, status, it) = solve_bounded_partition(&ops.energy, &fixed, &settings.qp)?;

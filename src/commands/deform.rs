@@ -169,9 +169,7 @@ pub fn deform(args: &DeformArgs) -> Result<String> {
         args.skinning,
         sig6(max_move)
     );
-    let wrote: Vec<String> =
-        [Some(&args.output), args.plot.as_ref()].into_iter().flatten().map(|p| p.display().to_string()).collect();
-    text += &format!("wrote {}\n", wrote.join(", "));
+    text += &super::wrote_line([Some(&args.output), args.plot.as_ref()]);
     Ok(text)
 }
 

@@ -179,7 +179,9 @@ pub fn diffuse(args: &DiffuseArgs) -> Result<String> {
                 let name = |p: &Path| p.file_name().unwrap_or_default().to_string_lossy().to_string();
                 let title = format!("{} coloured by {}", name(&args.input), name(&args.colors));
                 let view = if mesh.is_planar() { MeshView { azimuth: 0.0, elevation: 90.0 } } else { args.view };
-                staged.push(super::stage_plot(path, |p| plot_mesh_colours(p, mesh.positions(), mesh.faces(), &colours, &title, view))?);
+                staged.push(super::stage_plot(path, |p| {
+                    plot_mesh_colours(p, mesh.positions(), mesh.faces(), &colours, &title, view)
+                })?);
                 wrote.push(path.display().to_string());
             }
         }

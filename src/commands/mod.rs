@@ -92,6 +92,12 @@ fn stage_plot(
     crate::io::stage_with(path, |tmp| draw(tmp).map_err(|e| std::io::Error::other(e.to_string())))
 }
 
+/// The line listing the files written (the given paths, skipping `None`).
+fn wrote_line<'a>(paths: impl IntoIterator<Item = Option<&'a std::path::PathBuf>>) -> String {
+    let names: Vec<String> = paths.into_iter().flatten().map(|p| p.display().to_string()).collect();
+    format!("wrote {}\n", names.join(", "))
+}
+
 /// Output paths must differ from each other and from the inputs (symbolic links resolved),
 /// and none may be a directory: checked before any work, so that no output is half written.
 fn check_distinct(inputs: &[&Path], outputs: &[(&str, Option<&Path>)]) -> Result<()> {

@@ -225,12 +225,7 @@ fn run_cage(args: &WeightsArgs, shape: &TriMesh, cage: &[[f64; 2]], start: Insta
         sig6(c.reproduction_error)
     );
     text += &format!("seconds: {}\n", sig6(start.elapsed().as_secs_f64()));
-    let wrote: Vec<String> = [Some(&args.output), Some(&cage_path), args.plot.as_ref()]
-        .into_iter()
-        .flatten()
-        .map(|p| p.display().to_string())
-        .collect();
-    text += &format!("wrote {}\n", wrote.join(", "));
+    text += &super::wrote_line([Some(&args.output), Some(&cage_path), args.plot.as_ref()]);
     Ok(text)
 }
 
@@ -383,11 +378,6 @@ fn finish(
         args.settings.threads,
         sig6(start.elapsed().as_secs_f64())
     );
-    let wrote: Vec<String> = [Some(&args.output), args.plot.as_ref(), args.report.as_ref()]
-        .into_iter()
-        .flatten()
-        .map(|p| p.display().to_string())
-        .collect();
-    text += &format!("wrote {}\n", wrote.join(", "));
+    text += &super::wrote_line([Some(&args.output), args.plot.as_ref(), args.report.as_ref()]);
     Ok(text)
 }

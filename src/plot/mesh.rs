@@ -80,13 +80,16 @@ fn project(positions: &[[f64; 3]], view: MeshView) -> (Vec<[f64; 3]>, [f64; 3]) 
     (screen, w)
 }
 
+/// The colour of a pixel from its triangle and barycentric weights.
+type ColourAt<'a> = dyn Fn(&[usize; 3], [f64; 3]) -> [u8; 3] + 'a;
+
 /// Rasterises one panel: RGB pixels and the depth buffer.
 fn raster(
     positions: &[[f64; 3]],
     screen: &[[f64; 3]],
     towards: [f64; 3],
     triangles: &[[usize; 3]],
-    colour_at: &dyn Fn(&[usize; 3], [f64; 3]) -> [u8; 3],
+    colour_at: &ColourAt,
 ) -> (Vec<u8>, Vec<f64>) {
     let size = PANEL as usize;
     let mut rgb = vec![255u8; size * size * 3];
@@ -228,7 +231,12 @@ pub fn plot_mesh_colours(
     view: MeshView,
 ) -> Result<(), PlotError> {
     if colours.len() != positions.len() {
-        return Err(PlotError(format!("plot {}: {} colours for {} vertices", path.display(), colours.len(), positions.len())));
+        return Err(PlotError(format!(
+            "plot {}: {} colours for {} vertices",
+            path.display(),
+            colours.len(),
+            positions.len()
+        )));
     }
     let (screen, towards) = project(positions, view);
     let size = (2 * MARGIN + PANEL, TITLE_H + PANEL + MARGIN);
@@ -236,10 +244,15 @@ pub fn plot_mesh_colours(
         let centred = TextStyle::from((FONT, 20.0).into_font()).pos(Pos::new(HPos::Center, VPos::Center));
         root.draw(&Text::new(title, (size.0 as i32 / 2, TITLE_H as i32 / 2 + 2), centred))?;
         let colour_at = |t: &[usize; 3], w: [f64; 3]| {
-            std::array::from_fn(|ch| (0..3).map(|k| w[k] * f64::from(colours[t[k]][ch])).sum::<f64>().round().clamp(0.0, 255.0) as u8)
+            std::array::from_fn(|ch| {
+                (0..3).map(|k| w[k] * f64::from(colours[t[k]][ch])).sum::<f64>().round().clamp(0.0, 255.0) as u8
+            })
         };
         let (rgb, _) = raster(positions, &screen, towards, triangles, &colour_at);
-        root.draw(&BitMapElement::with_owned_buffer((MARGIN as i32, TITLE_H as i32), (PANEL, PANEL), rgb).ok_or("panel buffer")?)?;
+        root.draw(
+            &BitMapElement::with_owned_buffer((MARGIN as i32, TITLE_H as i32), (PANEL, PANEL), rgb)
+                .ok_or("panel buffer")?,
+        )?;
         Ok(())
     })?;
     Ok(())

@@ -121,11 +121,7 @@ fn four_methods_on_a_bar_with_two_point_handles() {
     let k = tampered.arrays.iter().position(|x| x.name == "weight_a_raw").unwrap();
     tampered.arrays[k].values[100] = 2.0;
     let bad = out(&dir, "tampered.vtu");
-    let arrays: Vec<(&str, &[f64])> = tampered.arrays.iter().map(|x| (x.name.as_str(), x.values.as_slice())).collect();
-    toposmooth::io::vtk::stage_vtu(Path::new(&bad), &tampered.positions, &tampered.triangles, &arrays)
-        .unwrap()
-        .commit()
-        .unwrap();
+    write_vtu(&bad, &tampered);
     let o = toposmooth(&["verify", &bad]);
     assert_eq!(o.status.code(), Some(1), "{}", text(&o));
 }
@@ -473,11 +469,7 @@ fn adjacent_handles_form_one_region_and_tampered_weights_fail_verify() {
         let mut t = d.clone();
         f(&mut t);
         let path = out(&dir, name);
-        let arrays: Vec<(&str, &[f64])> = t.arrays.iter().map(|x| (x.name.as_str(), x.values.as_slice())).collect();
-        toposmooth::io::vtk::stage_vtu(Path::new(&path), &t.positions, &t.triangles, &arrays)
-            .unwrap()
-            .commit()
-            .unwrap();
+        write_vtu(&path, &t);
         let o = toposmooth(&["verify", &path]);
         assert_eq!(o.status.code(), Some(1), "{name}: {}", text(&o));
     };

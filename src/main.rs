@@ -47,7 +47,7 @@ enum Command {
     },
     /// Smooth a series keeping exactly the selected extrema; certify the output.
     Smooth(Box<SmoothCli>),
-    /// Re-check an output file of `smooth` from what it carries.
+    /// Re-check an output file of `smooth` (or a weights file of `weights`/`diffuse`) from what it carries.
     Verify {
         /// Output file of `smooth`: series CSV (x,input,output,u,role), .vti, .npz, .vtu, .vtp
         /// or .ply.
@@ -341,7 +341,7 @@ fn weight_method(m: WeightMethodCli) -> WeightMethod {
 struct WeightsCli {
     /// Mesh: .obj, .off, .ply, .vtu, .vtp (a planar mesh for 2D shapes).
     input: PathBuf,
-    /// handles.json: points, bones, vertex lists (SPEC.md formats).
+    /// handles.json: points, bones, vertex lists, or a 2D cage (SPEC.md formats).
     #[arg(long, value_name = "JSON")]
     handles: PathBuf,
     /// Output mesh (.vtu, .vtp, .ply) with weight_<name>, weight_<name>_raw, u_<name>, role_<name>.

@@ -263,9 +263,27 @@ fn cage_weights_on_the_horse() {
     let dir = scratch("nodata_cage");
     let horse = dataset("horse_silhouette_2d.obj");
     let w = out(&dir, "w.vtu");
-    let o = toposmooth(&["weights", &horse, "--handles", &dataset("horse_cage.json"), "-o", &w, "--order", "1"]);
+    let report = out(&dir, "r.json");
+    let o = toposmooth(&[
+        "weights",
+        &horse,
+        "--handles",
+        &dataset("horse_cage.json"),
+        "-o",
+        &w,
+        "--order",
+        "1",
+        "--report",
+        &report,
+    ]);
     assert_eq!(o.status.code(), Some(0), "{}", text(&o));
     assert!(text(&o).contains("7 of 7 monotone functions"), "{}", text(&o));
+    let r: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    assert!(r["linear_reproduction_error"].as_f64().unwrap() < 1e-6);
+    // the interpolated weights are not certified: verify points to the cage file
+    let o = toposmooth(&["verify", &w]);
+    assert_eq!(o.status.code(), Some(2), "{}", text(&o));
+    assert!(text(&o).contains("_cage.vtu"), "{}", text(&o));
     let o = toposmooth(&["verify", &out(&dir, "w_cage.vtu")]);
     assert_eq!(o.status.code(), Some(0), "{}", text(&o));
     let d = read_mesh(Path::new(&w)).unwrap();
@@ -401,6 +419,17 @@ fn diffusion_on_a_mesh_writes_colour_arrays() {
     assert!(g.iter().all(|&x| x <= 200.0));
     let o = toposmooth(&["verify", &o_path]);
     assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+    // a colour moved outside the box is caught
+    let mut d = d;
+    let k = d.arrays.iter().position(|a| a.name == "green").unwrap();
+    d.arrays[k].values[100] = 250.0;
+    let bad_path = out(&dir, "bad_colour.vtu");
+    write_vtu(&bad_path, &d);
+    let o = toposmooth(&["verify", &bad_path]);
+    assert_eq!(o.status.code(), Some(1), "{}", text(&o));
+    // --weights is for images
+    let o = toposmooth(&["diffuse", &bar, "--colors", &colors, "-o", &o_path, "--weights", &out(&dir, "w.vtu")]);
+    assert_eq!(o.status.code(), Some(2), "{}", text(&o));
     // an image-only field on a mesh is refused
     let bad = write(
         &dir,
@@ -473,6 +502,27 @@ fn adjacent_handles_form_one_region_and_tampered_weights_fail_verify() {
         let o = toposmooth(&["verify", &path]);
         assert_eq!(o.status.code(), Some(1), "{name}: {}", text(&o));
     };
+    // a spurious maximum hidden behind role 2, and a region member marked as a lone extremum
+    tamper("hidden.vtu", &|t| {
+        let at = |t: &toposmooth::io::mesh::MeshData, n: &str| t.arrays.iter().position(|a| a.name == n).unwrap();
+        let (raw, u, role) = (at(t, "weight_a_raw"), at(t, "u_a"), at(t, "role_a"));
+        t.arrays[raw].values[30] = 0.999;
+        t.arrays[u].values[30] = 0.999;
+        t.arrays[role].values[30] = 2.0;
+        // renormalise so that only the fixed value gives it away
+        let raws: Vec<Vec<f64>> =
+            ["a", "b", "c"].iter().map(|h| t.arrays[at(t, &format!("weight_{h}_raw"))].values.clone()).collect();
+        for (k, h) in ["a", "b", "c"].iter().enumerate() {
+            let i = at(t, &format!("weight_{h}"));
+            for (v, w) in t.arrays[i].values.iter_mut().enumerate() {
+                *w = raws[k][v] / (raws[0][v] + raws[1][v] + raws[2][v]);
+            }
+        }
+    });
+    tamper("lone.vtu", &|t| {
+        let role = t.arrays.iter().position(|a| a.name == "role_c").unwrap();
+        t.arrays[role].values[0] = -1.0;
+    });
     let scale = |t: &mut toposmooth::io::mesh::MeshData| {
         for a in t.arrays.iter_mut().filter(|a| a.name == "weight_c_raw" || a.name == "u_c") {
             a.values.iter_mut().for_each(|x| *x *= 0.5);

@@ -75,6 +75,12 @@ pub fn diffuse(args: &DiffuseArgs) -> Result<String> {
         std::fs::read_to_string(&args.colors).map_err(|source| Error::Io { path: args.colors.clone(), source })?;
     let points = parse_colors(&text).map_err(|e| e.in_file(&args.colors))?;
     let image = is_image(&args.input);
+    if !image && args.weights.is_some() {
+        return Err(Error::Usage(
+            "--weights is for images; on a mesh the weights are written into the -o file beside red, green, blue"
+                .into(),
+        ));
+    }
     let (mesh, pm): (TriMesh, Option<PixelMesh>) = if image {
         let img = image::ImageReader::open(&args.input)
             .map_err(|source| Error::Io { path: args.input.clone(), source })?

@@ -217,6 +217,12 @@ fn verify_mesh(args: &VerifyArgs) -> Result<String> {
     if data.arrays.iter().any(|a| a.name.starts_with("weight_") && a.name.ends_with("_raw")) {
         return verify_weights(args, &mesh, &data);
     }
+    if data.arrays.iter().any(|a| a.name.starts_with("weight_") && a.name.ends_with("_interpolated")) {
+        return Err(Error::Usage(format!(
+            "{}: cage weights interpolated onto a shape are reported, not certified; verify the cage file `weights` wrote beside it (<output>_cage.vtu)",
+            args.file.display()
+        )));
+    }
     let n = mesh.n_vertices();
     let take = |name: &str| -> Result<Vec<f64>> {
         let a = data.array(name).map_err(|m| {
@@ -316,6 +322,7 @@ fn verify_weights(
     let mut sums = vec![0.0; n];
     let mut raw_sums = vec![0.0; n];
     let mut pairs: Vec<(String, Vec<f64>, Vec<f64>)> = Vec::new();
+    let mut structure: Vec<FixedSet> = Vec::new();
     let mut lines = Vec::new();
     for name in &names {
         let raw = take(&format!("weight_{name}_raw"))?;
@@ -335,6 +342,7 @@ fn verify_weights(
                 _ => return Err(bad(format!("role_{name}: {} at vertex {v} is not one of −1, 0, 1, 2", role[v]))),
             }
         }
+        structure.push((name.clone(), prescribed.clone(), role.clone()));
         let vals: Vec<f64> = prescribed.iter().flatten().copied().collect();
         if vals.is_empty() {
             problems.push(format!("{name}: no prescribed vertex"));
@@ -370,6 +378,27 @@ fn verify_weights(
         }
         lines.push(format!("{name}: {} minimum and {} maximum regions", c.strict_minima, c.strict_maxima));
     }
+    problems.extend(structure_problems(mesh, &structure));
+    // a diffusion output: every colour inside the box of the colours at the handles
+    if let (Ok(r), Ok(g), Ok(b)) = (data.array("red"), data.array("green"), data.array("blue")) {
+        let rgb = [r.values, g.values, b.values];
+        let mut lo = [f64::INFINITY; 3];
+        let mut hi = [f64::NEG_INFINITY; 3];
+        for (_, prescribed, _) in &structure {
+            for v in (0..n).filter(|&v| prescribed[v] == Some(1.0)) {
+                for ch in 0..3 {
+                    lo[ch] = lo[ch].min(rgb[ch][v]);
+                    hi[ch] = hi[ch].max(rgb[ch][v]);
+                }
+            }
+        }
+        let outside = (0..n).filter(|&v| (0..3).any(|ch| !(rgb[ch][v] >= lo[ch] && rgb[ch][v] <= hi[ch]))).count();
+        if outside > 0 {
+            problems.push(format!("{outside} vertices have colours outside the box of the colours at the handles"));
+        } else {
+            lines.push("colours inside the handles' box".into());
+        }
+    }
     if let Some(v) = (0..n).find(|&v| (sums[v] - 1.0).abs().is_nan() || (sums[v] - 1.0).abs() > 1e-9) {
         problems.push(format!("the normalised weights sum to {} at vertex {v}, not 1", sums[v]));
     }
@@ -394,4 +423,80 @@ fn verify_weights(
         names.len(),
         lines.join("; ")
     ))
+}
+
+/// What a weights file's fixed sets must look like beyond each function's certificate, so that
+/// a role code cannot hide an extremum. A cage file fixes exactly the mesh's boundary in every
+/// function. Otherwise (handles) every fixed value is 0 or 1, a single-vertex region has role
+/// ±1 and the members of larger regions role 2, every function keeps a free vertex, and a
+/// vertex fixed in only some functions (a part filled by the fill rule) has only fixed
+/// neighbours there.
+/// One function of a weights file: name, prescribed values, role codes.
+type FixedSet = (String, Vec<Option<f64>>, Vec<f64>);
+
+fn structure_problems(mesh: &crate::domain::TriMesh, functions: &[FixedSet]) -> Vec<String> {
+    let n = mesh.n_vertices();
+    let mut edges: Vec<(usize, usize)> = mesh
+        .faces()
+        .iter()
+        .flat_map(|t| [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])].map(|(a, b)| (a.min(b), a.max(b))))
+        .collect();
+    edges.sort_unstable();
+    let mut boundary = vec![false; n];
+    let mut i = 0;
+    while i < edges.len() {
+        let mut j = i;
+        while j < edges.len() && edges[j] == edges[i] {
+            j += 1;
+        }
+        if j - i == 1 {
+            boundary[edges[i].0] = true;
+            boundary[edges[i].1] = true;
+        }
+        i = j;
+    }
+    let cage =
+        boundary.iter().any(|&b| b) && functions.iter().all(|(_, p, _)| (0..n).all(|v| p[v].is_some() == boundary[v]));
+    if cage {
+        return Vec::new();
+    }
+    let mut problems = Vec::new();
+    let fixed_everywhere: Vec<bool> = (0..n).map(|v| functions.iter().all(|(_, p, _)| p[v].is_some())).collect();
+    for (name, prescribed, role) in functions {
+        if let Some(v) = (0..n).find(|&v| prescribed[v].is_some_and(|x| x != 0.0 && x != 1.0)) {
+            problems.push(format!(
+                "{name}: vertex {v} is fixed at {} (handle weights fix 0 or 1 only)",
+                prescribed[v].unwrap_or(f64::NAN)
+            ));
+            continue;
+        }
+        if prescribed.iter().all(Option::is_some) {
+            problems.push(format!("{name}: every vertex is fixed"));
+            continue;
+        }
+        for region in crate::verify::fixed_regions(mesh, prescribed) {
+            let expect = |v: usize| match (region.len(), prescribed[v]) {
+                (1, Some(1.0)) => 1.0,
+                (1, _) => -1.0,
+                _ => 2.0,
+            };
+            if let Some(&v) = region.iter().find(|&&v| role[v] != expect(v)) {
+                problems.push(format!(
+                    "{name}: vertex {v} has role {} but is in a fixed region of {} vertices (expected {})",
+                    role[v],
+                    region.len(),
+                    expect(v)
+                ));
+                break;
+            }
+        }
+        if let Some(v) = (0..n).find(|&v| {
+            prescribed[v].is_some() && !fixed_everywhere[v] && mesh.neighbors(v).any(|w| prescribed[w].is_none())
+        }) {
+            problems.push(format!(
+                "{name}: vertex {v} is fixed in this function only but has a free neighbour (not a part filled by the fill rule)"
+            ));
+        }
+    }
+    problems
 }

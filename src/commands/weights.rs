@@ -171,8 +171,10 @@ fn run_cage(args: &WeightsArgs, shape: &TriMesh, cage: &[[f64; 2]], start: Insta
     if !shape.is_planar() {
         return Err(Error::input("a cage needs a planar shape (every vertex at z = 0)").in_file(&args.input));
     }
-    let c = crate::apps::cage::cage_weights(shape, cage, args.cage_max_area, &args.settings)
-        .map_err(|e| e.in_file(&args.handles))?;
+    let c = crate::apps::cage::cage_weights(shape, cage, args.cage_max_area, &args.settings).map_err(|e| match e {
+        Error::Usage(m) => Error::Usage(m.replace("--max-area", "--cage-max-area")),
+        e => e.in_file(&args.handles),
+    })?;
     let names: Vec<String> = (0..cage.len()).map(|j| j.to_string()).collect();
     let cage_path = cage_output_path(args);
     let cage_mesh = &c.cage_mesh;
@@ -205,6 +207,36 @@ fn run_cage(args: &WeightsArgs, shape: &TriMesh, cage: &[[f64; 2]], start: Insta
             Ok(())
         })?);
     }
+    if let Some(path) = &args.report {
+        #[derive(serde::Serialize)]
+        struct CageReport<'a> {
+            input_file: String,
+            cage_file: String,
+            cage_vertices: usize,
+            cage_mesh_vertices: usize,
+            cage_mesh_triangles: usize,
+            settings: &'a WeightSettings,
+            functions: &'a [crate::apps::weights::WeightFunction],
+            max_normalisation_change: f64,
+            linear_reproduction_error: f64,
+            total_seconds: f64,
+        }
+        staged.push(stage_json(
+            path,
+            &CageReport {
+                input_file: args.input.display().to_string(),
+                cage_file: args.handles.display().to_string(),
+                cage_vertices: m,
+                cage_mesh_vertices: cage_mesh.n_vertices(),
+                cage_mesh_triangles: cage_mesh.faces().len(),
+                settings: &args.settings,
+                functions: &c.weights.functions,
+                max_normalisation_change: c.weights.max_normalisation_change,
+                linear_reproduction_error: c.reproduction_error,
+                total_seconds: start.elapsed().as_secs_f64(),
+            },
+        )?);
+    }
     for s in staged {
         s.commit()?;
     }
@@ -225,7 +257,7 @@ fn run_cage(args: &WeightsArgs, shape: &TriMesh, cage: &[[f64; 2]], start: Insta
         sig6(c.reproduction_error)
     );
     text += &format!("seconds: {}\n", sig6(start.elapsed().as_secs_f64()));
-    text += &super::wrote_line([Some(&args.output), Some(&cage_path), args.plot.as_ref()]);
+    text += &super::wrote_line([Some(&args.output), Some(&cage_path), args.plot.as_ref(), args.report.as_ref()]);
     Ok(text)
 }
 

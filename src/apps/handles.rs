@@ -213,7 +213,9 @@ pub fn resolve(mesh: &TriMesh, handles: &[Handle]) -> Result<Vec<Vec<usize>>> {
     let n = mesh.n_vertices();
     let pos = mesh.positions();
     let h = mean_edge_length(mesh);
-    let planar = mesh.is_planar();
+    // a flat mesh (every vertex at one z): points must lie inside the shape
+    let z0 = pos.first().map_or(0.0, |p| p[2]);
+    let planar = pos.iter().all(|p| p[2] == z0);
     let mut owner: Vec<Option<usize>> = vec![None; n];
     let mut sets: Vec<Vec<usize>> = vec![Vec::new(); handles.len()];
     let claim = |v: usize, k: usize, owner: &mut Vec<Option<usize>>| -> Result<()> {
@@ -271,6 +273,8 @@ pub fn resolve(mesh: &TriMesh, handles: &[Handle]) -> Result<Vec<Vec<usize>>> {
                 }
             }
             HandleShape::Point(p) => {
+                // on a flat mesh a point given in 2D (z = 0) lies in the mesh's plane
+                let p = &if planar && p[2] == 0.0 { [p[0], p[1], z0] } else { *p };
                 let v = (0..n)
                     .min_by(|&a, &b| norm(sub(pos[a], *p)).total_cmp(&norm(sub(pos[b], *p))))
                     .expect("a mesh has vertices");
@@ -390,6 +394,17 @@ mod tests {
             r#"{"handles": [{"name": "a", "bone": [[5,5],[6,5]], "radius": 0.1}, {"name": "b", "vertices": [1]}]}"#
         )
         .contains("no vertex"));
+    }
+
+    #[test]
+    fn a_flat_mesh_off_the_z0_plane_still_refuses_points_outside_it() {
+        let d = shapes::disk(4, 16, &[]);
+        let lifted: Vec<[f64; 3]> = d.positions().iter().map(|p| [p[0], p[1], 5.0]).collect();
+        let mesh = TriMesh::new(lifted, d.faces().to_vec()).unwrap();
+        let ok = handles(r#"{"handles": [{"name": "a", "point": [0.5, 0]}, {"name": "b", "point": [-0.5, 0, 5]}]}"#);
+        assert_eq!(resolve(&mesh, &ok).unwrap().len(), 2);
+        let out = handles(r#"{"handles": [{"name": "a", "point": [1.3, 0]}, {"name": "b", "point": [-0.5, 0]}]}"#);
+        assert!(resolve(&mesh, &out).unwrap_err().to_string().contains("outside"));
     }
 
     #[test]

@@ -411,7 +411,10 @@ pub fn parallelism_for(s: &SymbolicCholesky<usize>) -> Par {
 /// ordering costs more than it saves. `Err` if `A` is not numerically positive definite.
 pub fn solve_spd_once(a: SparseColMatRef<'_, usize, f64>, b: &mut [f64]) -> Result<(), String> {
     let n = a.ncols();
-    let s = cached_amd(a.symbolic())?;
+    let s = cached_symbolic(&LAST_AMD, a.symbolic(), || {
+        factorize_symbolic_cholesky(a.symbolic(), Side::Upper, SymmetricOrdering::Amd, Default::default())
+            .map_err(|e| format!("symbolic Cholesky: {e:?}"))
+    })?;
     let s: &SymbolicCholesky<usize> = &s;
     let par = parallelism_for(s);
     let mut l = vec![0.0f64; s.len_val()];
@@ -427,30 +430,35 @@ pub fn solve_spd_once(a: SparseColMatRef<'_, usize, f64>, b: &mut [f64]) -> Resu
     Ok(())
 }
 
-/// A pattern and its symbolic Cholesky factorisation.
-pub type CachedSymbolic = Option<(SymbolicSparseColMat<usize>, std::rc::Rc<SymbolicCholesky<usize>>)>;
+/// A per-thread slot holding the last pattern analysed and its symbolic factorisation.
+pub type SymbolicSlot = std::cell::RefCell<Option<(SymbolicSparseColMat<usize>, std::rc::Rc<SymbolicCholesky<usize>>)>>;
 
-thread_local! {
-    /// The last pattern [`solve_spd_once`] analysed on this thread: repeated solves on one
-    /// pattern (the representatives of the weight functions of a run) order it once.
-    static LAST_AMD: std::cell::RefCell<CachedSymbolic> =
-        const { std::cell::RefCell::new(None) };
-}
-
-fn cached_amd(p: SymbolicSparseColMatRef<'_, usize>) -> Result<std::rc::Rc<SymbolicCholesky<usize>>, String> {
+/// The symbolic factorisation of `pattern`: the one in `slot` when the slot holds the same
+/// pattern, else `build()`, which is then stored. Repeated problems on one pattern (the weight
+/// functions of a run, each thread taking several) order it once per thread.
+///
+/// # Errors
+/// What `build` returns, or a failure to copy the pattern.
+pub fn cached_symbolic(
+    slot: &'static std::thread::LocalKey<SymbolicSlot>,
+    pattern: SymbolicSparseColMatRef<'_, usize>,
+    build: impl FnOnce() -> Result<SymbolicCholesky<usize>, String>,
+) -> Result<std::rc::Rc<SymbolicCholesky<usize>>, String> {
     let same = |a: &SymbolicSparseColMat<usize>| {
-        a.nrows() == p.nrows() && a.col_ptr() == p.col_ptr() && a.row_idx() == p.row_idx()
+        a.nrows() == pattern.nrows() && a.col_ptr() == pattern.col_ptr() && a.row_idx() == pattern.row_idx()
     };
-    if let Some(s) = LAST_AMD.with(|c| c.borrow().as_ref().filter(|(q, _)| same(q)).map(|(_, s)| s.clone())) {
+    if let Some(s) = slot.with(|c| c.borrow().as_ref().filter(|(q, _)| same(q)).map(|(_, s)| s.clone())) {
         return Ok(s);
     }
-    let s = std::rc::Rc::new(
-        factorize_symbolic_cholesky(p, Side::Upper, SymmetricOrdering::Amd, Default::default())
-            .map_err(|e| format!("symbolic Cholesky: {e:?}"))?,
-    );
-    let owned = p.to_owned().map_err(|e| format!("{e:?}"))?;
-    LAST_AMD.with(|c| *c.borrow_mut() = Some((owned, s.clone())));
+    let s = std::rc::Rc::new(build()?);
+    let owned = pattern.to_owned().map_err(|e| format!("{e:?}"))?;
+    slot.with(|c| *c.borrow_mut() = Some((owned, s.clone())));
     Ok(s)
+}
+
+thread_local! {
+    /// The last pattern [`solve_spd_once`] analysed on this thread.
+    static LAST_AMD: SymbolicSlot = const { std::cell::RefCell::new(None) };
 }
 
 /// The pattern (upper triangle with diagonal) of a matrix given by triplets; for tests and

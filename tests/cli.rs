@@ -2,21 +2,8 @@
 
 mod common;
 
-use common::scratch;
+use common::{dataset, scratch, text, toposmooth};
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
-
-fn toposmooth(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_toposmooth")).args(args).output().expect("runs")
-}
-
-fn dataset(name: &str) -> String {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("datasets").join(name).display().to_string()
-}
-
-fn text(o: &Output) -> String {
-    format!("{}{}", String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr))
-}
 
 fn write(dir: &Path, name: &str, content: &str) -> String {
     let p = dir.join(name);

@@ -3,22 +3,9 @@
 
 mod common;
 
-use common::{grid_extrema, scratch};
+use common::{dataset, grid_extrema, scratch, text, toposmooth};
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
 use toposmooth::io::npz::read_npz;
-
-fn toposmooth(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_toposmooth")).args(args).output().expect("runs")
-}
-
-fn dataset(name: &str) -> String {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("datasets").join(name).display().to_string()
-}
-
-fn text(o: &Output) -> String {
-    format!("{}{}", String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr))
-}
 
 fn path(dir: &Path, name: &str) -> String {
     dir.join(name).display().to_string()

@@ -4,22 +4,9 @@
 
 mod common;
 
-use common::{mesh_extrema, scratch};
+use common::{dataset, mesh_extrema, scratch, text, toposmooth};
 use std::path::Path;
-use std::process::{Command, Output};
 use toposmooth::io::mesh::read_mesh;
-
-fn toposmooth(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_toposmooth")).args(args).output().expect("runs")
-}
-
-fn dataset(name: &str) -> String {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("datasets").join(name).display().to_string()
-}
-
-fn text(o: &Output) -> String {
-    format!("{}{}", String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr))
-}
 
 #[test]
 fn geodesic_distance_keeps_all_its_maxima_on_spot_and_mountain() {

@@ -3,19 +3,10 @@
 
 mod common;
 
-use common::scratch;
+use common::{scratch, text, toposmooth};
 use std::path::Path;
-use std::process::{Command, Output};
 use toposmooth::domain::{triangle_area, TriMesh};
 use toposmooth::io::mesh::read_mesh;
-
-fn toposmooth(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_toposmooth")).args(args).output().expect("runs")
-}
-
-fn text(o: &Output) -> String {
-    format!("{}{}", String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr))
-}
 
 /// The mesh written at `path`, validated, and its total area.
 fn read_back(path: &Path) -> (TriMesh, f64) {

@@ -4,7 +4,7 @@
 //! (1 at the vertex, linear to 0 at its neighbours, 0 on the rest), solved and certified on
 //! that triangulation, then interpolated onto the shape (reported, not certified).
 
-use super::outline::{triangulate, Outline};
+use super::outline::{triangulate, Outline, MAX_TRIANGLES};
 use super::weights::{weights_prescribed, WeightSettings, Weights};
 use crate::domain::{Domain, TriMesh};
 use crate::error::{Error, Result};
@@ -121,6 +121,24 @@ fn interpolate(mesh: &TriMesh, fields: &[Vec<f64>], points: &[[f64; 3]]) -> Resu
     Ok(out)
 }
 
+/// Checks a requested largest triangle area of the cage's triangulation (finite, > 0).
+///
+/// # Errors
+/// [`Error::Usage`] naming `--cage-max-area`.
+pub fn check_max_area(max_area: Option<f64>) -> Result<()> {
+    match max_area {
+        Some(a) if !(a.is_finite() && a > 0.0) => {
+            let shown = if a != 0.0 && a.is_finite() && (a.abs() < 1e-4 || a.abs() > 1e9) {
+                format!("{a:e}")
+            } else {
+                format!("{a}")
+            };
+            Err(Error::Usage(format!("--cage-max-area must be finite and > 0, got {shown}")))
+        }
+        _ => Ok(()),
+    }
+}
+
 /// Computes cage weights for the planar `shape`.
 ///
 /// # Errors
@@ -156,7 +174,16 @@ pub fn cage_weights(
         })
         .sum::<f64>()
         / shape.faces().len() as f64;
-    let cage_mesh = triangulate(&outline, Some(max_area.unwrap_or(mean_area)), 25.0)?;
+    check_max_area(max_area)?;
+    let area = max_area.unwrap_or(mean_area);
+    let estimate = outline.area() / area;
+    if estimate > MAX_TRIANGLES {
+        return Err(Error::Usage(format!(
+            "a largest triangle area of {area:e}{} asks for about {estimate:.3e} triangles in the cage (at most {MAX_TRIANGLES:e}): raise --cage-max-area",
+            if max_area.is_none() { " (the shape's mean)" } else { "" }
+        )));
+    }
+    let cage_mesh = triangulate(&outline, Some(area), 25.0)?;
     let params = boundary_parameters(&cage_mesh, cage);
     let m = cage.len();
     let prescribed: Vec<Vec<Option<f64>>> = (0..m)
@@ -178,9 +205,12 @@ pub fn cage_weights(
         })
         .collect();
     let weights = weights_prescribed(&cage_mesh, &prescribed, settings)?;
-    let raw: Vec<Vec<f64>> = weights.functions.iter().map(|f| f.raw.clone()).collect();
-    let raw_on_shape = interpolate(&cage_mesh, &raw, shape.positions())?;
-    let normalised_on_shape = interpolate(&cage_mesh, &weights.normalised, shape.positions())?;
+    // raw and normalised functions interpolated together: each shape vertex is located once
+    let fields: Vec<Vec<f64>> =
+        weights.functions.iter().map(|f| f.raw.clone()).chain(weights.normalised.iter().cloned()).collect();
+    let mut on_shape = interpolate(&cage_mesh, &fields, shape.positions())?;
+    let normalised_on_shape = on_shape.split_off(m);
+    let raw_on_shape = on_shape;
     let reproduction_error = shape
         .positions()
         .iter()

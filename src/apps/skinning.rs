@@ -260,11 +260,7 @@ pub fn skin_named<S: AsRef<str>>(
             return Err(Error::input(format!("skinning: the weight of `{}` at vertex {v} is {}", name(h), w[v])));
         }
     }
-    for (h, t) in transforms.iter().enumerate() {
-        if t.0.iter().flatten().any(|x| !x.is_finite()) {
-            return Err(Error::input(format!("skinning: the transform of `{}` has a non-finite entry", name(h))));
-        }
-    }
+    check_transforms(transforms, names, Skinning::Lbs)?;
     if let Some(v) = rest.iter().position(|p| p.iter().any(|x| !x.is_finite())) {
         return Err(Error::input(format!("skinning: rest position of vertex {v} is not finite: {:?}", rest[v])));
     }
@@ -304,35 +300,8 @@ pub fn skin_named<S: AsRef<str>>(
             out
         }
         Skinning::Dqs => {
-            let mut dqs = Vec::with_capacity(transforms.len());
-            for (h, t) in transforms.iter().enumerate() {
-                let a = t.linear();
-                let d = det(&a);
-                if is_singular(&a) {
-                    return Err(Error::input(format!(
-                        "skinning: the transform of `{}` has a singular linear part (determinant {d:e}); \
-                         dual quaternions need a rotation",
-                        name(h)
-                    )));
-                }
-                if d < 0.0 {
-                    return Err(Error::input(format!(
-                        "skinning: the transform of `{}` is a reflection (determinant {d}); dual quaternions \
-                         represent rotations only",
-                        name(h)
-                    )));
-                }
-                let r = polar_rotation(&a).ok_or_else(|| {
-                    Error::input(format!("skinning: the rotation part of `{}` could not be computed", name(h)))
-                })?;
-                if fro(&sub3(&a, &r)) > NOT_ROTATION * fro(&r) {
-                    warnings.push(format!(
-                        "dual quaternions use the rotation part of `{}`; its scale/shear is dropped",
-                        name(h)
-                    ));
-                }
-                dqs.push(DualQuat::new(quat_from_rotation(&r), t.translation()));
-            }
+            let (dqs, dq_warnings) = dual_quaternions(transforms, names)?;
+            warnings.extend(dq_warnings);
             let mut out = Vec::with_capacity(n);
             let mut wv = vec![0.0; transforms.len()];
             for v in 0..n {
@@ -350,6 +319,61 @@ pub fn skin_named<S: AsRef<str>>(
         }
     };
     Ok((positions, warnings))
+}
+
+/// Checks the transforms alone, for the method: finite entries; for dual quaternions also a
+/// non-singular, non-reflecting linear part. Returns the warnings (scale or shear dropped by
+/// dual quaternions). [`skin_named`] runs the same checks; a caller that wants to blame the pose
+/// file and not the weights for them runs this first.
+///
+/// # Errors
+/// [`Error::input`] naming the transform.
+pub fn check_transforms<S: AsRef<str>>(transforms: &[Transform], names: &[S], method: Skinning) -> Result<Vec<String>> {
+    for (h, t) in transforms.iter().enumerate() {
+        if t.0.iter().flatten().any(|x| !x.is_finite()) {
+            let name = names.get(h).map_or("?", |n| n.as_ref());
+            return Err(Error::input(format!("skinning: the transform of `{name}` has a non-finite entry")));
+        }
+    }
+    match method {
+        Skinning::Lbs => Ok(Vec::new()),
+        Skinning::Dqs => dual_quaternions(transforms, names).map(|(_, w)| w),
+    }
+}
+
+/// The unit dual quaternion of each transform's rotation part and translation, with a warning
+/// per transform whose scale or shear is dropped.
+fn dual_quaternions<S: AsRef<str>>(transforms: &[Transform], names: &[S]) -> Result<(Vec<DualQuat>, Vec<String>)> {
+    let name = |h: usize| names.get(h).map_or("?", |n| n.as_ref());
+    let mut dqs = Vec::with_capacity(transforms.len());
+    let mut warnings = Vec::new();
+    for (h, t) in transforms.iter().enumerate() {
+        let a = t.linear();
+        let d = det(&a);
+        if is_singular(&a) {
+            return Err(Error::input(format!(
+                "skinning: the transform of `{}` has a singular linear part (determinant {d:e}); \
+                 dual quaternions need a rotation",
+                name(h)
+            )));
+        }
+        if d < 0.0 {
+            return Err(Error::input(format!(
+                "skinning: the transform of `{}` is a reflection (determinant {d}); dual quaternions \
+                 represent rotations only",
+                name(h)
+            )));
+        }
+        let r = polar_rotation(&a).ok_or_else(|| {
+            Error::input(format!("skinning: the rotation part of `{}` could not be computed", name(h)))
+        })?;
+        if fro(&sub3(&a, &r)) > NOT_ROTATION * fro(&r) {
+            warnings
+                .push(format!("dual quaternions use the rotation part of `{}`; its scale/shear is dropped", name(h)));
+        }
+        dqs.push(DualQuat::new(quat_from_rotation(&r), t.translation()));
+    }
+    Ok((dqs, warnings))
 }
 
 /// A 3×3 matrix, row-major.

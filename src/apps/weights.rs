@@ -115,9 +115,16 @@ pub struct WeightFunction {
 }
 
 impl WeightFunction {
-    /// A function not computed yet: its representative and prescribed values.
-    fn new(handle: usize, u: Vec<f64>, prescribed: Vec<Option<f64>>, filled: usize, refinements: usize) -> Self {
-        WeightFunction {
+    /// A function not computed yet: the given fixed values completed by the fill rule, and
+    /// its representative (harmonic with the non-negative-weight Laplacian `fill`).
+    fn prepare<D: Smoothable>(domain: &D, given: &[Option<f64>], handle: usize, fill: &Sparse) -> Result<Self> {
+        let mut prescribed = given.to_vec();
+        let filled = fill_rule(domain, &mut prescribed);
+        let (u, refinements) = ordered_harmonic(domain, fill, &prescribed).map_err(|e| Error::Representative {
+            path: None,
+            message: format!("handle {handle}: harmonic representative: {e}"),
+        })?;
+        Ok(WeightFunction {
             handle,
             raw: Vec::new(),
             u,
@@ -132,7 +139,7 @@ impl WeightFunction {
             solver_iterations: 0,
             repaired: 0,
             seconds: 0.0,
-        }
+        })
     }
 }
 
@@ -156,14 +163,20 @@ pub struct Weights {
 /// The fixed values of handle `which`'s function: 1 on its vertices, 0 on the other handles,
 /// then the fill rule ([`fill_rule`]). Returns the values and the number of filled vertices.
 pub fn prescribed_values<D: Smoothable>(domain: &D, handles: &[Vec<usize>], which: usize) -> (Vec<Option<f64>>, usize) {
-    let mut fixed = vec![None; domain.n_vertices()];
+    let mut fixed = handle_values(domain.n_vertices(), handles, which);
+    let filled = fill_rule(domain, &mut fixed);
+    (fixed, filled)
+}
+
+/// 1 on handle `which`'s vertices, 0 on the other handles', free elsewhere.
+fn handle_values(n: usize, handles: &[Vec<usize>], which: usize) -> Vec<Option<f64>> {
+    let mut fixed = vec![None; n];
     for (k, set) in handles.iter().enumerate() {
         for &v in set {
             fixed[v] = Some(if k == which { 1.0 } else { 0.0 });
         }
     }
-    let filled = fill_rule(domain, &mut fixed);
-    (fixed, filled)
+    fixed
 }
 
 /// SPEC's fill rule: a connected part of free vertices whose fixed neighbours all carry one
@@ -233,13 +246,7 @@ fn one_function<D: Smoothable>(
     settings: &WeightSettings,
 ) -> Result<WeightFunction> {
     let t = Instant::now();
-    let mut fixed = prescribed.to_vec();
-    let filled = fill_rule(domain, &mut fixed);
-    let (u, refinements) = ordered_harmonic(domain, &ops.fill, &fixed).map_err(|e| Error::Representative {
-        path: None,
-        message: format!("handle {which}: harmonic representative: {e}"),
-    })?;
-    let mut out = WeightFunction::new(which, u, fixed, filled, refinements);
+    let mut out = WeightFunction::prepare(domain, prescribed, which, &ops.fill)?;
     let fixed = &out.prescribed;
     out.raw = match settings.method {
         WeightMethod::Monotone => {
@@ -319,17 +326,7 @@ pub fn weights<D: Smoothable + Sync>(domain: &D, handles: &[Vec<usize>], setting
             owner[v] = k;
         }
     }
-    let prescribed: Vec<Vec<Option<f64>>> = (0..handles.len())
-        .map(|which| {
-            let mut fixed = vec![None; n];
-            for (k, set) in handles.iter().enumerate() {
-                for &v in set {
-                    fixed[v] = Some(if k == which { 1.0 } else { 0.0 });
-                }
-            }
-            fixed
-        })
-        .collect();
+    let prescribed: Vec<Vec<Option<f64>>> = (0..handles.len()).map(|which| handle_values(n, handles, which)).collect();
     weights_prescribed(domain, &prescribed, settings)
 }
 
@@ -427,13 +424,7 @@ fn bounded<D: Smoothable>(
     let t = Instant::now();
     let mut functions = Vec::with_capacity(given.len());
     for (which, g) in given.iter().enumerate() {
-        let mut prescribed = g.clone();
-        let filled = fill_rule(domain, &mut prescribed);
-        let (u, refinements) = ordered_harmonic(domain, &ops.fill, &prescribed).map_err(|e| Error::Representative {
-            path: None,
-            message: format!("handle {which}: harmonic representative: {e}"),
-        })?;
-        functions.push(WeightFunction::new(which, u, prescribed, filled, refinements));
+        functions.push(WeightFunction::prepare(domain, g, which, &ops.fill)?);
     }
     let fixed: Vec<Vec<Option<f64>>> = functions.iter().map(|f| f.prescribed.clone()).collect();
     let (w, status, it) = solve_bounded_partition(&ops.energy, &fixed, &settings.qp)?;

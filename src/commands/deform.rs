@@ -3,7 +3,7 @@
 
 use super::input::read_trimesh;
 use super::sig6;
-use crate::apps::skinning::{parse_pose, skin_named, Skinning, Transform};
+use crate::apps::skinning::{check_transforms, parse_pose, skin_named, Skinning, Transform};
 use crate::domain::TriMesh;
 use crate::error::{Error, Result};
 use crate::io::Staged;
@@ -95,11 +95,10 @@ pub fn deform(args: &DeformArgs) -> Result<String> {
         .collect();
     let names: Vec<&str> = weights.iter().map(|(n, _)| n.as_str()).collect();
     let w: Vec<Vec<f64>> = weights.iter().map(|(_, v)| v.clone()).collect();
-    let (posed, warnings) = skin_named(mesh.positions(), &w, &transforms, &names, args.skinning).map_err(|e| {
-        // problems of a transform belong to the pose file, of the weights to the weights file
-        let about_pose = ["transform", "reflection", "singular", "rotation"].iter().any(|k| e.to_string().contains(k));
-        e.in_file(if about_pose { &args.transforms } else { &args.weights })
-    })?;
+    // a transform's problems belong to the pose file, everything else to the weights
+    check_transforms(&transforms, &names, args.skinning).map_err(|e| e.in_file(&args.transforms))?;
+    let (posed, warnings) =
+        skin_named(mesh.positions(), &w, &transforms, &names, args.skinning).map_err(|e| e.in_file(&args.weights))?;
     let posed_mesh = TriMesh::new(posed.clone(), mesh.faces().to_vec());
     let mut staged: Vec<Staged> = vec![stage_geometry(&args.output, &posed, mesh.faces())?];
     // the most moved handle colours the picture

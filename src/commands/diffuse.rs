@@ -81,7 +81,7 @@ pub fn diffuse(args: &DiffuseArgs) -> Result<String> {
                 .into(),
         ));
     }
-    let (mesh, pm): (TriMesh, Option<PixelMesh>) = if image {
+    let (read, pm): (Option<TriMesh>, Option<PixelMesh>) = if image {
         let img = image::ImageReader::open(&args.input)
             .map_err(|source| Error::Io { path: args.input.clone(), source })?
             .with_guessed_format()
@@ -93,7 +93,7 @@ pub fn diffuse(args: &DiffuseArgs) -> Result<String> {
         let (w, h) = (rgba.width() as usize, rgba.height() as usize);
         let inside: Vec<bool> = rgba.pixels().map(|p| !has_alpha || p.0[3] >= 128).collect();
         let pm = pixel_mesh(w, h, &inside).map_err(|e| e.in_file(&args.input))?;
-        (pm.mesh.clone(), Some(pm))
+        (None, Some(pm))
     } else {
         if !args.output.extension().is_some_and(|e| ["vtu", "vtp", "ply"].iter().any(|x| e.eq_ignore_ascii_case(x))) {
             return Err(Error::Usage(format!(
@@ -101,7 +101,12 @@ pub fn diffuse(args: &DiffuseArgs) -> Result<String> {
                 args.output.display()
             )));
         }
-        (read_trimesh(&args.input)?.0, None)
+        (Some(read_trimesh(&args.input)?.0), None)
+    };
+    let mesh: &TriMesh = match (&read, &pm) {
+        (Some(m), _) => m,
+        (None, Some(pm)) => &pm.mesh,
+        (None, None) => unreachable!("an image gives a pixel mesh, a mesh file a mesh"),
     };
     if image && !args.output.extension().is_some_and(|e| e.eq_ignore_ascii_case("png")) {
         return Err(Error::Usage(format!("{}: the diffused image is written as PNG", args.output.display())));
@@ -143,8 +148,8 @@ pub fn diffuse(args: &DiffuseArgs) -> Result<String> {
         };
         handles.push(Handle { name: p.name.clone(), shape });
     }
-    let sets = resolve(&mesh, &handles).map_err(|e| e.in_file(&args.colors))?;
-    let w = weights(&mesh, &sets, &args.settings).map_err(|e| e.in_file(&args.input))?;
+    let sets = resolve(mesh, &handles).map_err(|e| e.in_file(&args.colors))?;
+    let w = weights(mesh, &sets, &args.settings).map_err(|e| e.in_file(&args.input))?;
     let rgbs: Vec<[u8; 3]> = points.iter().map(|p| p.rgb).collect();
     let lin = blend(&w.normalised, &rgbs);
     let colours: Vec<[u8; 3]> = lin.iter().map(|c| c.map(linear_to_srgb8)).collect();
@@ -162,7 +167,7 @@ pub fn diffuse(args: &DiffuseArgs) -> Result<String> {
             }
             staged.push(stage_png(&args.output, &img)?);
             let wpath = weights_path.clone();
-            staged.push(stage_weights(&wpath, &mesh, &names, &w)?);
+            staged.push(stage_weights(&wpath, mesh, &names, &w)?);
             wrote.push(wpath.display().to_string());
             if let Some(path) = &args.plot {
                 staged.push(stage_png(path, &enlarged(&img, pm, &sets, &rgbs))?);
@@ -177,10 +182,10 @@ pub fn diffuse(args: &DiffuseArgs) -> Result<String> {
                 owned.push((format!("weight_{}", names[h]), w.normalised[h].clone()));
                 owned.push((format!("weight_{}_raw", names[h]), f.raw.clone()));
                 owned.push((format!("u_{}", names[h]), f.u.clone()));
-                owned.push((format!("role_{}", names[h]), super::weights::weight_roles(&mesh, &f.prescribed)));
+                owned.push((format!("role_{}", names[h]), super::weights::weight_roles(mesh, &f.prescribed)));
             }
             let arrays: Vec<(&str, &[f64])> = owned.iter().map(|(n, v)| (n.as_str(), v.as_slice())).collect();
-            staged.push(super::smooth_mesh::stage_mesh_output(&args.output, &mesh, &arrays)?);
+            staged.push(super::smooth_mesh::stage_mesh_output(&args.output, mesh, &arrays)?);
             if let Some(path) = &args.plot {
                 let name = |p: &Path| p.file_name().unwrap_or_default().to_string_lossy().to_string();
                 let title = format!("{} coloured by {}", name(&args.input), name(&args.colors));

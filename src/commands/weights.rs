@@ -133,11 +133,7 @@ pub fn weights(args: &WeightsArgs) -> Result<String> {
             ("--cage-output", Some(&cage_path)),
         ],
     )?;
-    if let Some(a) = args.cage_max_area {
-        if !(a.is_finite() && a > 0.0) {
-            return Err(Error::Usage(format!("--cage-max-area must be finite and > 0, got {a}")));
-        }
-    }
+    crate::apps::cage::check_max_area(args.cage_max_area)?;
     let (mesh, _) = read_trimesh(&args.input)?;
     let text =
         std::fs::read_to_string(&args.handles).map_err(|source| Error::Io { path: args.handles.clone(), source })?;
@@ -171,10 +167,8 @@ fn run_cage(args: &WeightsArgs, shape: &TriMesh, cage: &[[f64; 2]], start: Insta
     if !shape.is_planar() {
         return Err(Error::input("a cage needs a planar shape (every vertex at z = 0)").in_file(&args.input));
     }
-    let c = crate::apps::cage::cage_weights(shape, cage, args.cage_max_area, &args.settings).map_err(|e| match e {
-        Error::Usage(m) => Error::Usage(m.replace("--max-area", "--cage-max-area")),
-        e => e.in_file(&args.handles),
-    })?;
+    let c = crate::apps::cage::cage_weights(shape, cage, args.cage_max_area, &args.settings)
+        .map_err(|e| e.in_file(&args.handles))?;
     let names: Vec<String> = (0..cage.len()).map(|j| j.to_string()).collect();
     let cage_path = cage_output_path(args);
     let cage_mesh = &c.cage_mesh;

@@ -17,7 +17,6 @@ use faer::linalg::cholesky::llt::factor::LltRegularization;
 use faer::sparse::linalg::cholesky::{LltRef, SymbolicCholesky};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
 use faer::{Conj, Side, Spec};
-use std::rc::Rc;
 
 /// Upper-triangular pattern of `N` and where each contribution lands in its value array.
 struct Normal {
@@ -107,23 +106,8 @@ impl Normal {
 }
 
 thread_local! {
-    /// The last pattern analysed on this thread and its symbolic factorisation: independent
-    /// problems on one domain (the weight functions of a run) share the normal-equation
-    /// pattern, and the ordering (nested dissection and AMD) is then done once per thread.
-    static LAST: std::cell::RefCell<ordering::CachedSymbolic> =
-        const { std::cell::RefCell::new(None) };
-}
-
-fn cached_symbolic(pattern: &SymbolicSparseColMat<usize>) -> Result<Rc<SymbolicCholesky<usize>>, String> {
-    let same = |a: &SymbolicSparseColMat<usize>| {
-        a.nrows() == pattern.nrows() && a.col_ptr() == pattern.col_ptr() && a.row_idx() == pattern.row_idx()
-    };
-    if let Some(s) = LAST.with(|c| c.borrow().as_ref().filter(|(p, _)| same(p)).map(|(_, s)| s.clone())) {
-        return Ok(s);
-    }
-    let s = Rc::new(ordering::symbolic_cholesky(pattern.as_ref(), Side::Upper)?);
-    LAST.with(|c| *c.borrow_mut() = Some((pattern.clone(), s.clone())));
-    Ok(s)
+    /// The last normal-equation pattern analysed on this thread (nested dissection and AMD).
+    static LAST: ordering::SymbolicSlot = const { std::cell::RefCell::new(None) };
 }
 
 /// Solves the reduced QP; `Err(reason)` when it cannot (the caller falls back to Clarabel).
@@ -176,7 +160,9 @@ pub fn solve(
     };
 
     let normal = Normal::new(r, &row_cols, &row_len);
-    let symbolic_rc = cached_symbolic(&normal.symbolic)?;
+    let symbolic_rc = ordering::cached_symbolic(&LAST, normal.symbolic.as_ref(), || {
+        ordering::symbolic_cholesky(normal.symbolic.as_ref(), Side::Upper)
+    })?;
     let symbolic: &SymbolicCholesky<usize> = &symbolic_rc;
     let par = ordering::parallelism_for(symbolic);
     let mut mem = MemBuffer::try_new(symbolic.factorize_numeric_llt_scratch::<f64>(par, Spec::default()))

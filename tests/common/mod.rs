@@ -101,3 +101,18 @@ pub fn mesh_extrema(n: usize, triangles: &[[usize; 3]], f: &[f64]) -> (Vec<usize
     }
     (mins, maxs, flat)
 }
+
+/// Runs the built binary with `args`.
+pub fn toposmooth(args: &[&str]) -> std::process::Output {
+    std::process::Command::new(env!("CARGO_BIN_EXE_toposmooth")).args(args).output().expect("runs")
+}
+
+/// A bundled dataset's path.
+pub fn dataset(name: &str) -> String {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("datasets").join(name).display().to_string()
+}
+
+/// Standard output and standard error of a run, for messages.
+pub fn text(o: &std::process::Output) -> String {
+    format!("{}{}", String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr))
+}

@@ -443,6 +443,7 @@ fn outputs_never_overwrite_inputs_or_each_other() {
         vec!["weights", &bar, "--handles", &h, "-o", &h],
         vec!["weights", &bar, "--handles", &h, "-o", &w, "--report", &w],
         vec!["weights", &bar, "--handles", &h, "-o", &w, "--cage-output", &w],
+        vec!["weights", &bar, "--handles", &h, "-o", &out(&dir, "w.txt")],
     ] {
         let o = toposmooth(&args);
         assert_eq!(o.status.code(), Some(2), "{args:?}: {}", text(&o));

@@ -68,6 +68,13 @@ pub fn deform(args: &DeformArgs) -> Result<String> {
         &[args.input.as_path(), args.weights.as_path(), args.transforms.as_path()],
         &[("-o", Some(&args.output)), ("--plot", args.plot.as_deref())],
     )?;
+    let ext = args.output.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
+    if !["obj", "off", "ply", "vtu", "vtp"].contains(&ext.as_str()) {
+        return Err(Error::Usage(format!(
+            "{}: a posed mesh is written as .obj, .off, .ply, .vtu or .vtp",
+            args.output.display()
+        )));
+    }
     let (mesh, _) = read_trimesh(&args.input)?;
     let weights = read_weights(args, &mesh)?;
     let text = std::fs::read_to_string(&args.transforms)

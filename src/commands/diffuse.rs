@@ -75,6 +75,9 @@ pub fn diffuse(args: &DiffuseArgs) -> Result<String> {
         std::fs::read_to_string(&args.colors).map_err(|source| Error::Io { path: args.colors.clone(), source })?;
     let points = parse_colors(&text).map_err(|e| e.in_file(&args.colors))?;
     let image = is_image(&args.input);
+    if image {
+        super::smooth_mesh::check_mesh_output(&weights_path)?;
+    }
     if !image && args.weights.is_some() {
         return Err(Error::Usage(
             "--weights is for images; on a mesh the weights are written into the -o file beside red, green, blue"
@@ -95,12 +98,7 @@ pub fn diffuse(args: &DiffuseArgs) -> Result<String> {
         let pm = pixel_mesh(w, h, &inside).map_err(|e| e.in_file(&args.input))?;
         (None, Some(pm))
     } else {
-        if !args.output.extension().is_some_and(|e| ["vtu", "vtp", "ply"].iter().any(|x| e.eq_ignore_ascii_case(x))) {
-            return Err(Error::Usage(format!(
-                "{}: colours diffused on a mesh are written as .vtu, .vtp or .ply (arrays red, green, blue)",
-                args.output.display()
-            )));
-        }
+        super::smooth_mesh::check_mesh_output(&args.output)?;
         (Some(read_trimesh(&args.input)?.0), None)
     };
     let mesh: &TriMesh = match (&read, &pm) {

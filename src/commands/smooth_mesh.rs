@@ -37,6 +37,19 @@ struct MeshRunReport<'a> {
     report: &'a Report,
 }
 
+/// Checks before any work that `path` names a mesh output format (`.vtu`, `.vtp`, `.ply`).
+///
+/// # Errors
+/// [`Error::Usage`] naming the path.
+pub fn check_mesh_output(path: &Path) -> Result<()> {
+    let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
+    if ["vtu", "vtp", "ply"].contains(&ext.as_str()) {
+        Ok(())
+    } else {
+        Err(Error::Usage(format!("{}: a mesh output is written as .vtu, .vtp or .ply", path.display())))
+    }
+}
+
 /// Stages the mesh output (`.vtu`, `.vtp` or `.ply`) with the arrays `input`, `smoothed`,
 /// `representative`, `role` (SPEC.md formats).
 pub fn stage_mesh_output(path: &Path, mesh: &TriMesh, arrays: &[(&str, &[f64])]) -> Result<Staged> {

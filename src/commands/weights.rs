@@ -134,6 +134,10 @@ pub fn weights(args: &WeightsArgs) -> Result<String> {
         ],
     )?;
     crate::apps::cage::check_max_area(args.cage_max_area)?;
+    super::smooth_mesh::check_mesh_output(&args.output)?;
+    if let Some(c) = &args.cage_output {
+        super::smooth_mesh::check_mesh_output(c)?;
+    }
     let (mesh, _) = read_trimesh(&args.input)?;
     let text =
         std::fs::read_to_string(&args.handles).map_err(|source| Error::Io { path: args.handles.clone(), source })?;

@@ -383,16 +383,27 @@ const ND_LEAF: usize = 128;
 /// AMD, whichever needs fewer flops.
 pub fn symbolic_cholesky(a: SymbolicSparseColMatRef<'_, usize>, side: Side) -> Result<SymbolicCholesky<usize>, String> {
     let n = a.ncols();
-    let amd = factorize_symbolic_cholesky(a, side, SymmetricOrdering::Amd, params(n))
-        .map_err(|e| format!("symbolic Cholesky: {e:?}"))?;
+    let amd = || {
+        factorize_symbolic_cholesky(a, side, SymmetricOrdering::Amd, params(n))
+            .map_err(|e| format!("symbolic Cholesky: {e:?}"))
+    };
     if n < ND_MIN_N {
-        return Ok(amd);
+        return amd();
     }
-    let perm = nested_dissection(&Graph::from_pattern(a), ND_LEAF);
-    let inv = inverse(&perm);
-    let p = PermRef::new_checked(&perm, &inv, n);
-    let nd = factorize_symbolic_cholesky(a, side, SymmetricOrdering::Custom(p), params(n))
-        .map_err(|e| format!("symbolic Cholesky: {e:?}"))?;
+    let nd = || {
+        let perm = nested_dissection(&Graph::from_pattern(a), ND_LEAF);
+        let inv = inverse(&perm);
+        let p = PermRef::new_checked(&perm, &inv, n);
+        factorize_symbolic_cholesky(a, side, SymmetricOrdering::Custom(p), params(n))
+            .map_err(|e| format!("symbolic Cholesky: {e:?}"))
+    };
+    // the two analyses run side by side (about equal cost)
+    let (amd, nd) = std::thread::scope(|scope| {
+        let other = scope.spawn(amd);
+        let nd = nd();
+        (other.join().unwrap_or_else(|e| std::panic::resume_unwind(e)), nd)
+    });
+    let (amd, nd) = (amd?, nd?);
     Ok(if factor_flops(&nd) < factor_flops(&amd) { nd } else { amd })
 }
 
@@ -480,7 +491,8 @@ pub fn upper_pattern(n: usize, edges: &[(usize, usize)]) -> SymbolicSparseColMat
     SymbolicSparseColMat::new_checked(n, n, cp, None, ri)
 }
 
-/// A sparse SPD solver for a fixed pattern: the symbolic analysis (AMD) is done once, each
+/// A sparse SPD solver for a fixed pattern: the symbolic analysis ([`symbolic_cholesky`]:
+/// nested dissection or AMD, supernodal above 1,000 unknowns) is done once, each
 /// [`SpdSolver::solve`] refactors the values and solves (for repeated solves with the same
 /// pattern and different values).
 pub struct SpdSolver {
@@ -496,8 +508,7 @@ impl SpdSolver {
     /// # Errors
     /// A message if the analysis or the workspace allocation fails.
     pub fn new(pattern: SymbolicSparseColMatRef<'_, usize>) -> Result<Self, String> {
-        let s = factorize_symbolic_cholesky(pattern, Side::Upper, SymmetricOrdering::Amd, Default::default())
-            .map_err(|e| format!("symbolic Cholesky: {e:?}"))?;
+        let s = symbolic_cholesky(pattern, Side::Upper)?;
         let par = parallelism_for(&s);
         let mem = MemBuffer::try_new(StackReq::any_of(&[
             s.factorize_numeric_llt_scratch::<f64>(par, Spec::default()),

@@ -237,6 +237,7 @@ enum DeriveCli {
 enum RepresentativeCli {
     Separatrix,
     Harmonic,
+    Flooded,
 }
 
 impl GridCli {
@@ -523,6 +524,7 @@ fn smooth_args(c: SmoothCli) -> Result<SmoothArgs> {
         representative: match c.representative {
             RepresentativeCli::Separatrix => RepresentativeChoice::Separatrix,
             RepresentativeCli::Harmonic => RepresentativeChoice::Harmonic,
+            RepresentativeCli::Flooded => RepresentativeChoice::Flooded,
         },
     };
     Ok(SmoothArgs {

@@ -34,6 +34,9 @@ pub enum RepresentativeChoice {
     Separatrix,
     /// Harmonic: kept minima at the data's minimum, kept maxima at its maximum.
     Harmonic,
+    /// The data itself with every cancelled basin flooded to its spill value (Tierny &
+    /// Pascucci 2012; NOTES.md 9), plateaus made strict in flood order.
+    Flooded,
 }
 
 /// A representative function, the construction that produced it and the complex it used.
@@ -158,11 +161,23 @@ fn surface_representative<D: Domain>(
         }
         None
     };
-    let (first, second): (&'static str, &'static str) = match choice {
-        RepresentativeChoice::Separatrix => ("separatrix", "harmonic"),
-        RepresentativeChoice::Harmonic => ("harmonic", "separatrix"),
+    let flooded = |why: &mut Vec<String>| -> Option<Vec<f64>> {
+        let u = flooded_representative(domain, h, kept);
+        if u.is_none() {
+            why.push("flooded representative: the floods did not settle".into());
+        }
+        u
     };
-    let build = |name: &str, why: &mut Vec<String>| if name == "separatrix" { separatrix(why) } else { harmonic(why) };
+    let order: [&'static str; 3] = match choice {
+        RepresentativeChoice::Separatrix => ["separatrix", "harmonic", "flooded"],
+        RepresentativeChoice::Harmonic => ["harmonic", "separatrix", "flooded"],
+        RepresentativeChoice::Flooded => ["flooded", "separatrix", "harmonic"],
+    };
+    let build = |name: &str, why: &mut Vec<String>| match name {
+        "separatrix" => separatrix(why),
+        "harmonic" => harmonic(why),
+        _ => flooded(why),
+    };
     let named = |name: &str, why: &[String]| {
         let name = if name == "separatrix" && released.get() > 0 {
             format!("separatrix ({} contradicting separatrix vertices released to the harmonic fill)", released.get())
@@ -175,18 +190,12 @@ fn surface_representative<D: Domain>(
             format!("{name} (fallback: {})", why.join("; "))
         }
     };
-    for kind in [first, second] {
+    for kind in order {
         if skip(kind) {
             continue;
         }
         if let Some(u) = build(kind, &mut why) {
             return Ok(Representative { u, kind, name: named(kind, &why), complex });
-        }
-    }
-    if !skip("flooded") {
-        match flooded_representative(domain, h, kept) {
-            Some(u) => return Ok(Representative { u, kind: "flooded", name: named("flooded", &why), complex }),
-            None => why.push("flooded representative: the floods did not settle".into()),
         }
     }
     Err(Error::Representative { path: None, message: why.join("; ") })

@@ -156,7 +156,7 @@ fn elevation_formats_and_representatives() {
     let (nx, h) = read_matrix(&volcano);
     let ny = h.len() / nx;
     let mut rms = Vec::new();
-    for rep in ["separatrix", "harmonic"] {
+    for rep in ["separatrix", "harmonic", "flooded"] {
         let (npz_out, json) = (path(&dir, &format!("{rep}.npz")), path(&dir, &format!("{rep}.json")));
         let o = toposmooth(&[
             "smooth",
@@ -179,6 +179,12 @@ fn elevation_formats_and_representatives() {
         rms.push(r["rms_deviation"].as_f64().unwrap());
     }
     assert!(rms.iter().all(|r| *r > 0.0 && *r < 5.0), "{rms:?}");
+    // the flooded representative is the data outside the flooded basins (up to the ulps that
+    // order the ties of these integer elevations), and fits closest
+    let flooded = &npz(&path(&dir, "flooded.npz"))["representative"].1;
+    let untouched = flooded.iter().zip(&h).filter(|(a, b)| (*a - *b).abs() <= 1e-9 * b.abs()).count();
+    assert!(untouched * 2 > h.len(), "{untouched} of {} vertices keep their value", h.len());
+    assert!(rms[2] < rms[0] && rms[2] < rms[1], "{rms:?}");
     // single-array exports hold the same smoothed values
     let (npy, csv) = (path(&dir, "s.npy"), path(&dir, "s.csv"));
     for out in [&npy, &csv] {

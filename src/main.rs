@@ -181,6 +181,9 @@ enum Command {
         /// QP solver.
         #[arg(long, value_enum, default_value_t = Solver::Structured)]
         solver: Solver,
+        /// Representative function on grids and meshes.
+        #[arg(long, value_enum, default_value_t = RepresentativeCli::Separatrix)]
+        representative: RepresentativeCli,
         /// Run one size in this process and print one JSON line.
         #[arg(long, hide = true)]
         single: Option<String>,
@@ -521,11 +524,7 @@ fn smooth_args(c: SmoothCli) -> Result<SmoothArgs> {
         smooth_length: c.smooth_length,
         edges: edge_set(c.edges),
         qp: QpSettings { max_iter: c.max_iter, method: method(c.solver), ..Default::default() },
-        representative: match c.representative {
-            RepresentativeCli::Separatrix => RepresentativeChoice::Separatrix,
-            RepresentativeCli::Harmonic => RepresentativeChoice::Harmonic,
-            RepresentativeCli::Flooded => RepresentativeChoice::Flooded,
-        },
+        representative: representative_choice(c.representative),
     };
     Ok(SmoothArgs {
         input: c.input,
@@ -617,7 +616,7 @@ fn run(cli: Cli) -> Result<String> {
         Command::Bench { weights, weight_orders, .. } if !weights.is_empty() => {
             commands::bench_weights(&weights, &weight_orders, 4)
         }
-        Command::Bench { sizes, order, persistence, edges, seed, single, solver, .. } => {
+        Command::Bench { sizes, order, persistence, edges, seed, single, solver, representative, .. } => {
             let persistence = match commands::parse_persistence(&persistence)? {
                 Selection::Relative(r) => r,
                 _ => return Err(Error::Usage("bench takes --persistence as a percentage".into())),
@@ -630,8 +629,17 @@ fn run(cli: Cli) -> Result<String> {
                 seed,
                 single,
                 method: method(solver),
+                representative: representative_choice(representative),
             })
         }
+    }
+}
+
+fn representative_choice(r: RepresentativeCli) -> RepresentativeChoice {
+    match r {
+        RepresentativeCli::Separatrix => RepresentativeChoice::Separatrix,
+        RepresentativeCli::Harmonic => RepresentativeChoice::Harmonic,
+        RepresentativeCli::Flooded => RepresentativeChoice::Flooded,
     }
 }
 

@@ -261,16 +261,15 @@ pub fn separatrix_representative<D: crate::domain::Domain>(
             }
         };
         for &v in &bad {
-            // around a failing kept extremum the release reaches farther each round
+            // around a failing kept extremum the release reaches one ring further each round
             // (its free neighbours can stay above a kept maximum while prescribed vertices
-            // farther out hold them up)
+            // farther out hold them up; doubling the radius instead made the retina image
+            // release too much and fall back to the harmonic representative)
             let around: Vec<usize> = if kept.roles[v].is_fixed() {
-                // widen until the rings hold a vertex still prescribed (at most 64 rings); the
-                // radius doubles each round, so a kept extremum that releasing cannot mend
-                // costs 7 solves, not 64
+                // widen until the rings hold a vertex still prescribed (at most 64 rings)
                 let r = reach.entry(v).or_insert(0);
                 loop {
-                    *r = (*r * 2).clamp(1, 64);
+                    *r += 1;
                     let ring = rings(domain, v, *r);
                     if *r >= 64 || ring.iter().any(|&w| fixed[w].is_some() && !kept.roles[w].is_fixed()) {
                         break ring;

@@ -7,7 +7,7 @@ use crate::constraints::EdgeSet;
 use crate::domain::{Grid2d, Series};
 use crate::error::{Error, Result};
 use crate::operators::Energy;
-use crate::pipeline::{smooth, SmoothSettings};
+use crate::pipeline::{smooth, RepresentativeChoice, SmoothSettings};
 use crate::solve::{Method, QpSettings};
 use crate::topology::Selection;
 use std::time::Instant;
@@ -29,6 +29,8 @@ pub struct BenchArgs {
     pub single: Option<String>,
     /// QP solver.
     pub method: Method,
+    /// Representative function on grids and meshes.
+    pub representative: RepresentativeChoice,
 }
 
 /// Uniform numbers in [0, 1) from a seed (splitmix64).
@@ -160,6 +162,7 @@ fn run_single(case: BenchCase, args: &BenchArgs) -> Result<String> {
         energy: args.energy.clone(),
         edges: args.edges,
         qp: QpSettings { method: args.method, ..Default::default() },
+        representative: args.representative,
         ..Default::default()
     };
     let t = Instant::now();
@@ -231,6 +234,14 @@ pub fn bench(args: &BenchArgs) -> Result<String> {
                     Method::Clarabel => "clarabel",
                     Method::ClarabelAuxiliary => "clarabel-auxiliary",
                     Method::Structured => "structured",
+                },
+            ])
+            .args([
+                "--representative",
+                match args.representative {
+                    RepresentativeChoice::Separatrix => "separatrix",
+                    RepresentativeChoice::Harmonic => "harmonic",
+                    RepresentativeChoice::Flooded => "flooded",
                 },
             ])
             .output()

@@ -133,19 +133,37 @@ fn surface_representative<D: Domain>(
         }
     };
     let released = std::cell::Cell::new(0);
+    let boundary_saddles = std::cell::Cell::new(0);
+    let merged_used: std::cell::RefCell<Option<MorseSmale>> = std::cell::RefCell::new(None);
+    // the matched saddles first; if u fails its check, once more with the one-sided boundary
+    // saddles (a kept boundary extremum's partner can be one: without its separatrices the
+    // cells beside it reach along the boundary to values beyond it)
     let separatrix = |why: &mut Vec<String>| -> Option<Vec<f64>> {
         let ms = complex.as_ref()?;
-        match separatrix_representative(domain, h, kept, ms, k) {
-            Ok((u, r)) => {
-                let c = certify(domain, &u, &kept.roles, None);
-                released.set(r);
-                if c.passed {
-                    return Some(u);
+        let merged = ms.with_boundary();
+        let mut first_failure = None;
+        for (attempt, ms) in std::iter::once(ms).chain(merged.as_ref()).enumerate() {
+            match separatrix_representative(domain, h, kept, ms, k) {
+                Ok((u, r)) => {
+                    let c = certify(domain, &u, &kept.roles, None);
+                    if c.passed {
+                        released.set(r);
+                        if attempt > 0 {
+                            let mut b: Vec<usize> = ms.saddles.clone();
+                            b.retain(|v| complex.as_ref().is_some_and(|c| c.saddles.binary_search(v).is_err()));
+                            boundary_saddles.set(b.len());
+                            *merged_used.borrow_mut() = Some(ms.clone());
+                        }
+                        return Some(u);
+                    }
+                    first_failure.get_or_insert(format!("separatrix representative: {}", c.summary()));
                 }
-                why.push(format!("separatrix representative: {}", c.summary()));
+                Err(e) => {
+                    first_failure.get_or_insert(format!("separatrix representative: {e}"));
+                }
             }
-            Err(e) => why.push(format!("separatrix representative: {e}")),
         }
+        why.extend(first_failure);
         None
     };
     let harmonic = |why: &mut Vec<String>| -> Option<Vec<f64>> {
@@ -179,11 +197,14 @@ fn surface_representative<D: Domain>(
         _ => flooded(why),
     };
     let named = |name: &str, why: &[String]| {
-        let name = if name == "separatrix" && released.get() > 0 {
-            format!("separatrix ({} contradicting separatrix vertices released to the harmonic fill)", released.get())
-        } else {
-            name.to_string()
-        };
+        let mut name = name.to_string();
+        if name == "separatrix" && boundary_saddles.get() > 0 {
+            name = format!("separatrix with {} one-sided boundary saddles", boundary_saddles.get());
+        }
+        if name.starts_with("separatrix") && released.get() > 0 {
+            name =
+                format!("{name} ({} contradicting separatrix vertices released to the harmonic fill)", released.get());
+        }
         if why.is_empty() {
             name
         } else {
@@ -195,6 +216,8 @@ fn surface_representative<D: Domain>(
             continue;
         }
         if let Some(u) = build(kind, &mut why) {
+            // --complex writes the separatrices u was built from
+            let complex = if kind == "separatrix" { merged_used.take().or(complex) } else { complex };
             return Ok(Representative { u, kind, name: named(kind, &why), complex });
         }
     }

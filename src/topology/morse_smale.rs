@@ -24,6 +24,12 @@ pub struct MorseSmale {
     pub descending: Vec<Separatrix>,
     /// Separatrices ascending to kept maxima.
     pub ascending: Vec<Separatrix>,
+    /// Partners of kept extrema that are saddles of one structure only (on a boundary the
+    /// cones sit above the domain in the descending structure and below it in the ascending
+    /// one), with their separatrices of both families: the descending ones first, as `(true,
+    /// path)`, then the ascending ones. Not in the lists above; [`MorseSmale::with_boundary`]
+    /// merges them.
+    pub boundary: Vec<(bool, Separatrix)>,
     /// Seconds spent building the two discrete gradients and simplifying them.
     pub seconds: [f64; 2],
 }
@@ -42,15 +48,24 @@ impl MorseSmale {
         let built = t.elapsed().as_secs_f64();
         let t = std::time::Instant::now();
         let keep_min: Vec<bool> = kept.roles.iter().map(|&r| r == Role::Min).collect();
-        down.simplify(&sublevel_pairs(domain, values), &keep_min)?;
+        let (low_pairs, high_pairs) = (sublevel_pairs(domain, values), superlevel_pairs(domain, values));
+        down.simplify(&low_pairs, &keep_min)?;
         let keep_max: Vec<bool> = kept.roles.iter().map(|&r| r == Role::Max).collect();
-        up.simplify(&superlevel_pairs(domain, values), &keep_max)?;
+        up.simplify(&high_pairs, &keep_max)?;
         let (ds, us) = (down.saddles(), up.saddles());
-        let mut saddles: Vec<usize> = ds
+        let in_down: std::collections::HashSet<usize> = ds.iter().map(|s| s.vertex).collect();
+        let in_up: std::collections::HashSet<usize> = us.iter().map(|s| s.vertex).collect();
+        // partners of kept extrema that are saddles of one structure only (boundary saddles:
+        // the cones sit above the domain in one structure, below it in the other)
+        let one_sided: Vec<usize> = low_pairs
             .iter()
-            .map(|s| s.vertex)
-            .filter(|v| us.iter().any(|u| u.vertex == *v) && !kept.roles[*v].is_fixed())
+            .filter(|p| keep_min[p.extremum])
+            .chain(high_pairs.iter().filter(|p| keep_max[p.extremum]))
+            .filter_map(|p| p.partner)
+            .filter(|v| in_down.contains(v) != in_up.contains(v) && !kept.roles[*v].is_fixed())
             .collect();
+        let mut saddles: Vec<usize> =
+            ds.iter().map(|s| s.vertex).filter(|v| in_up.contains(v) && !kept.roles[*v].is_fixed()).collect();
         saddles.sort_unstable();
         saddles.dedup();
         let trace = |g: &DiscreteGradient, list: &[super::gradient::Saddle]| -> Vec<Separatrix> {
@@ -60,6 +75,44 @@ impl MorseSmale {
                 .collect()
         };
         let (descending, ascending) = (trace(&down, &ds), trace(&up, &us));
-        Ok(MorseSmale { descending, ascending, saddles, seconds: [built, t.elapsed().as_secs_f64()] })
+        // a one-sided saddle: its separatrices in the structure it is a saddle of, and for the
+        // other family the V-path from it in the other structure
+        let mut boundary = Vec::new();
+        for &v in &one_sided {
+            let (own, other, own_is_down) = if in_down.contains(&v) { (&down, &up, true) } else { (&up, &down, false) };
+            let list = if own_is_down { &ds } else { &us };
+            for s in list.iter().filter(|s| s.vertex == v) {
+                for path in own.separatrices(s).into_iter().filter(|p| p.len() > 1) {
+                    boundary.push((own_is_down, Separatrix { saddle: v, path }));
+                }
+            }
+            let path = other.vertex_path(v);
+            if path.len() > 1 {
+                boundary.push((!own_is_down, Separatrix { saddle: v, path }));
+            }
+        }
+        boundary.sort_by_key(|(down, _)| !*down);
+        Ok(MorseSmale { descending, ascending, boundary, saddles, seconds: [built, t.elapsed().as_secs_f64()] })
+    }
+
+    /// The complex with the one-sided boundary saddles and their separatrices merged in
+    /// (`None` when there are none).
+    pub fn with_boundary(&self) -> Option<MorseSmale> {
+        if self.boundary.is_empty() {
+            return None;
+        }
+        let mut merged = self.clone();
+        for (down, sep) in &self.boundary {
+            merged.saddles.push(sep.saddle);
+            if *down {
+                merged.descending.push(sep.clone());
+            } else {
+                merged.ascending.push(sep.clone());
+            }
+        }
+        merged.saddles.sort_unstable();
+        merged.saddles.dedup();
+        merged.boundary.clear();
+        Some(merged)
     }
 }

@@ -199,3 +199,41 @@ fn appendix_formulation_reaches_the_same_optimum() {
     };
     assert_eq!(smooth(&g, &h, &settings).unwrap_err().exit_code(), 2);
 }
+
+/// The measurement behind docs/grids.md section 5 (representatives on 400 random grids):
+/// every run certifies (checked by the independent counter); prints which representative
+/// each took, the summed RMS and the iterations. `--ignored --nocapture` to run it.
+#[test]
+#[ignore]
+fn representatives_on_random_grids() {
+    use toposmooth::pipeline::RepresentativeChoice;
+    for choice in [RepresentativeChoice::Separatrix, RepresentativeChoice::Flooded] {
+        let (mut rms, mut iterations) = (0.0, 0u64);
+        let mut kinds = std::collections::BTreeMap::new();
+        for seed in 0..400u64 {
+            let (nx, ny) = (5 + (seed % 17) as usize, 4 + (seed % 13) as usize);
+            let r = uniform(seed, nx * ny);
+            let h: Vec<f64> = (0..nx * ny)
+                .map(|v| {
+                    let (x, y) = ((v % nx) as f64 / nx as f64, (v / nx) as f64 / ny as f64);
+                    (6.0 * x).sin() * (5.0 * y).cos() + 0.3 * r[v]
+                })
+                .collect();
+            let g = Grid2d::new(nx, ny).unwrap();
+            let settings = SmoothSettings {
+                selection: Selection::Count { minima: 1 + (seed % 4) as usize, maxima: 1 + (seed % 3) as usize },
+                representative: choice,
+                ..Default::default()
+            };
+            let out = smooth(&g, &h, &settings).unwrap_or_else(|e| panic!("seed {seed}: {e}"));
+            let (mins, maxs, flat) = grid_extrema(nx, ny, &out.output);
+            assert!(flat.is_empty(), "seed {seed}");
+            assert_eq!(mins, (0..nx * ny).filter(|&v| out.roles[v] == Role::Min).collect::<Vec<_>>());
+            assert_eq!(maxs, (0..nx * ny).filter(|&v| out.roles[v] == Role::Max).collect::<Vec<_>>());
+            rms += out.report.rms_deviation;
+            iterations += u64::from(out.report.solver_iterations);
+            *kinds.entry(out.report.representative.split(' ').next().unwrap().to_string()).or_insert(0) += 1;
+        }
+        eprintln!("{choice:?}: {kinds:?}, summed RMS {rms:.1}, {iterations} iterations");
+    }
+}

@@ -133,14 +133,14 @@ fn surface_representative<D: Domain>(
         }
     };
     let released = std::cell::Cell::new(0);
-    let boundary_saddles = std::cell::Cell::new(0);
+    let one_sided_saddles = std::cell::Cell::new(0);
     let merged_used: std::cell::RefCell<Option<MorseSmale>> = std::cell::RefCell::new(None);
-    // the matched saddles first; if u fails its check, once more with the one-sided boundary
-    // saddles (a kept boundary extremum's partner can be one: without its separatrices the
-    // cells beside it reach along the boundary to values beyond it)
+    // the matched saddles first; if u fails its check, once more with the one-sided saddles
+    // (a kept boundary extremum's partner is often one: without its separatrices the cells
+    // beside it reach along the boundary to values beyond it)
     let separatrix = |why: &mut Vec<String>| -> Option<Vec<f64>> {
         let ms = complex.as_ref()?;
-        let merged = ms.with_boundary();
+        let merged = ms.with_one_sided();
         let mut first_failure = None;
         for (attempt, ms) in std::iter::once(ms).chain(merged.as_ref()).enumerate() {
             match separatrix_representative(domain, h, kept, ms, k) {
@@ -151,7 +151,7 @@ fn surface_representative<D: Domain>(
                         if attempt > 0 {
                             let mut b: Vec<usize> = ms.saddles.clone();
                             b.retain(|v| complex.as_ref().is_some_and(|c| c.saddles.binary_search(v).is_err()));
-                            boundary_saddles.set(b.len());
+                            one_sided_saddles.set(b.len());
                             *merged_used.borrow_mut() = Some(ms.clone());
                         }
                         return Some(u);
@@ -198,8 +198,8 @@ fn surface_representative<D: Domain>(
     };
     let named = |name: &str, why: &[String]| {
         let mut name = name.to_string();
-        if name == "separatrix" && boundary_saddles.get() > 0 {
-            name = format!("separatrix with {} one-sided boundary saddles", boundary_saddles.get());
+        if name == "separatrix" && one_sided_saddles.get() > 0 {
+            name = format!("separatrix with {} one-sided saddles", one_sided_saddles.get());
         }
         if name.starts_with("separatrix") && released.get() > 0 {
             name =

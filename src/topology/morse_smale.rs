@@ -24,12 +24,13 @@ pub struct MorseSmale {
     pub descending: Vec<Separatrix>,
     /// Separatrices ascending to kept maxima.
     pub ascending: Vec<Separatrix>,
-    /// Partners of kept extrema that are saddles of one structure only (on a boundary the
+    /// Partners of kept extrema that are saddles of one structure only — on the boundary (the
     /// cones sit above the domain in the descending structure and below it in the ascending
-    /// one), with their separatrices of both families: the descending ones first, as `(true,
-    /// path)`, then the ascending ones. Not in the lists above; [`MorseSmale::with_boundary`]
-    /// merges them.
-    pub boundary: Vec<(bool, Separatrix)>,
+    /// one) and at degenerate interior saddles the other structure cancelled with an extremum
+    /// it did not keep — with their separatrices of both families: the descending ones first,
+    /// as `(true, path)`, then the ascending ones. Not in the lists above;
+    /// [`MorseSmale::with_one_sided`] merges them.
+    pub one_sided: Vec<(bool, Separatrix)>,
     /// Seconds spent building the two discrete gradients and simplifying them.
     pub seconds: [f64; 2],
 }
@@ -55,15 +56,16 @@ impl MorseSmale {
         let (ds, us) = (down.saddles(), up.saddles());
         let in_down: std::collections::HashSet<usize> = ds.iter().map(|s| s.vertex).collect();
         let in_up: std::collections::HashSet<usize> = us.iter().map(|s| s.vertex).collect();
-        // partners of kept extrema that are saddles of one structure only (boundary saddles:
-        // the cones sit above the domain in one structure, below it in the other)
-        let one_sided: Vec<usize> = low_pairs
+        // partners of kept extrema that are saddles of one structure only
+        let mut one_sided_saddles: Vec<usize> = low_pairs
             .iter()
             .filter(|p| keep_min[p.extremum])
             .chain(high_pairs.iter().filter(|p| keep_max[p.extremum]))
             .filter_map(|p| p.partner)
             .filter(|v| in_down.contains(v) != in_up.contains(v) && !kept.roles[*v].is_fixed())
             .collect();
+        one_sided_saddles.sort_unstable();
+        one_sided_saddles.dedup();
         let mut saddles: Vec<usize> =
             ds.iter().map(|s| s.vertex).filter(|v| in_up.contains(v) && !kept.roles[*v].is_fixed()).collect();
         saddles.sort_unstable();
@@ -77,32 +79,32 @@ impl MorseSmale {
         let (descending, ascending) = (trace(&down, &ds), trace(&up, &us));
         // a one-sided saddle: its separatrices in the structure it is a saddle of, and for the
         // other family the V-path from it in the other structure
-        let mut boundary = Vec::new();
-        for &v in &one_sided {
+        let mut one_sided = Vec::new();
+        for &v in &one_sided_saddles {
             let (own, other, own_is_down) = if in_down.contains(&v) { (&down, &up, true) } else { (&up, &down, false) };
             let list = if own_is_down { &ds } else { &us };
             for s in list.iter().filter(|s| s.vertex == v) {
                 for path in own.separatrices(s).into_iter().filter(|p| p.len() > 1) {
-                    boundary.push((own_is_down, Separatrix { saddle: v, path }));
+                    one_sided.push((own_is_down, Separatrix { saddle: v, path }));
                 }
             }
             let path = other.vertex_path(v);
             if path.len() > 1 {
-                boundary.push((!own_is_down, Separatrix { saddle: v, path }));
+                one_sided.push((!own_is_down, Separatrix { saddle: v, path }));
             }
         }
-        boundary.sort_by_key(|(down, _)| !*down);
-        Ok(MorseSmale { descending, ascending, boundary, saddles, seconds: [built, t.elapsed().as_secs_f64()] })
+        one_sided.sort_by_key(|(down, _)| !*down);
+        Ok(MorseSmale { descending, ascending, one_sided, saddles, seconds: [built, t.elapsed().as_secs_f64()] })
     }
 
-    /// The complex with the one-sided boundary saddles and their separatrices merged in
+    /// The complex with the one-sided saddles and their separatrices merged in
     /// (`None` when there are none).
-    pub fn with_boundary(&self) -> Option<MorseSmale> {
-        if self.boundary.is_empty() {
+    pub fn with_one_sided(&self) -> Option<MorseSmale> {
+        if self.one_sided.is_empty() {
             return None;
         }
         let mut merged = self.clone();
-        for (down, sep) in &self.boundary {
+        for (down, sep) in &self.one_sided {
             merged.saddles.push(sep.saddle);
             if *down {
                 merged.descending.push(sep.clone());
@@ -112,7 +114,66 @@ impl MorseSmale {
         }
         merged.saddles.sort_unstable();
         merged.saddles.dedup();
-        merged.boundary.clear();
+        merged.one_sided.clear();
         Some(merged)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::domain::Grid2d;
+    use crate::topology::{select, Selection};
+
+    /// One-sided saddles come mostly from the cones (on the boundary); every separatrix
+    /// (matched or one-sided) runs from its saddle to a kept extremum of its family's type.
+    #[test]
+    fn one_sided_saddles_reach_kept_extrema() {
+        let (mut with_one_sided, mut outer, mut inner) = (0, 0, 0);
+        for seed in 0..200u64 {
+            let (nx, ny) = (5 + (seed % 11) as usize, 4 + (seed % 7) as usize);
+            let mut state = seed;
+            let h: Vec<f64> = (0..nx * ny)
+                .map(|v| {
+                    state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+                    let (x, y) = ((v % nx) as f64 / nx as f64, (v / nx) as f64 / ny as f64);
+                    (6.0 * x).sin() * (5.0 * y).cos() + 0.3 * (state >> 11) as f64 / (1u64 << 53) as f64
+                })
+                .collect();
+            let g = Grid2d::new(nx, ny).unwrap();
+            let kept =
+                select(&g, &h, &Selection::Count { minima: 1 + (seed % 4) as usize, maxima: 1 + (seed % 3) as usize })
+                    .unwrap();
+            let ms = MorseSmale::new(&g, &h, &kept).unwrap();
+            let on_boundary = |v: usize| v % nx == 0 || v % nx == nx - 1 || v / nx == 0 || v / nx == ny - 1;
+            for (down, sep) in &ms.one_sided {
+                if on_boundary(sep.saddle) {
+                    outer += 1;
+                } else {
+                    inner += 1;
+                }
+                assert!(ms.saddles.binary_search(&sep.saddle).is_err(), "seed {seed}: also matched");
+                let end = *sep.path.last().unwrap();
+                assert_eq!(kept.roles[end], if *down { Role::Min } else { Role::Max }, "seed {seed}");
+            }
+            let merged = ms.with_one_sided();
+            assert_eq!(merged.is_some(), !ms.one_sided.is_empty());
+            if let Some(m) = merged {
+                with_one_sided += 1;
+                assert_eq!(
+                    m.descending.len() + m.ascending.len(),
+                    ms.descending.len() + ms.ascending.len() + ms.one_sided.len()
+                );
+                for s in m.descending.iter() {
+                    assert_eq!(kept.roles[*s.path.last().unwrap()], Role::Min);
+                }
+                for s in m.ascending.iter() {
+                    assert_eq!(kept.roles[*s.path.last().unwrap()], Role::Max);
+                }
+            }
+        }
+        eprintln!("{with_one_sided} fields with one-sided saddles; their separatrices: {outer} from boundary vertices, {inner} inside");
+        assert!(with_one_sided > 20, "{with_one_sided} of 200 fields have one-sided saddles");
+        assert!(outer > inner, "mostly the cones' doing: {outer} on the boundary, {inner} inside");
     }
 }

@@ -374,7 +374,35 @@ impl DiscreteGradient {
         self.vertex_pair.iter().chain(&self.edge_pair).chain(&self.triangle_pair).all(|p| *p != Pair::None)
     }
 
+    /// For every vertex (cones included), the critical vertex its V-path ends at; each path
+    /// is walked once (the ends of the vertices on it are filled on the way back).
+    fn initial_path_ends(&self) -> Vec<u32> {
+        const UNKNOWN: u32 = u32::MAX;
+        let mut end = vec![UNKNOWN; self.vertex_pair.len()];
+        let mut trail = Vec::new();
+        for v in 0..end.len() as u32 {
+            let mut x = v;
+            while end[x as usize] == UNKNOWN {
+                match self.vertex_pair[x as usize] {
+                    Pair::Cell(e) => {
+                        trail.push(x);
+                        x = self.other(e, x);
+                    }
+                    _ => {
+                        end[x as usize] = x;
+                    }
+                }
+            }
+            let target = end[x as usize];
+            for y in trail.drain(..) {
+                end[y as usize] = target;
+            }
+        }
+        end
+    }
+
     /// The critical vertex a V-path from `v` ends at (cones included).
+    #[cfg_attr(not(debug_assertions), allow(dead_code))]
     fn path_end(&self, v: u32) -> u32 {
         let mut x = v;
         while let Pair::Cell(e) = self.vertex_pair[x as usize] {
@@ -399,7 +427,22 @@ impl DiscreteGradient {
                 .total_cmp(&b.persistence)
                 .then(self.rank[a.partner.expect("filtered")].cmp(&self.rank[b.partner.expect("filtered")]))
         });
+        // Where each vertex's V-path ends, kept up to date without walking the paths again:
+        // cancelling (m, s) through the edge (a, b), a flowing to m, sends every vertex that
+        // flowed to m on through the reversed path and the edge to b's end, and no other
+        // vertex's path changes — so the ends are the basins' initial critical vertices,
+        // merged m → end(b) by a union-find.
+        let basin = self.initial_path_ends();
+        let mut merged: Vec<u32> = (0..basin.len() as u32).collect();
+        fn root(merged: &mut [u32], mut x: u32) -> u32 {
+            while merged[x as usize] != x {
+                merged[x as usize] = merged[merged[x as usize] as usize];
+                x = merged[x as usize];
+            }
+            x
+        }
         let mut cancelled = 0;
+        let edges_at = self.c.clone();
         for p in order {
             let m = p.extremum as u32;
             let s = p.partner.expect("filtered") as u32;
@@ -408,18 +451,21 @@ impl DiscreteGradient {
             }
             let rs = self.rank[s as usize];
             let mut done = false;
-            for &e in &self.c.clone().vertex_edges[s as usize] {
+            for &e in &edges_at.vertex_edges[s as usize] {
                 if self.edge_pair[e as usize] != Pair::Critical || self.rank[self.other(e, s) as usize] > rs {
                     continue;
                 }
                 let [a, b] = self.c.edges[e as usize];
-                let (ea, eb) = (self.path_end(a), self.path_end(b));
-                let start = match (ea == m, eb == m) {
-                    (true, false) => a,
-                    (false, true) => b,
+                let ea = root(&mut merged, basin[a as usize]);
+                let eb = root(&mut merged, basin[b as usize]);
+                debug_assert_eq!((ea, eb), (self.path_end(a), self.path_end(b)));
+                let (start, other_end) = match (ea == m, eb == m) {
+                    (true, false) => (a, eb),
+                    (false, true) => (b, ea),
                     _ => continue,
                 };
                 self.reverse(e, start);
+                merged[m as usize] = other_end;
                 cancelled += 1;
                 done = true;
                 break;

@@ -139,19 +139,18 @@ fn surface_representative<D: Domain>(
     // (a kept boundary extremum's partner is often one: without its separatrices the cells
     // beside it reach along the boundary to values beyond it)
     let separatrix = |why: &mut Vec<String>| -> Option<Vec<f64>> {
-        let ms = complex.as_ref()?;
-        let merged = ms.with_one_sided();
+        let matched = complex.as_ref()?;
+        let merged = matched.with_one_sided();
         let mut first_failure = None;
-        for (attempt, ms) in std::iter::once(ms).chain(merged.as_ref()).enumerate() {
+        for (attempt, ms) in std::iter::once(matched).chain(merged.as_ref()).enumerate() {
             match separatrix_representative(domain, h, kept, ms, k) {
                 Ok((u, r)) => {
                     let c = certify(domain, &u, &kept.roles, None);
                     if c.passed {
                         released.set(r);
                         if attempt > 0 {
-                            let mut b: Vec<usize> = ms.saddles.clone();
-                            b.retain(|v| complex.as_ref().is_some_and(|c| c.saddles.binary_search(v).is_err()));
-                            one_sided_saddles.set(b.len());
+                            // the one-sided saddles are never matched ones
+                            one_sided_saddles.set(ms.saddles.len() - matched.saddles.len());
                             *merged_used.borrow_mut() = Some(ms.clone());
                         }
                         return Some(u);

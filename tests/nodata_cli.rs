@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::{dataset, mesh_extrema, scratch, text, toposmooth};
+use common::{dataset, mesh_extrema, scratch, succeeds, text, toposmooth};
 use std::path::{Path, PathBuf};
 use toposmooth::io::mesh::read_mesh;
 
@@ -63,7 +63,7 @@ fn four_methods_on_a_bar_with_two_point_handles() {
     );
     let w = out(&dir, "w.vtu");
     let report = out(&dir, "r.json");
-    let o = toposmooth(&[
+    succeeds(&[
         "weights",
         &bar,
         "--handles",
@@ -76,7 +76,6 @@ fn four_methods_on_a_bar_with_two_point_handles() {
         "--plot",
         &out(&dir, "w.png"),
     ]);
-    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
     let r: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
     let cmp = r["comparison"].as_array().unwrap();
     let get = |m: &str| cmp.iter().find(|c| c["method"] == m).unwrap_or_else(|| panic!("{m} missing"));
@@ -92,8 +91,7 @@ fn four_methods_on_a_bar_with_two_point_handles() {
         assert!(get(m)["spurious_tolerance_1e9"].is_array());
     }
     // the file: certified by verify, extrema counted independently, partition of unity
-    let o = toposmooth(&["verify", &w]);
-    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+    succeeds(&["verify", &w]);
     let d = read_mesh(Path::new(&w)).unwrap();
     for name in ["a", "b"] {
         let raw = d.array(&format!("weight_{name}_raw")).unwrap().values;
@@ -119,27 +117,14 @@ fn penguin_weights_pose_and_identity_pose() {
     let penguin = dataset("penguin.obj");
     let handles = dataset("penguin_handles.json");
     let w = out(&dir, "w.vtu");
-    let o = toposmooth(&["weights", &penguin, "--handles", &handles, "-o", &w, "--order", "3"]);
-    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+    let o = succeeds(&["weights", &penguin, "--handles", &handles, "-o", &w, "--order", "3"]);
     assert!(text(&o).matches("certified;").count() >= 4, "{}", text(&o));
     // identity transforms reproduce the rest pose, both skinning methods
     let identity = write(&dir, "id.json", r#"{"transforms": {"head": [[1,0,0,0],[0,1,0,0],[0,0,1,0]]}}"#);
     let rest = read_mesh(Path::new(&penguin)).unwrap();
     for s in ["lbs", "dqs"] {
         let posed = out(&dir, &format!("id_{s}.obj"));
-        let o = toposmooth(&[
-            "deform",
-            &penguin,
-            "--weights",
-            &w,
-            "--transforms",
-            &identity,
-            "-o",
-            &posed,
-            "--skinning",
-            s,
-        ]);
-        assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+        succeeds(&["deform", &penguin, "--weights", &w, "--transforms", &identity, "-o", &posed, "--skinning", s]);
         let p = read_mesh(Path::new(&posed)).unwrap();
         assert_eq!(p.triangles, rest.triangles);
         let err = p
@@ -152,7 +137,7 @@ fn penguin_weights_pose_and_identity_pose() {
     }
     // the bundled pose moves the flippers and not the feet
     let posed = out(&dir, "posed.obj");
-    let o = toposmooth(&[
+    succeeds(&[
         "deform",
         &penguin,
         "--weights",
@@ -166,7 +151,6 @@ fn penguin_weights_pose_and_identity_pose() {
         "--plot",
         &out(&dir, "posed.png"),
     ]);
-    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
     let p = read_mesh(Path::new(&posed)).unwrap();
     let moved = |v: usize| (0..3).map(|k| (p.positions[v][k] - rest.positions[v][k]).powi(2)).sum::<f64>().sqrt();
     assert!(moved(927) > 0.3, "left flipper tip moved {}", moved(927));
@@ -178,7 +162,7 @@ fn diffusion_stays_in_the_colour_box_and_the_biharmonic_one_does_not() {
     let dir = scratch("nodata_diffuse");
     let colors = dataset("horse_colors.json");
     let png = out(&dir, "horse.png");
-    let o = toposmooth(&[
+    succeeds(&[
         "diffuse",
         &dataset("horse_mask.png"),
         "--colors",
@@ -188,7 +172,6 @@ fn diffusion_stays_in_the_colour_box_and_the_biharmonic_one_does_not() {
         "--plot",
         &out(&dir, "plot.png"),
     ]);
-    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
     let c: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&colors).unwrap()).unwrap();
     let rgbs: Vec<[u8; 3]> = c["points"]
         .as_array()
@@ -226,10 +209,9 @@ fn diffusion_stays_in_the_colour_box_and_the_biharmonic_one_does_not() {
     let px = img.get_pixel(p0[0].as_u64().unwrap() as u32, p0[1].as_u64().unwrap() as u32);
     assert_eq!([px.0[0], px.0[1], px.0[2]], rgbs[0]);
     // the weights file is verifiable
-    let o = toposmooth(&["verify", &out(&dir, "horse_weights.vtu")]);
-    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+    succeeds(&["verify", &out(&dir, "horse_weights.vtu")]);
     let bih = out(&dir, "bih.png");
-    let o = toposmooth(&[
+    let o = succeeds(&[
         "diffuse",
         &dataset("horse_mask.png"),
         "--colors",
@@ -239,7 +221,6 @@ fn diffusion_stays_in_the_colour_box_and_the_biharmonic_one_does_not() {
         "--method",
         "unconstrained",
     ]);
-    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
     let (_, out_bih) = outside(&bih);
     assert!(out_bih > 100, "{out_bih}");
     assert!(text(&o).contains(&format!("{out_bih} of")), "{}", text(&o));
@@ -251,7 +232,7 @@ fn cage_weights_on_the_horse() {
     let horse = dataset("horse_silhouette_2d.obj");
     let w = out(&dir, "w.vtu");
     let report = out(&dir, "r.json");
-    let o = toposmooth(&[
+    let o = succeeds(&[
         "weights",
         &horse,
         "--handles",
@@ -263,7 +244,6 @@ fn cage_weights_on_the_horse() {
         "--report",
         &report,
     ]);
-    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
     assert!(text(&o).contains("7 of 7 monotone functions"), "{}", text(&o));
     let r: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
     assert!(r["linear_reproduction_error"].as_f64().unwrap() < 1e-6);
@@ -271,8 +251,7 @@ fn cage_weights_on_the_horse() {
     let o = toposmooth(&["verify", &w]);
     assert_eq!(o.status.code(), Some(2), "{}", text(&o));
     assert!(text(&o).contains("_cage.vtu"), "{}", text(&o));
-    let o = toposmooth(&["verify", &out(&dir, "w_cage.vtu")]);
-    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+    succeeds(&["verify", &out(&dir, "w_cage.vtu")]);
     let d = read_mesh(Path::new(&w)).unwrap();
     let n = d.positions.len();
     let sums: Vec<f64> =
@@ -336,8 +315,7 @@ fn every_no_data_error_path_names_its_file() {
         "ok.json",
         r#"{"handles": [{"name": "a", "point": [2.5, 0.5]}, {"name": "b", "point": [7.5, 0.5]}]}"#,
     );
-    let o = toposmooth(&["weights", &bar, "--handles", &hw, "-o", &w]);
-    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+    succeeds(&["weights", &bar, "--handles", &hw, "-o", &w]);
     let pose = write(&dir, "pose.json", r#"{"transforms": {"c": [[1,0,0,0],[0,1,0,0],[0,0,1,0]]}}"#);
     let o = toposmooth(&["deform", &bar, "--weights", &w, "--transforms", &pose, "-o", &out(&dir, "p.obj")]);
     assert_eq!(o.status.code(), Some(3), "{}", text(&o));
@@ -364,8 +342,7 @@ fn a_bone_across_a_bar_fills_the_part_beyond_it() {
     );
     let w = out(&dir, "w.vtu");
     let report = out(&dir, "r.json");
-    let o = toposmooth(&["weights", &bar, "--handles", &h, "-o", &w, "--report", &report]);
-    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+    succeeds(&["weights", &bar, "--handles", &h, "-o", &w, "--report", &report]);
     let r: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
     // the bone takes the columns at x = 7 (±0.2 reaches only that column of vertices: spacing 0.25);
     // the 12 columns beyond (x = 7.25 … 10) are filled, 5 vertices each
@@ -380,8 +357,7 @@ fn a_bone_across_a_bar_fills_the_part_beyond_it() {
             assert_eq!((tip[v], wrist[v]), (0.0, 1.0), "vertex {v} beyond the bone");
         }
     }
-    let o = toposmooth(&["verify", &w]);
-    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+    succeeds(&["verify", &w]);
 }
 
 #[test]
@@ -395,8 +371,7 @@ fn diffusion_on_a_mesh_writes_colour_arrays() {
     );
     let o_path = out(&dir, "bar_colours.ply");
     let png = out(&dir, "bar.png");
-    let o = toposmooth(&["diffuse", &bar, "--colors", &colors, "-o", &o_path, "--plot", &png]);
-    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+    let o = succeeds(&["diffuse", &bar, "--colors", &colors, "-o", &o_path, "--plot", &png]);
     assert!(text(&o).contains("0 of 205 vertices outside"), "{}", text(&o));
     assert!(image::open(&png).unwrap().width() > 300);
     let d = read_mesh(Path::new(&o_path)).unwrap();
@@ -404,8 +379,7 @@ fn diffusion_on_a_mesh_writes_colour_arrays() {
     assert_eq!((r[0], g[0], b[0]), (255.0, 0.0, 0.0));
     assert_eq!((r[40], g[40], b[40]), (0.0, 0.0, 255.0));
     assert!(g.iter().all(|&x| x <= 200.0));
-    let o = toposmooth(&["verify", &o_path]);
-    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+    succeeds(&["verify", &o_path]);
     // a colour moved outside the box is caught
     let mut d = d;
     let k = d.arrays.iter().position(|a| a.name == "green").unwrap();
@@ -450,16 +424,14 @@ fn outputs_never_overwrite_inputs_or_each_other() {
         assert!(!Path::new(&w).exists());
     }
     assert_eq!(std::fs::read(&bar).unwrap(), before);
-    let o = toposmooth(&["weights", &bar, "--handles", &h, "-o", &w]);
-    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+    succeeds(&["weights", &bar, "--handles", &h, "-o", &w]);
     let pose = write(&dir, "pose.json", r#"{"transforms": {"a": [[1,0,0,1],[0,1,0,0],[0,0,1,0]]}}"#);
     for target in [&bar, &w, &pose] {
         let o = toposmooth(&["deform", &bar, "--weights", &w, "--transforms", &pose, "-o", target]);
         assert_eq!(o.status.code(), Some(2), "{}", text(&o));
     }
     assert_eq!(std::fs::read(&bar).unwrap(), before);
-    let o = toposmooth(&["verify", &w]);
-    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+    succeeds(&["verify", &w]);
 }
 
 #[test]
@@ -473,15 +445,13 @@ fn adjacent_handles_form_one_region_and_tampered_weights_fail_verify() {
         r#"{"handles": [{"name": "a", "vertices": [0]}, {"name": "b", "vertices": [1]}, {"name": "c", "vertices": [40]}]}"#,
     );
     let w = out(&dir, "w.vtu");
-    let o = toposmooth(&["weights", &bar, "--handles", &h, "-o", &w]);
-    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+    succeeds(&["weights", &bar, "--handles", &h, "-o", &w]);
     let d = read_mesh(Path::new(&w)).unwrap();
     let role_c = d.array("role_c").unwrap().values;
     assert_eq!((role_c[0], role_c[1], role_c[40]), (2.0, 2.0, 1.0));
     let role_a = d.array("role_a").unwrap().values;
     assert_eq!((role_a[0], role_a[1], role_a[40]), (1.0, -1.0, -1.0)); // different values: separate regions
-    let o = toposmooth(&["verify", &w]);
-    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+    succeeds(&["verify", &w]);
     let tamper = |name: &str, f: &dyn Fn(&mut toposmooth::io::mesh::MeshData)| {
         let mut t = d.clone();
         f(&mut t);

@@ -116,3 +116,10 @@ pub fn dataset(name: &str) -> String {
 pub fn text(o: &std::process::Output) -> String {
     format!("{}{}", String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr))
 }
+
+/// Runs the built binary with `args` and asserts that it exits 0 (the message otherwise).
+pub fn succeeds(args: &[&str]) -> std::process::Output {
+    let o = toposmooth(args);
+    assert_eq!(o.status.code(), Some(0), "{args:?}: {}", text(&o));
+    o
+}

@@ -127,14 +127,6 @@ pub fn ordered_harmonic<D: Domain>(domain: &D, k: &Sparse, fixed: &[Option<f64>]
             })
             .collect();
         if levels == MAX_LEVELS {
-            if std::env::var("TS_DEBUG").is_ok() {
-                for &v in &bad {
-                    eprintln!("bad {v} at {:?} phi {:?}", domain.point(v), phi[v]);
-                    for w in domain.neighbors(v) {
-                        eprintln!("   nb {w} at {:?} phi {:?} fixed {:?}", domain.point(w), phi[w], fixed[w]);
-                    }
-                }
-            }
             return Err(format!(
                 "{} vertices (first {}) are still not strictly regular after {MAX_LEVELS} refinements of the harmonic order",
                 bad.len(),

@@ -361,6 +361,8 @@ pub fn weights_prescribed<D: Smoothable + Sync>(
             let workers: Vec<_> = (0..threads)
                 .map(|_| {
                     s.spawn(|| {
+                        // one function per core already: no nested two-thread factorisations
+                        crate::linalg::allow_split_on_this_thread(threads == 1);
                         let mut mine = Vec::new();
                         loop {
                             let h = next.fetch_add(1, Ordering::Relaxed);

@@ -21,6 +21,8 @@ use faer::sparse::linalg::cholesky::{
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMat, SymbolicSparseColMatRef};
 use faer::{Conj, Par, Side, Spec};
 
+pub mod two_way;
+
 /// An undirected graph in compressed adjacency form (no self loops).
 pub struct Graph {
     xadj: Vec<usize>,
@@ -203,14 +205,14 @@ impl Dissect<'_> {
 
 /// The separator level of a level structure (level starts `bounds`, `len` vertices): smallest
 /// `|S| / (|A| |B|)` among fairly balanced levels, as (score, level).
-fn best_level(bounds: &[usize], len: usize) -> (f64, usize) {
+fn best_level(bounds: &[usize], len: usize, min_fraction: f64) -> (f64, usize) {
     let nlev = bounds.len() - 1;
     let mut best = (f64::INFINITY, nlev / 2);
     for k in 1..nlev.saturating_sub(1) {
         let a = bounds[k] as f64;
         let s = (bounds[k + 1] - bounds[k]) as f64;
         let b = len as f64 - a - s;
-        if a.min(b) < 0.2 * len as f64 {
+        if a.min(b) < min_fraction * len as f64 {
             continue;
         }
         let score = s / (a * b);
@@ -221,10 +223,22 @@ fn best_level(bounds: &[usize], len: usize) -> (f64, usize) {
     best
 }
 
+/// Smallest share of the vertices in each part at the top level of the dissection.
+const TOP_BALANCE: f64 = 0.45;
+
 /// A nested-dissection ordering of `g`: `perm[new] = old`. Parts of at most `leaf_size`
 /// vertices are ordered by AMD.
 pub fn nested_dissection(g: &Graph, leaf_size: usize) -> Vec<usize> {
+    nested_dissection_split(g, leaf_size).0
+}
+
+/// [`nested_dissection`] and, when the whole graph was bisected at the top (it is connected
+/// and not a near-clique), the sizes `[a, b]` of the two parts: `perm[..a]` is one part,
+/// `perm[a..a + b]` the other, `perm[a + b..]` the separator between them, and no edge joins
+/// the two parts.
+pub fn nested_dissection_split(g: &Graph, leaf_size: usize) -> (Vec<usize>, Option<[usize; 2]>) {
     let n = g.n();
+    let mut top = None;
     let mut out = vec![0usize; n];
     let mut d = Dissect {
         g,
@@ -262,13 +276,15 @@ pub fn nested_dissection(g: &Graph, leaf_size: usize) -> Vec<usize> {
         // pseudo-peripheral root: repeat BFS from a minimum-degree vertex of the last level;
         // every level structure met is a candidate and the best separator level wins
         let mut ecc = bounds.len() - 2;
-        let mut best = (best_level(&bounds, len), verts[0]);
+        // the top level is split evenly: its two parts are factorised side by side
+        let min_fraction = if len == n { TOP_BALANCE } else { 0.2 };
+        let mut best = (best_level(&bounds, len, min_fraction), verts[0]);
         let mut last = (verts[0], bounds.clone());
         for _ in 0..4 {
             let far = &d.queue[bounds[bounds.len() - 2]..];
             let cand = *far.iter().min_by_key(|&&v| d.g.neighbours(v).len()).expect("non-empty level");
             let b2 = d.bfs(cand, p);
-            let l2 = best_level(&b2, len);
+            let l2 = best_level(&b2, len, min_fraction);
             if l2.0 < best.0 .0 {
                 best = (l2, cand);
             }
@@ -287,7 +303,7 @@ pub fn nested_dissection(g: &Graph, leaf_size: usize) -> Vec<usize> {
             d.leaf(&verts, &mut out, lo);
             continue;
         }
-        let best = best_level(&bounds, len);
+        let best = best_level(&bounds, len, min_fraction);
         let k = best.1;
         let (pa, pb) = (d.new_part(), d.new_part());
         let order = std::mem::take(&mut d.queue);
@@ -321,11 +337,14 @@ pub fn nested_dissection(g: &Graph, leaf_size: usize) -> Vec<usize> {
             d.owner[v] = PLACED;
         }
         let (la, lb) = (part_a.len(), part_b.len());
+        if len == n {
+            top = Some([la, lb]);
+        }
         out[lo + la + lb..lo + len].copy_from_slice(&sep);
         stack.push((pa, part_a, lo));
         stack.push((pb, part_b, lo + la));
     }
-    out
+    (out, top)
 }
 
 /// The inverse of a permutation.
@@ -441,20 +460,20 @@ pub fn solve_spd_once(a: SparseColMatRef<'_, usize, f64>, b: &mut [f64]) -> Resu
     Ok(())
 }
 
-/// A per-thread slot holding the last pattern analysed and its symbolic factorisation.
-pub type SymbolicSlot = std::cell::RefCell<Option<(SymbolicSparseColMat<usize>, std::rc::Rc<SymbolicCholesky<usize>>)>>;
+/// A per-thread slot holding the last pattern analysed and its analysis.
+pub type SymbolicSlot<T> = std::cell::RefCell<Option<(SymbolicSparseColMat<usize>, std::rc::Rc<T>)>>;
 
-/// The symbolic factorisation of `pattern`: the one in `slot` when the slot holds the same
-/// pattern, else `build()`, which is then stored. Repeated problems on one pattern (the weight
-/// functions of a run, each thread taking several) order it once per thread.
+/// The analysis of `pattern`: the one in `slot` when the slot holds the same pattern, else
+/// `build()`, which is then stored. Repeated problems on one pattern (the weight functions of
+/// a run, each thread taking several) order it once per thread.
 ///
 /// # Errors
 /// What `build` returns, or a failure to copy the pattern.
-pub fn cached_symbolic(
-    slot: &'static std::thread::LocalKey<SymbolicSlot>,
+pub fn cached_symbolic<T>(
+    slot: &'static std::thread::LocalKey<SymbolicSlot<T>>,
     pattern: SymbolicSparseColMatRef<'_, usize>,
-    build: impl FnOnce() -> Result<SymbolicCholesky<usize>, String>,
-) -> Result<std::rc::Rc<SymbolicCholesky<usize>>, String> {
+    build: impl FnOnce() -> Result<T, String>,
+) -> Result<std::rc::Rc<T>, String> {
     let same = |a: &SymbolicSparseColMat<usize>| {
         a.nrows() == pattern.nrows() && a.col_ptr() == pattern.col_ptr() && a.row_idx() == pattern.row_idx()
     };
@@ -469,7 +488,7 @@ pub fn cached_symbolic(
 
 thread_local! {
     /// The last pattern [`solve_spd_once`] analysed on this thread.
-    static LAST_AMD: SymbolicSlot = const { std::cell::RefCell::new(None) };
+    static LAST_AMD: SymbolicSlot<SymbolicCholesky<usize>> = const { std::cell::RefCell::new(None) };
 }
 
 /// The pattern (upper triangle with diagonal) of a matrix given by triplets; for tests and
@@ -491,15 +510,158 @@ pub fn upper_pattern(n: usize, edges: &[(usize, usize)]) -> SymbolicSparseColMat
     SymbolicSparseColMat::new_checked(n, n, cp, None, ri)
 }
 
-/// A sparse SPD solver for a fixed pattern: the symbolic analysis ([`symbolic_cholesky`]:
-/// nested dissection or AMD, supernodal above 1,000 unknowns) is done once, each
+thread_local! {
+    /// Whether [`analyse`] may split a factorisation over two threads on this thread.
+    static SPLIT_ALLOWED: std::cell::Cell<bool> = const { std::cell::Cell::new(true) };
+}
+
+/// Forbids (or allows again) two-thread factorisations analysed on the calling thread: for
+/// callers that already run one problem per core (the weight functions).
+pub fn allow_split_on_this_thread(allowed: bool) {
+    SPLIT_ALLOWED.with(|c| c.set(allowed));
+}
+
+/// How a fixed pattern is factorised: one faer factorisation (AMD or nested dissection,
+/// sequential or faer's parallel kernels), or two halves side by side ([`two_way`]).
+pub enum Analysis {
+    /// One factorisation.
+    Single {
+        /// faer's analysis.
+        symbolic: Box<SymbolicCholesky<usize>>,
+        /// Parallelism of its numeric factorisation.
+        par: Par,
+    },
+    /// The two parts of the top-level dissection on two threads.
+    TwoWay(Box<two_way::Symbolic>),
+}
+
+/// Speed-up of faer's parallel kernels on this machine's two cores, for factors above
+/// [`PARALLEL_MIN_FLOPS`] (measured: spot @3 solve 88.7 s sequential, 66.6 s parallel).
+const PARALLEL_SPEEDUP: f64 = 1.33;
+/// Below this many factor flops faer's parallel kernels were slower than sequential ones.
+const PARALLEL_MIN_FLOPS: f64 = 2e10;
+
+/// Analyses the upper-triangular pattern `a` of a symmetric positive definite matrix: nested
+/// dissection and AMD side by side, then the cheapest of AMD, nested dissection on one
+/// factorisation, and nested dissection's two halves on two threads (estimated time: flops on
+/// the critical path).
+///
+/// # Errors
+/// A message if faer's analysis fails.
+pub fn analyse(a: SymbolicSparseColMatRef<'_, usize>) -> Result<Analysis, String> {
+    let n = a.ncols();
+    let single = |symbolic: SymbolicCholesky<usize>| {
+        let par = parallelism_for(&symbolic);
+        Analysis::Single { symbolic: Box::new(symbolic), par }
+    };
+    let amd = || {
+        factorize_symbolic_cholesky(a, Side::Upper, SymmetricOrdering::Amd, params(n))
+            .map_err(|e| format!("symbolic Cholesky: {e:?}"))
+    };
+    if n < ND_MIN_N {
+        return Ok(single(amd()?));
+    }
+    let split_allowed = SPLIT_ALLOWED.with(|c| c.get());
+    let nd = || -> Result<Result<two_way::Symbolic, SymbolicCholesky<usize>>, String> {
+        let (perm, top) = nested_dissection_split(&Graph::from_pattern(a), ND_LEAF);
+        if let Some(t) = top.filter(|_| split_allowed).and_then(|sizes| two_way::Symbolic::new(a, &perm, sizes)) {
+            return Ok(Ok(t));
+        }
+        let inv = inverse(&perm);
+        let p = PermRef::new_checked(&perm, &inv, n);
+        factorize_symbolic_cholesky(a, Side::Upper, SymmetricOrdering::Custom(p), params(n))
+            .map(Err)
+            .map_err(|e| format!("symbolic Cholesky: {e:?}"))
+    };
+    let (amd, nd) = std::thread::scope(|scope| {
+        let other = scope.spawn(amd);
+        let nd = nd();
+        (other.join().unwrap_or_else(|e| std::panic::resume_unwind(e)), nd)
+    });
+    let (amd, nd) = (amd?, nd?);
+    let time = |s: &SymbolicCholesky<usize>| {
+        let f = factor_flops(s);
+        if f < PARALLEL_MIN_FLOPS {
+            f
+        } else {
+            f / PARALLEL_SPEEDUP
+        }
+    };
+    Ok(match nd {
+        Ok(two) if two.critical_flops() < time(&amd) => Analysis::TwoWay(Box::new(two)),
+        Ok(_) => single(amd),
+        Err(nd) if factor_flops(&nd) < factor_flops(&amd) => single(nd),
+        Err(_) => single(amd),
+    })
+}
+
+/// Numeric storage for one [`Analysis`].
+enum Numeric {
+    Single { l: Vec<f64>, mem: MemBuffer },
+    TwoWay(Box<two_way::TwoWay>),
+}
+
+/// A Cholesky factorisation of matrices with one analysed pattern: [`SpdFactor::factor`]
+/// refactors the values, [`SpdFactor::solve_in_place`] solves with the last factor.
+pub struct SpdFactor {
+    analysis: std::rc::Rc<Analysis>,
+    numeric: Numeric,
+}
+
+impl SpdFactor {
+    /// Workspace for `analysis`.
+    ///
+    /// # Errors
+    /// A message if the workspace cannot be allocated.
+    pub fn new(analysis: std::rc::Rc<Analysis>) -> Result<SpdFactor, String> {
+        let numeric = match &*analysis {
+            Analysis::Single { symbolic, par } => Numeric::Single {
+                l: vec![0.0; symbolic.len_val()],
+                mem: MemBuffer::try_new(StackReq::any_of(&[
+                    symbolic.factorize_numeric_llt_scratch::<f64>(*par, Spec::default()),
+                    symbolic.solve_in_place_scratch::<f64>(1, *par),
+                ]))
+                .map_err(|_| "out of memory for the Cholesky workspace".to_string())?,
+            },
+            Analysis::TwoWay(s) => Numeric::TwoWay(Box::new(two_way::TwoWay::new(s)?)),
+        };
+        Ok(SpdFactor { analysis, numeric })
+    }
+
+    /// Factorises `a` (upper triangle, the analysed pattern).
+    ///
+    /// # Errors
+    /// A message if `a` is not numerically positive definite.
+    pub fn factor(&mut self, a: SparseColMatRef<'_, usize, f64>) -> Result<(), String> {
+        match (&*self.analysis, &mut self.numeric) {
+            (Analysis::Single { symbolic, par }, Numeric::Single { l, mem }) => symbolic
+                .factorize_numeric_llt(l, a, Side::Upper, Default::default(), *par, MemStack::new(mem), Spec::default())
+                .map(|_| ())
+                .map_err(|e| format!("{e:?}")),
+            (Analysis::TwoWay(s), Numeric::TwoWay(t)) => t.factor(s, a.val()),
+            _ => unreachable!("numeric storage made for its analysis"),
+        }
+    }
+
+    /// Overwrites `b` with `A⁻¹ b` for the last factorised `A`.
+    pub fn solve_in_place(&mut self, b: &mut [f64]) {
+        match (&*self.analysis, &mut self.numeric) {
+            (Analysis::Single { symbolic, par }, Numeric::Single { l, mem }) => {
+                let n = b.len();
+                let rhs = faer::MatMut::from_column_major_slice_mut(b, n, 1);
+                LltRef::new(symbolic, l).solve_in_place_with_conj(Conj::No, rhs, *par, MemStack::new(mem));
+            }
+            (Analysis::TwoWay(s), Numeric::TwoWay(t)) => t.solve_in_place(s, b),
+            _ => unreachable!("numeric storage made for its analysis"),
+        }
+    }
+}
+
+/// A sparse SPD solver for a fixed pattern: the analysis ([`analyse`]) is done once, each
 /// [`SpdSolver::solve`] refactors the values and solves (for repeated solves with the same
 /// pattern and different values).
 pub struct SpdSolver {
-    s: SymbolicCholesky<usize>,
-    par: Par,
-    l: Vec<f64>,
-    mem: MemBuffer,
+    f: SpdFactor,
 }
 
 impl SpdSolver {
@@ -508,14 +670,13 @@ impl SpdSolver {
     /// # Errors
     /// A message if the analysis or the workspace allocation fails.
     pub fn new(pattern: SymbolicSparseColMatRef<'_, usize>) -> Result<Self, String> {
-        let s = symbolic_cholesky(pattern, Side::Upper)?;
-        let par = parallelism_for(&s);
-        let mem = MemBuffer::try_new(StackReq::any_of(&[
-            s.factorize_numeric_llt_scratch::<f64>(par, Spec::default()),
-            s.solve_in_place_scratch::<f64>(1, par),
-        ]))
-        .map_err(|_| "out of memory for the Cholesky workspace".to_string())?;
-        Ok(SpdSolver { l: vec![0.0; s.len_val()], s, par, mem })
+        thread_local! {
+            /// The last pattern analysed for an `SpdSolver` on this thread (a run's geodesic
+            /// and harmonic fills share the Laplacian's).
+            static LAST: SymbolicSlot<Analysis> = const { std::cell::RefCell::new(None) };
+        }
+        let analysis = cached_symbolic(&LAST, pattern, || analyse(pattern))?;
+        Ok(SpdSolver { f: SpdFactor::new(analysis)? })
     }
 
     /// Factors `a` (upper triangle, the analysed pattern) and overwrites `b` with `a⁻¹ b`.
@@ -523,20 +684,8 @@ impl SpdSolver {
     /// # Errors
     /// A message if `a` is not positive definite.
     pub fn solve(&mut self, a: SparseColMatRef<'_, usize, f64>, b: &mut [f64]) -> Result<(), String> {
-        let n = a.ncols();
-        let s = &self.s;
-        s.factorize_numeric_llt(
-            &mut self.l,
-            a,
-            Side::Upper,
-            Default::default(),
-            self.par,
-            MemStack::new(&mut self.mem),
-            Spec::default(),
-        )
-        .map_err(|e| format!("{e:?}"))?;
-        let rhs = faer::MatMut::from_column_major_slice_mut(b, n, 1);
-        LltRef::new(s, &self.l).solve_in_place_with_conj(Conj::No, rhs, self.par, MemStack::new(&mut self.mem));
+        self.f.factor(a)?;
+        self.f.solve_in_place(b);
         Ok(())
     }
 }
@@ -601,6 +750,84 @@ mod tests {
         assert!(factor_flops(&nd) < factor_flops(&amd));
         let best = symbolic_cholesky(a.as_ref(), Side::Upper).unwrap();
         assert_eq!(best.len_val(), nd.len_val());
+    }
+
+    /// A diagonally dominant SPD matrix on `a`'s pattern with off-diagonal entries of varying
+    /// size: values aligned with `a`'s entries.
+    fn spd_values(a: SymbolicSparseColMatRef<'_, usize>) -> Vec<f64> {
+        let n = a.ncols();
+        let (cp, ri) = (a.col_ptr(), a.row_idx());
+        let mut deg = vec![0.0; n];
+        let off = |i: usize, j: usize| -1.0 - ((i * 7 + j * 3) % 5) as f64 * 0.5;
+        for j in 0..n {
+            for &i in &ri[cp[j]..cp[j + 1]] {
+                if i != j {
+                    deg[i] -= off(i, j);
+                    deg[j] -= off(i, j);
+                }
+            }
+        }
+        (0..n)
+            .flat_map(|j| ri[cp[j]..cp[j + 1]].iter().map(move |&i| (i, j)))
+            .map(|(i, j)| if i == j { deg[j] + 0.01 } else { off(i, j) })
+            .collect()
+    }
+
+    /// Largest entry of `b − A x` for `A` given by its upper triangle.
+    fn residual(a: SymbolicSparseColMatRef<'_, usize>, vals: &[f64], x: &[f64], b: &[f64]) -> f64 {
+        let (cp, ri) = (a.col_ptr(), a.row_idx());
+        let mut r = b.to_vec();
+        for j in 0..a.ncols() {
+            for (p, &i) in ri[cp[j]..cp[j + 1]].iter().enumerate() {
+                let v = vals[cp[j] + p];
+                r[i] -= v * x[j];
+                if i != j {
+                    r[j] -= v * x[i];
+                }
+            }
+        }
+        r.iter().fold(0.0f64, |m, v| m.max(v.abs()))
+    }
+
+    #[test]
+    fn two_way_factorisation_solves_like_one_factorisation() {
+        for (nx, ny, ring2) in [(70, 50, true), (90, 40, false), (45, 45, true)] {
+            let n = nx * ny;
+            let a = upper_pattern(n, &grid_edges(nx, ny, ring2));
+            let vals = spd_values(a.as_ref());
+            let analysis = analyse(a.as_ref()).unwrap();
+            let Analysis::TwoWay(t) = &analysis else { panic!("{nx}x{ny}: a grid is split in two") };
+            // the separator is a thin cut: one or two grid lines across
+            assert!(t.separator_len() <= 3 * nx.max(ny), "separator {}", t.separator_len());
+            let mut f = SpdFactor::new(std::rc::Rc::new(analysis)).unwrap();
+            f.factor(SparseColMatRef::new(a.as_ref(), &vals)).unwrap();
+            for seed in 0..3 {
+                let b: Vec<f64> = (0..n).map(|i| ((i * (seed + 3)) as f64 * 0.37).sin()).collect();
+                let mut x = b.clone();
+                f.solve_in_place(&mut x);
+                let r = residual(a.as_ref(), &vals, &x, &b);
+                assert!(r < 1e-9, "{nx}x{ny}: residual {r:e}");
+            }
+            // not positive definite: an error, not a wrong answer
+            let mut bad = vals.clone();
+            let diag = a.col_ptr()[n / 2 + 1] - 1;
+            bad[diag] = -1.0;
+            assert!(f.factor(SparseColMatRef::new(a.as_ref(), &bad)).is_err());
+        }
+    }
+
+    #[test]
+    fn two_way_split_is_refused_when_the_parts_touch_or_on_request() {
+        let (nx, ny) = (60, 40);
+        let n = nx * ny;
+        let a = upper_pattern(n, &grid_edges(nx, ny, true));
+        // parts = first and second half of the rows, "separator" = the last row: they touch
+        let perm: Vec<usize> = (0..n).collect();
+        assert!(two_way::Symbolic::new(a.as_ref(), &perm, [n / 2, n / 2 - nx]).is_none());
+        allow_split_on_this_thread(false);
+        let analysis = analyse(a.as_ref());
+        allow_split_on_this_thread(true);
+        assert!(matches!(analysis.unwrap(), Analysis::Single { .. }));
     }
 
     #[test]

@@ -15,8 +15,9 @@ use crate::constraints::{choose_margin, constraint_edges, margin_cap, max_margin
 use crate::domain::{sos_sort, Domain, Grid2d, Series, TriMesh};
 use crate::error::{Error, Result};
 use crate::operators::{
-    cotan_stiffness, dirichlet_solve, grid_mass, grid_stiffness, lumped_mass, polyharmonic, positive_cotan_stiffness,
-    quadratic_form, scaled_plus_diagonal, series_mass, series_stiffness, Energy, Sparse,
+    cotan_stiffness, dirichlet_solve, grid_mass, grid_stiffness, lumped_mass, plus_diagonal, polyharmonic,
+    positive_cotan_stiffness, quadratic_form, quadratic_form_without_diagonal, series_mass, series_stiffness, Energy,
+    Sparse,
 };
 use crate::representative::{flooded_representative, separatrix_representative, series_representative};
 use crate::solve::{repair, solve_monotone_qp, Method, MonotoneQp, QpSettings, RepairSummary, SolveStatus};
@@ -507,6 +508,8 @@ pub fn smooth<D: Smoothable>(domain: &D, h: &[f64], settings: &SmoothSettings) -
         }
     };
 
+    // the fills' Laplacian analysis is not needed again: free it before the solver's
+    crate::linalg::forget_solver_analysis();
     let t = Instant::now();
     let m = domain.mass();
     let ell = settings.smooth_length * domain.diameter();
@@ -519,17 +522,19 @@ pub fn smooth<D: Smoothable>(domain: &D, h: &[f64], settings: &SmoothSettings) -
     let q_energy = polyharmonic(&k, &m, &settings.energy, &weights);
     let gd = settings.data_weight;
     let data_diag: Vec<f64> = m.iter().map(|mi| gd * mi).collect();
-    let p = scaled_plus_diagonal(&q_energy, 1.0, &data_diag);
+    let factor = match settings.qp.method {
+        Method::ClarabelAuxiliary => Some(energy_factor(&k, &m, &settings.energy, &weights, &q_energy)?),
+        _ => None,
+    };
+    // P = energy + data diagonal, in the energy's storage (one matrix of the size of a
+    // bilaplacian less: 300 MiB at a million vertices)
+    let p = plus_diagonal(q_energy, &data_diag);
     let q: Vec<f64> = (0..n).map(|i| -gd * m[i] * z[i]).collect();
     seconds.operators = t.elapsed().as_secs_f64();
 
     let t = Instant::now();
     let hint: Vec<f64> = u.iter().map(|v| (v - lo) / range).collect();
     let u_margin = edges.iter().map(|&(i, j)| u[j] - u[i]).fold(f64::INFINITY, f64::min);
-    let factor = match settings.qp.method {
-        Method::ClarabelAuxiliary => Some(energy_factor(&k, &m, &settings.energy, &weights, &q_energy)?),
-        _ => None,
-    };
     let qp = MonotoneQp {
         p: &p,
         q: &q,
@@ -570,7 +575,7 @@ pub fn smooth<D: Smoothable>(domain: &D, h: &[f64], settings: &SmoothSettings) -
         });
     }
 
-    let smoothness = quadratic_form(&q_energy, &f);
+    let smoothness = quadratic_form_without_diagonal(&p, &data_diag, &f);
     let data: f64 = gd * (0..n).map(|i| m[i] * (f[i] - h[i]).powi(2)).sum::<f64>();
     let sq: f64 = (0..n).map(|i| (f[i] - h[i]).powi(2)).sum();
     let max_deviation = (0..n).map(|i| (f[i] - h[i]).abs()).fold(0.0, f64::max);

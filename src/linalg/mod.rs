@@ -657,6 +657,18 @@ impl SpdFactor {
     }
 }
 
+thread_local! {
+    /// The last pattern analysed for an [`SpdSolver`] on this thread (a run's geodesic and
+    /// harmonic fills share the Laplacian's).
+    static SOLVER_LAST: SymbolicSlot<Analysis> = const { std::cell::RefCell::new(None) };
+}
+
+/// Drops the analysis [`SpdSolver::new`] keeps for reuse on this thread (a million-vertex
+/// Laplacian's is hundreds of MiB): for callers done with that pattern.
+pub fn forget_solver_analysis() {
+    SOLVER_LAST.with(|c| *c.borrow_mut() = None);
+}
+
 /// A sparse SPD solver for a fixed pattern: the analysis ([`analyse`]) is done once, each
 /// [`SpdSolver::solve`] refactors the values and solves (for repeated solves with the same
 /// pattern and different values).
@@ -670,12 +682,7 @@ impl SpdSolver {
     /// # Errors
     /// A message if the analysis or the workspace allocation fails.
     pub fn new(pattern: SymbolicSparseColMatRef<'_, usize>) -> Result<Self, String> {
-        thread_local! {
-            /// The last pattern analysed for an `SpdSolver` on this thread (a run's geodesic
-            /// and harmonic fills share the Laplacian's).
-            static LAST: SymbolicSlot<Analysis> = const { std::cell::RefCell::new(None) };
-        }
-        let analysis = cached_symbolic(&LAST, pattern, || analyse(pattern))?;
+        let analysis = cached_symbolic(&SOLVER_LAST, pattern, || analyse(pattern))?;
         Ok(SpdSolver { f: SpdFactor::new(analysis)? })
     }
 

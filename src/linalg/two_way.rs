@@ -30,7 +30,8 @@ use faer::{Accum, Conj, Mat, MatMut, Par, Side, Spec};
 struct Half {
     verts: Vec<usize>,
     pattern: SymbolicSparseColMat<usize>,
-    src: Vec<usize>,
+    /// (u32: a million-unknown bilaplacian has 2·10⁷ entries; N's values fit far below 2³².)
+    src: Vec<u32>,
     symbolic: SymbolicCholesky<usize>,
 }
 
@@ -115,7 +116,7 @@ impl Symbolic {
                 col_ptr[j + 1] += col_ptr[j];
             }
             let row_idx: Vec<usize> = t.iter().map(|&(i, _, _)| i).collect();
-            let src: Vec<usize> = t.iter().map(|&(_, _, p)| p).collect();
+            let src = t.iter().map(|&(_, _, p)| u32::try_from(p).ok()).collect::<Option<Vec<u32>>>()?;
             let pattern = SymbolicSparseColMat::new_checked(m, m, col_ptr, None, row_idx);
             let symbolic =
                 factorize_symbolic_cholesky(pattern.as_ref(), Side::Upper, SymmetricOrdering::Identity, params).ok()?;
@@ -152,15 +153,16 @@ struct HalfNumeric {
     mem: MemBuffer,
     /// The trailing block `T` (lower triangle, zero above).
     t: Mat<f64>,
-    /// `T Tᵀ` (lower triangle).
-    gram: Mat<f64>,
     work: Vec<f64>,
 }
 
 /// A two-way factorisation: numeric values for a [`Symbolic`].
 pub struct TwoWay {
     halves: [HalfNumeric; 2],
+    /// `T_A T_Aᵀ`, then `Σ`, then `L_Σ` (lower triangles).
     sigma: Mat<f64>,
+    /// `T_B T_Bᵀ` (lower triangle).
+    gram: Mat<f64>,
     sigma_mem: MemBuffer,
 }
 
@@ -191,7 +193,6 @@ impl TwoWay {
                 l: vec![0.0; h.symbolic.len_val()],
                 mem: MemBuffer::try_new(req).map_err(oom)?,
                 t: Mat::zeros(ls, ls),
-                gram: Mat::zeros(ls, ls),
                 work: vec![0.0; m],
             });
         }
@@ -204,7 +205,7 @@ impl TwoWay {
         .map_err(oom)?;
         let h1 = halves.pop().expect("two halves");
         let h0 = halves.pop().expect("two halves");
-        Ok(TwoWay { halves: [h0, h1], sigma: Mat::zeros(ls, ls), sigma_mem })
+        Ok(TwoWay { halves: [h0, h1], sigma: Mat::zeros(ls, ls), gram: Mat::zeros(ls, ls), sigma_mem })
     }
 
     /// Factorises `N` given by `values` (aligned with the analysed pattern).
@@ -214,18 +215,18 @@ impl TwoWay {
     pub fn factor(&mut self, s: &Symbolic, values: &[f64]) -> Result<(), String> {
         let [n0, n1] = &mut self.halves;
         let [h0, h1] = &s.halves;
+        let (sigma, gram) = (&mut self.sigma, &mut self.gram);
         let (r0, r1) = std::thread::scope(|scope| {
-            let other = scope.spawn(|| factor_half(h1, n1, values));
-            let mine = factor_half(h0, n0, values);
+            let other = scope.spawn(|| factor_half(h1, n1, values, gram));
+            let mine = factor_half(h0, n0, values, sigma);
             (mine, other.join().unwrap_or_else(|e| std::panic::resume_unwind(e)))
         });
         r0?;
         r1?;
         let ls = s.sep.len();
-        let (g0, g1) = (&self.halves[0].gram, &self.halves[1].gram);
         for j in 0..ls {
             for i in j..ls {
-                self.sigma[(i, j)] = g0[(i, j)] + g1[(i, j)];
+                self.sigma[(i, j)] += self.gram[(i, j)];
             }
         }
         for &(i, j, p) in &s.sep_entries {
@@ -285,10 +286,10 @@ impl TwoWay {
     }
 }
 
-/// Gathers a half's values, factorises it, extracts `T` and forms `T Tᵀ`.
-fn factor_half(h: &Half, num: &mut HalfNumeric, values: &[f64]) -> Result<(), String> {
+/// Gathers a half's values, factorises it, extracts `T` and writes `T Tᵀ` to `gram`.
+fn factor_half(h: &Half, num: &mut HalfNumeric, values: &[f64], gram: &mut Mat<f64>) -> Result<(), String> {
     for (v, &p) in num.values.iter_mut().zip(&h.src) {
-        *v = values[p];
+        *v = values[p as usize];
     }
     h.symbolic
         .factorize_numeric_llt(
@@ -328,7 +329,7 @@ fn factor_half(h: &Half, num: &mut HalfNumeric, values: &[f64]) -> Result<(), St
         }
     }
     faer::linalg::matmul::triangular::matmul(
-        num.gram.as_mut(),
+        gram.as_mut(),
         BlockStructure::TriangularLower,
         Accum::Replace,
         num.t.as_ref(),

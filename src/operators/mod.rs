@@ -30,4 +30,4 @@ pub use gradient::gradient_operator;
 pub use harmonic::{dirichlet_solve, Dirichlet};
 pub use polyharmonic::{polyharmonic, Energy};
 pub use series::{series_mass, series_stiffness};
-pub use sparse::{quadratic_form, scaled_plus_diagonal, Sparse};
+pub use sparse::{plus_diagonal, quadratic_form, quadratic_form_without_diagonal, scaled_plus_diagonal, Sparse};

@@ -66,6 +66,40 @@ pub fn scaled_plus_diagonal(a: &Sparse, c: f64, d: &[f64]) -> Sparse {
     from_triplets(n, n, &t)
 }
 
+/// `A + diag(d)`, reusing `a`'s storage when its pattern holds every diagonal entry.
+pub fn plus_diagonal(mut a: Sparse, d: &[f64]) -> Sparse {
+    let n = a.nrows();
+    let (cp, ri) = (a.symbolic().col_ptr(), a.symbolic().row_idx());
+    let diag: Option<Vec<usize>> =
+        (0..n).map(|j| ri[cp[j]..cp[j + 1]].iter().position(|&i| i == j).map(|p| cp[j] + p)).collect();
+    match diag {
+        Some(diag) => {
+            let val = a.val_mut();
+            for (j, p) in diag.into_iter().enumerate() {
+                val[p] += d[j];
+            }
+            a
+        }
+        None => scaled_plus_diagonal(&a, 1.0, d),
+    }
+}
+
+/// `fᵀ (A − diag(d)) f` for an `A` that holds `diag(d)` in its diagonal entries (from
+/// [`plus_diagonal`]): `d` is taken off each diagonal entry before it is used, so a large `d`
+/// does not swamp the rest by cancellation.
+pub fn quadratic_form_without_diagonal(a: &Sparse, d: &[f64], f: &[f64]) -> f64 {
+    let (cp, ri, v) = (a.symbolic().col_ptr(), a.symbolic().row_idx(), a.val());
+    let mut s = 0.0;
+    for j in 0..a.ncols() {
+        for p in cp[j]..cp[j + 1] {
+            let i = ri[p];
+            let aij = if i == j { v[p] - d[j] } else { v[p] };
+            s += f[i] * aij * f[j];
+        }
+    }
+    s
+}
+
 /// `A · B`.
 pub(crate) fn matmul(a: &Sparse, b: &Sparse) -> Sparse {
     sparse_sparse_matmul(a.as_ref(), b.as_ref(), 1.0, Par::Seq).expect("sparse product fits in memory")

@@ -444,13 +444,23 @@ pub struct Smoothed {
     pub complex: Option<MorseSmale>,
 }
 
+/// The energy's matrices, built beside the representative.
+struct Operators {
+    m: Vec<f64>,
+    weights: Vec<f64>,
+    data_diag: Vec<f64>,
+    factor: Option<Sparse>,
+    p: Sparse,
+    q: Vec<f64>,
+}
+
 /// Smooths `h` on `domain` keeping exactly the selected extrema; returns only certified output.
 ///
 /// # Errors
 /// Input and usage errors (exit 3, 2), an unrealizable explicit list (3), a representative
 /// that fails its check (1), no solver point (4), an output that fails the certificate even
 /// after repair (1).
-pub fn smooth<D: Smoothable>(domain: &D, h: &[f64], settings: &SmoothSettings) -> Result<Smoothed> {
+pub fn smooth<D: Smoothable + Sync>(domain: &D, h: &[f64], settings: &SmoothSettings) -> Result<Smoothed> {
     settings.validate()?;
     let n = domain.n_vertices();
     if h.len() != n {
@@ -477,60 +487,87 @@ pub fn smooth<D: Smoothable>(domain: &D, h: &[f64], settings: &SmoothSettings) -
     // A representative whose order makes the constraints infeasible (the harmonic one can
     // order a high kept minimum below a low kept maximum) gives way to the next construction;
     // for a kept set chosen by persistence the flooded one always fits the data's order.
-    let mut excluded: Vec<(&'static str, String)> = Vec::new();
-    let (u, representative, complex, representative_certificate, edges, eps_max, eps) = loop {
-        let t = Instant::now();
-        let rep = domain.representative(h, &kept, settings.representative, &k, &excluded)?;
-        if let Some(ms) = &rep.complex {
-            seconds.complex = ms.seconds[0];
-            seconds.simplify = ms.seconds[1];
-        }
-        let representative_certificate = certify(domain, &rep.u, &kept.roles, None);
-        if !representative_certificate.passed {
-            return Err(Error::Representative { path: None, message: representative_certificate.summary() });
-        }
-        seconds.representative += t.elapsed().as_secs_f64() - seconds.complex - seconds.simplify;
-        let t = Instant::now();
-        let edges = constraint_edges(domain, &rep.u, &fixed, settings.edges);
-        let margins = max_margin(&rep.u, &edges, &fixed, Some(margin_cap(1.0, resolution)))
-            .and_then(|eps_max| Ok((eps_max, choose_margin(eps_max, 1.0, resolution)?)));
-        seconds.constraints += t.elapsed().as_secs_f64();
-        match margins {
-            Ok((eps_max, eps)) => {
-                break (rep.u, rep.name, rep.complex, representative_certificate, edges, eps_max, eps);
+    let mut representative_stage = || -> Result<_> {
+        let mut excluded: Vec<(&'static str, String)> = Vec::new();
+        loop {
+            let t = Instant::now();
+            let rep = domain.representative(h, &kept, settings.representative, &k, &excluded)?;
+            if let Some(ms) = &rep.complex {
+                seconds.complex = ms.seconds[0];
+                seconds.simplify = ms.seconds[1];
             }
-            Err(e @ Error::Infeasible { .. })
-                if settings.selection.by_persistence() && rep.kind != "linear" && rep.kind != "flooded" =>
-            {
-                excluded.push((rep.kind, e.to_string()));
+            let representative_certificate = certify(domain, &rep.u, &kept.roles, None);
+            if !representative_certificate.passed {
+                return Err(Error::Representative { path: None, message: representative_certificate.summary() });
             }
-            Err(e) => return Err(e),
+            seconds.representative += t.elapsed().as_secs_f64() - seconds.complex - seconds.simplify;
+            let t = Instant::now();
+            let edges = constraint_edges(domain, &rep.u, &fixed, settings.edges);
+            let margins = max_margin(&rep.u, &edges, &fixed, Some(margin_cap(1.0, resolution)))
+                .and_then(|eps_max| Ok((eps_max, choose_margin(eps_max, 1.0, resolution)?)));
+            seconds.constraints += t.elapsed().as_secs_f64();
+            match margins {
+                Ok((eps_max, eps)) => {
+                    return Ok((rep.u, rep.name, rep.complex, representative_certificate, edges, eps_max, eps));
+                }
+                Err(e @ Error::Infeasible { .. })
+                    if settings.selection.by_persistence() && rep.kind != "linear" && rep.kind != "flooded" =>
+                {
+                    excluded.push((rep.kind, e.to_string()));
+                }
+                Err(e) => return Err(e),
+            }
         }
     };
-
+    // The energy and the solver's analysis of its normal matrix need only the kept set: they
+    // are built on the other core while the complex and the representative are.
+    let operators = || -> Result<Operators> {
+        let m = domain.mass();
+        let ell = settings.smooth_length * domain.diameter();
+        let weights: Vec<f64> = settings
+            .energy
+            .terms
+            .iter()
+            .map(|&(order, _)| settings.smooth_weight.unwrap_or(ell.powi(2 * order as i32)))
+            .collect();
+        let q_energy = polyharmonic(&k, &m, &settings.energy, &weights);
+        let gd = settings.data_weight;
+        let data_diag: Vec<f64> = m.iter().map(|mi| gd * mi).collect();
+        let factor = match settings.qp.method {
+            Method::ClarabelAuxiliary => Some(energy_factor(&k, &m, &settings.energy, &weights, &q_energy)?),
+            _ => None,
+        };
+        // P = energy + data diagonal, in the energy's storage (one matrix of the size of a
+        // bilaplacian less: 300 MiB at a million vertices)
+        let p = plus_diagonal(q_energy, &data_diag);
+        let q: Vec<f64> = (0..n).map(|i| -gd * m[i] * z[i]).collect();
+        Ok(Operators { m, weights, data_diag, factor, p, q })
+    };
+    let (representative_result, (operators_result, operators_seconds, prepared)) = std::thread::scope(|scope| {
+        let background = scope.spawn(|| {
+            let t = Instant::now();
+            let ops = operators();
+            let seconds = t.elapsed().as_secs_f64();
+            let prepared = match (&ops, settings.qp.method) {
+                // a failed analysis is redone (and reported) by the solver itself
+                (Ok(o), Method::Structured) => crate::solve::prepare(&o.p, &fixed).ok(),
+                _ => None,
+            };
+            (ops, seconds, prepared)
+        });
+        let rep = representative_stage();
+        (rep, background.join().unwrap_or_else(|e| std::panic::resume_unwind(e)))
+    });
+    let (u, representative, complex, representative_certificate, edges, eps_max, eps) = representative_result?;
+    let Operators { m, weights, data_diag, factor, p, q } = operators_result?;
+    seconds.operators = operators_seconds;
+    let gd = settings.data_weight;
+    let ell = settings.smooth_length * domain.diameter();
     // the fills' Laplacian analysis is not needed again: free it before the solver's
     crate::linalg::forget_solver_analysis();
-    let t = Instant::now();
-    let m = domain.mass();
-    let ell = settings.smooth_length * domain.diameter();
-    let weights: Vec<f64> = settings
-        .energy
-        .terms
-        .iter()
-        .map(|&(order, _)| settings.smooth_weight.unwrap_or(ell.powi(2 * order as i32)))
-        .collect();
-    let q_energy = polyharmonic(&k, &m, &settings.energy, &weights);
-    let gd = settings.data_weight;
-    let data_diag: Vec<f64> = m.iter().map(|mi| gd * mi).collect();
-    let factor = match settings.qp.method {
-        Method::ClarabelAuxiliary => Some(energy_factor(&k, &m, &settings.energy, &weights, &q_energy)?),
-        _ => None,
-    };
-    // P = energy + data diagonal, in the energy's storage (one matrix of the size of a
-    // bilaplacian less: 300 MiB at a million vertices)
-    let p = plus_diagonal(q_energy, &data_diag);
-    let q: Vec<f64> = (0..n).map(|i| -gd * m[i] * z[i]).collect();
-    seconds.operators = t.elapsed().as_secs_f64();
+    if let Some(prepared) = prepared {
+        prepared.install();
+    }
 
     let t = Instant::now();
     let hint: Vec<f64> = u.iter().map(|v| (v - lo) / range).collect();

@@ -12,7 +12,7 @@
 
 use super::qp::{QpSettings, ReducedQp, SolveStatus};
 use crate::linalg as ordering;
-use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
+use faer::sparse::{SparseColMatRef, SymbolicSparseColMat, SymbolicSparseColMatRef};
 
 /// Upper-triangular pattern of `N` and where each contribution lands in its value array.
 struct Normal {
@@ -25,60 +25,47 @@ struct Normal {
     pos_diag: Vec<usize>,
 }
 
+/// Upper-triangular pattern, every diagonal entry included, of the pairs `(i, j)` with
+/// `i ≤ j` (duplicates merged): column pointers and sorted row indices.
+fn upper_pattern(n: usize, pairs: impl Iterator<Item = (usize, usize)> + Clone) -> (Vec<usize>, Vec<usize>) {
+    let mut count = vec![0usize; n + 1];
+    for (_, j) in pairs.clone() {
+        count[j + 1] += 1;
+    }
+    for j in 0..n {
+        count[j + 1] += count[j] + 1;
+    }
+    let mut fill = count.clone();
+    let mut rows = vec![0usize; count[n]];
+    for j in 0..n {
+        rows[fill[j]] = j;
+        fill[j] += 1;
+    }
+    for (i, j) in pairs {
+        rows[fill[j]] = i;
+        fill[j] += 1;
+    }
+    let mut col_ptr = vec![0usize; n + 1];
+    let mut row_idx = Vec::with_capacity(rows.len());
+    for j in 0..n {
+        let col = &mut rows[count[j]..count[j + 1]];
+        col.sort_unstable();
+        let start = row_idx.len();
+        for &i in col.iter() {
+            if row_idx.len() == start || row_idx[row_idx.len() - 1] != i {
+                row_idx.push(i);
+            }
+        }
+        col_ptr[j + 1] = row_idx.len();
+    }
+    (col_ptr, row_idx)
+}
+
 impl Normal {
     fn new(r: &ReducedQp, row_cols: &[[usize; 2]], row_len: &[u8]) -> Normal {
         let n = r.n;
-        let mut count = vec![0usize; n + 1];
-        let mut push = |c: usize| count[c + 1] += 1;
-        for &(_, j, _) in &r.p {
-            push(j);
-        }
-        for (k, cols) in row_cols.iter().enumerate() {
-            push(cols[0]);
-            if row_len[k] == 2 {
-                push(cols[1]);
-                push(cols[0].max(cols[1]));
-            }
-        }
-        for j in 0..n {
-            push(j);
-        }
-        for j in 0..n {
-            count[j + 1] += count[j];
-        }
-        let mut fill = count.clone();
-        let mut rows = vec![0usize; count[n]];
-        let mut put = |i: usize, j: usize| {
-            rows[fill[j]] = i;
-            fill[j] += 1;
-        };
-        for &(i, j, _) in &r.p {
-            put(i, j);
-        }
-        for (k, c) in row_cols.iter().enumerate() {
-            put(c[0], c[0]);
-            if row_len[k] == 2 {
-                put(c[1], c[1]);
-                put(c[0].min(c[1]), c[0].max(c[1]));
-            }
-        }
-        for j in 0..n {
-            put(j, j);
-        }
-        // sort and deduplicate each column
-        let mut col_ptr = vec![0usize; n + 1];
-        let mut row_idx = Vec::with_capacity(rows.len());
-        for j in 0..n {
-            let col = &mut rows[count[j]..count[j + 1]];
-            col.sort_unstable();
-            let start = row_idx.len();
-            for &i in col.iter() {
-                if row_idx.len() == start || *row_idx.last().expect("non-empty") != i {
-                    row_idx.push(i);
-                }
-            }
-            col_ptr[j + 1] = row_idx.len();
-        }
+        let rows = row_cols.iter().zip(row_len).filter(|(_, &l)| l == 2).map(|(c, _)| (c[0].min(c[1]), c[0].max(c[1])));
+        let (col_ptr, row_idx) = upper_pattern(n, r.p.iter().map(|&(i, j, _)| (i, j)).chain(rows));
         let find = |i: usize, j: usize| {
             col_ptr[j] + row_idx[col_ptr[j]..col_ptr[j + 1]].binary_search(&i).expect("in pattern")
         };
@@ -98,6 +85,48 @@ impl Normal {
         let pos_diag = (0..n).map(|j| find(j, j)).collect();
         let symbolic = SymbolicSparseColMat::new_checked(n, n, col_ptr, None, row_idx);
         Normal { symbolic, pos_p, pos_row, pos_diag }
+    }
+}
+
+/// The analysis of a normal matrix made before its constraints are known: from the pattern of
+/// `P` on the free variables alone. The constrained pairs of a monotone QP are edges of the
+/// domain, inside the pattern of any energy built on its Laplacian, so the normal matrix's
+/// pattern is that one and [`solve`] finds this analysis ready ([`Prepared::install`]).
+pub struct Prepared {
+    pattern: SymbolicSparseColMat<usize>,
+    analysis: ordering::Analysis,
+}
+
+impl Prepared {
+    /// Analyses the pattern of the upper triangle of `P` on the free variables (`slot[i]`:
+    /// index of variable `i` among the free ones, `usize::MAX` if fixed; `n` free ones).
+    ///
+    /// # Errors
+    /// A message if the analysis fails.
+    pub fn new(p: SymbolicSparseColMatRef<'_, usize>, slot: &[usize], n: usize) -> Result<Prepared, String> {
+        let (cp, ri) = (p.col_ptr(), p.row_idx());
+        let pairs = (0..p.ncols()).flat_map(|j| {
+            ri[cp[j]..p.col_range(j).end].iter().filter_map(move |&i| {
+                let (si, sj) = (slot[i], slot[j]);
+                (si != usize::MAX && sj != usize::MAX && si <= sj).then_some((si, sj))
+            })
+        });
+        let (col_ptr, row_idx) = upper_pattern(n, pairs);
+        let pattern = SymbolicSparseColMat::new_checked(n, n, col_ptr, None, row_idx);
+        let analysis = ordering::analyse(pattern.as_ref())?;
+        Ok(Prepared { pattern, analysis })
+    }
+
+    /// The analysed pattern.
+    #[cfg(test)]
+    pub(crate) fn pattern(&self) -> SymbolicSparseColMatRef<'_, usize> {
+        self.pattern.as_ref()
+    }
+
+    /// Makes the analysis the one [`solve`] on this thread uses for a normal matrix of this
+    /// pattern.
+    pub fn install(self) {
+        LAST.with(|c| *c.borrow_mut() = Some((self.pattern, std::rc::Rc::new(self.analysis))));
     }
 }
 
@@ -350,4 +379,17 @@ pub fn solve(
         "no convergence in {} iterations (primal {pres:.1e}, dual {dres:.1e}, gap {mu:.1e})",
         settings.max_iter
     ))
+}
+
+/// The normal matrix's pattern [`solve`] analyses for `r`.
+#[cfg(test)]
+pub(crate) fn normal_pattern(r: &ReducedQp) -> SymbolicSparseColMat<usize> {
+    let mut row_cols = vec![[0usize; 2]; r.m()];
+    let mut row_len = vec![0u8; r.m()];
+    for k in 0..r.a_row.len() {
+        let row = r.a_row[k];
+        row_cols[row][row_len[row] as usize] = r.a_col[k];
+        row_len[row] += 1;
+    }
+    Normal::new(r, &row_cols, &row_len).symbolic
 }

@@ -11,5 +11,6 @@ mod qp;
 mod repair;
 
 pub use bounded::solve_bounded_partition;
-pub use qp::{solve_monotone_qp, Method, MonotoneQp, QpSettings, QpSolution, ReducedQp, SolveStatus};
+pub use ipm::Prepared;
+pub use qp::{prepare, solve_monotone_qp, Method, MonotoneQp, QpSettings, QpSolution, ReducedQp, SolveStatus};
 pub use repair::{repair, RepairSummary};

@@ -1,5 +1,6 @@
 //! The monotone QP, its reduction to the free variables, and the choice of solver.
 
+use super::ipm::Prepared;
 use crate::error::Result;
 use crate::operators::Sparse;
 
@@ -163,6 +164,27 @@ pub fn solve_monotone_qp(qp: &MonotoneQp<'_>, settings: &QpSettings) -> Result<Q
     Ok(QpSolution { x, status, iterations, method, fallback })
 }
 
+/// The structured solver's analysis of the normal matrix of a QP with energy `p` and fixed
+/// entries `fixed`, made before the constraints and the linear term are known (so that it can
+/// run beside the work that finds them); installed on the calling thread by
+/// [`Prepared::install`], it is used by the next [`solve_monotone_qp`] there whose normal
+/// matrix has this pattern (constrained pairs inside `p`'s pattern, as for every energy
+/// built on the domain's Laplacian).
+///
+/// # Errors
+/// A message if the analysis fails.
+pub fn prepare(p: &Sparse, fixed: &[Option<f64>]) -> std::result::Result<Prepared, String> {
+    let mut slot = vec![usize::MAX; fixed.len()];
+    let mut n = 0;
+    for (i, f) in fixed.iter().enumerate() {
+        if f.is_none() {
+            slot[i] = n;
+            n += 1;
+        }
+    }
+    Prepared::new(p.symbolic(), &slot, n)
+}
+
 /// Eliminates the fixed variables: `P_FF`, `q_F + P_FX x_X`, and one row per constrained edge.
 fn reduce(qp: &MonotoneQp<'_>, free: &[usize]) -> ReducedQp {
     let n = qp.q.len();
@@ -223,6 +245,61 @@ fn reduce(qp: &MonotoneQp<'_>, free: &[usize]) -> ReducedQp {
 mod tests {
     use super::*;
     use faer::sparse::Triplet;
+
+    /// `P = K + I` of an `nx × ny` grid with the 4-neighbour Laplacian `K`, and its edges.
+    fn grid_qp(nx: usize, ny: usize) -> (Sparse, Vec<(usize, usize)>) {
+        let n = nx * ny;
+        let mut t = Vec::new();
+        let mut edges = Vec::new();
+        for y in 0..ny {
+            for x in 0..nx {
+                let v = y * nx + x;
+                t.push(Triplet::new(v, v, 1.0));
+                for w in [(x + 1 < nx).then_some(v + 1), (y + 1 < ny).then_some(v + nx)].into_iter().flatten() {
+                    edges.push((v, w));
+                    t.extend([Triplet::new(v, w, -1.0), Triplet::new(w, v, -1.0)]);
+                    t.extend([Triplet::new(v, v, 1.0), Triplet::new(w, w, 1.0)]);
+                }
+            }
+        }
+        (Sparse::try_new_from_triplets(n, n, &t).unwrap(), edges)
+    }
+
+    #[test]
+    fn a_prepared_analysis_matches_the_normal_matrix_and_changes_nothing() {
+        let (nx, ny) = (60, 50);
+        let n = nx * ny;
+        let (p, edges) = grid_qp(nx, ny);
+        let h: Vec<f64> = (0..n).map(|i| ((i % nx) as f64 * 0.3).sin() + (i / nx) as f64 * 0.01).collect();
+        let q: Vec<f64> = h.iter().map(|v| -v).collect();
+        let mut fixed = vec![None; n];
+        fixed[0] = Some(-1.0);
+        fixed[n - 1] = Some(2.0);
+        // every edge increasing to the right and upwards: a monotone ramp, feasible
+        let hint: Vec<f64> = (0..n).map(|i| -1.0 + 3.0 * ((i % nx) + (i / nx)) as f64 / (nx + ny - 2) as f64).collect();
+        let qp =
+            MonotoneQp { p: &p, q: &q, fixed: &fixed, edges: &edges, margin: 1e-6, hint: Some(&hint), factored: None };
+        let free: Vec<usize> = (0..n).filter(|&i| fixed[i].is_none()).collect();
+        let reduced = reduce(&qp, &free);
+        let prepared = prepare(&p, &fixed).unwrap();
+        let normal = super::super::ipm::normal_pattern(&reduced);
+        let same = |a: faer::sparse::SymbolicSparseColMatRef<'_, usize>| {
+            a.col_ptr() == normal.col_ptr() && a.row_idx() == normal.row_idx()
+        };
+        assert!(same(prepared.pattern()), "the prepared pattern is the normal matrix's");
+        // a constrained pair outside P's pattern: a different pattern (analysed anew by the solver)
+        let far = [(1, n - 2)];
+        let other = reduce(&MonotoneQp { edges: &far, ..qp }, &free);
+        assert!(!same(super::super::ipm::normal_pattern(&other).as_ref()));
+        let settings = QpSettings::default();
+        let plain = solve_monotone_qp(&qp, &settings).unwrap();
+        prepare(&p, &fixed).unwrap().install();
+        let with = solve_monotone_qp(&qp, &settings).unwrap();
+        assert_eq!(plain.iterations, with.iterations);
+        let diff = plain.x.iter().zip(&with.x).fold(0.0f64, |a, (x, y)| a.max((x - y).abs()));
+        assert!(diff < 1e-12, "{diff:e}");
+        assert!(edges.iter().all(|&(i, j)| with.x[j] - with.x[i] >= 0.5e-6));
+    }
 
     #[test]
     fn both_solvers_project_onto_a_monotone_chain() {

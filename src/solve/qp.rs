@@ -45,7 +45,8 @@ pub enum Method {
 pub struct QpSettings {
     /// Largest number of interior-point iterations. {200}
     pub max_iter: u32,
-    /// Feasibility and gap tolerance on the scaled problem. {1e-9}
+    /// Feasibility tolerance on the scaled problem; the structured solver also needs the mean
+    /// complementarity 10× below it. {1e-9}
     pub tolerance: f64,
     /// Solver. {structured}
     pub method: Method,

@@ -8,8 +8,9 @@
 //! small parts by faer's AMD. On planar-like graphs (grids, triangulated meshes) this
 //! gives far less fill and fewer flops than minimum degree at large n (about 20 % at a million vertices with
 //! the 19-point pattern of a bilaplacian).
-//! [`symbolic_cholesky`] analyses a pattern with both this ordering and AMD and keeps the one
-//! whose factorisation needs fewer flops.
+//! [`analyse`] orders a pattern with both this ordering and AMD and keeps the cheapest
+//! factorisation: AMD, nested dissection, or nested dissection's two halves side by side
+//! ([`two_way`]).
 
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::perm::PermRef;
@@ -22,6 +23,27 @@ use faer::sparse::{SparseColMatRef, SymbolicSparseColMat, SymbolicSparseColMatRe
 use faer::{Conj, Par, Side, Spec};
 
 pub mod two_way;
+
+/// Compressed columns from buckets: `rows[start[j]..start[j + 1]]` holds column `j`'s row
+/// indices in any order, repeats allowed. Returns the column pointers and the sorted, distinct
+/// row indices of every column.
+pub fn compress_columns(start: &[usize], rows: &mut [usize]) -> (Vec<usize>, Vec<usize>) {
+    let n = start.len() - 1;
+    let mut col_ptr = vec![0usize; n + 1];
+    let mut row_idx = Vec::with_capacity(rows.len());
+    for j in 0..n {
+        let col = &mut rows[start[j]..start[j + 1]];
+        col.sort_unstable();
+        let first = row_idx.len();
+        for &i in col.iter() {
+            if row_idx.len() == first || row_idx[row_idx.len() - 1] != i {
+                row_idx.push(i);
+            }
+        }
+        col_ptr[j + 1] = row_idx.len();
+    }
+    (col_ptr, row_idx)
+}
 
 /// An undirected graph in compressed adjacency form (no self loops).
 pub struct Graph {
@@ -60,21 +82,9 @@ impl Graph {
                 }
             }
         }
-        // sort and deduplicate each list (a full symmetric pattern lists every edge twice)
-        let mut xadj = vec![0usize; n + 1];
-        let mut out = Vec::with_capacity(adj.len());
-        for v in 0..n {
-            let list = &mut adj[deg[v]..deg[v + 1]];
-            list.sort_unstable();
-            let start = out.len();
-            for &u in list.iter() {
-                if out.len() == start || out[out.len() - 1] != u {
-                    out.push(u);
-                }
-            }
-            xadj[v + 1] = out.len();
-        }
-        Graph { xadj, adj: out }
+        // sorted and deduplicated (a full symmetric pattern lists every edge twice)
+        let (xadj, adj) = compress_columns(&deg, &mut adj);
+        Graph { xadj, adj }
     }
 
     /// Number of vertices.
@@ -398,34 +408,6 @@ const ND_MIN_N: usize = 2000;
 /// Parts at most this large are ordered by AMD inside the dissection.
 const ND_LEAF: usize = 128;
 
-/// Symbolic Cholesky of the pattern `a` (its `side` triangle), with nested dissection or
-/// AMD, whichever needs fewer flops.
-pub fn symbolic_cholesky(a: SymbolicSparseColMatRef<'_, usize>, side: Side) -> Result<SymbolicCholesky<usize>, String> {
-    let n = a.ncols();
-    let amd = || {
-        factorize_symbolic_cholesky(a, side, SymmetricOrdering::Amd, params(n))
-            .map_err(|e| format!("symbolic Cholesky: {e:?}"))
-    };
-    if n < ND_MIN_N {
-        return amd();
-    }
-    let nd = || {
-        let perm = nested_dissection(&Graph::from_pattern(a), ND_LEAF);
-        let inv = inverse(&perm);
-        let p = PermRef::new_checked(&perm, &inv, n);
-        factorize_symbolic_cholesky(a, side, SymmetricOrdering::Custom(p), params(n))
-            .map_err(|e| format!("symbolic Cholesky: {e:?}"))
-    };
-    // the two analyses run side by side (about equal cost)
-    let (amd, nd) = std::thread::scope(|scope| {
-        let other = scope.spawn(amd);
-        let nd = nd();
-        (other.join().unwrap_or_else(|e| std::panic::resume_unwind(e)), nd)
-    });
-    let (amd, nd) = (amd?, nd?);
-    Ok(if factor_flops(&nd) < factor_flops(&amd) { nd } else { amd })
-}
-
 /// Parallelism for a numeric factorisation: sequential below about 2e10 factor flops (on
 /// 2 cores rayon only paid off for the largest factors measured), else faer's global setting.
 pub fn parallelism_for(s: &SymbolicCholesky<usize>) -> Par {
@@ -720,6 +702,17 @@ mod tests {
         e
     }
 
+    /// [`analyse`] restricted to one factorisation (AMD or nested dissection).
+    fn single_analysis(a: SymbolicSparseColMatRef<'_, usize>) -> SymbolicCholesky<usize> {
+        allow_split_on_this_thread(false);
+        let analysis = analyse(a);
+        allow_split_on_this_thread(true);
+        match analysis.unwrap() {
+            Analysis::Single { symbolic, .. } => *symbolic,
+            Analysis::TwoWay(_) => panic!("split forbidden"),
+        }
+    }
+
     fn is_permutation(p: &[usize]) -> bool {
         let mut seen = vec![false; p.len()];
         p.iter().all(|&i| i < p.len() && !std::mem::replace(&mut seen[i], true))
@@ -755,7 +748,7 @@ mod tests {
             factorize_symbolic_cholesky(a.as_ref(), Side::Upper, SymmetricOrdering::Amd, Default::default()).unwrap();
         assert!(nd.len_val() < amd.len_val(), "nd {} amd {}", nd.len_val(), amd.len_val());
         assert!(factor_flops(&nd) < factor_flops(&amd));
-        let best = symbolic_cholesky(a.as_ref(), Side::Upper).unwrap();
+        let best = single_analysis(a.as_ref());
         assert_eq!(best.len_val(), nd.len_val());
     }
 
@@ -860,7 +853,7 @@ mod tests {
             .flat_map(|j| ri[cp[j]..cp[j + 1]].iter().map(move |&i| (i, j)))
             .map(|(i, j)| if i == j { deg[j] + 1.0 } else { -1.0 })
             .collect();
-        let s = symbolic_cholesky(a.as_ref(), Side::Upper).unwrap();
+        let s = single_analysis(a.as_ref());
         assert!(s.perm().is_some());
         let par = faer::Par::Seq;
         let mut l = vec![0.0; s.len_val()];

@@ -97,23 +97,9 @@ impl EdgeMatrix {
                 fill[v] += 2;
             }
         }
-        let mut col_ptr = vec![0usize; n + 1];
-        let mut row_idx = Vec::with_capacity(rows.len() / 2 + n);
-        let mut diag = vec![0usize; n];
-        for j in 0..n {
-            let col = &mut rows[count[j]..count[j + 1]];
-            col.sort_unstable();
-            let start = row_idx.len();
-            for &i in col.iter() {
-                if row_idx.len() == start || row_idx[row_idx.len() - 1] != i {
-                    if i == j {
-                        diag[j] = row_idx.len();
-                    }
-                    row_idx.push(i);
-                }
-            }
-            col_ptr[j + 1] = row_idx.len();
-        }
+        let (col_ptr, row_idx) = crate::linalg::compress_columns(&count, &mut rows);
+        let diag =
+            (0..n).map(|j| col_ptr[j] + row_idx[col_ptr[j]..col_ptr[j + 1]].partition_point(|&i| i < j)).collect();
         let val = vec![0.0; row_idx.len()];
         EdgeMatrix { col_ptr, row_idx, diag, val }
     }

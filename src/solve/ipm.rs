@@ -45,20 +45,7 @@ fn upper_pattern(n: usize, pairs: impl Iterator<Item = (usize, usize)> + Clone) 
         rows[fill[j]] = i;
         fill[j] += 1;
     }
-    let mut col_ptr = vec![0usize; n + 1];
-    let mut row_idx = Vec::with_capacity(rows.len());
-    for j in 0..n {
-        let col = &mut rows[count[j]..count[j + 1]];
-        col.sort_unstable();
-        let start = row_idx.len();
-        for &i in col.iter() {
-            if row_idx.len() == start || row_idx[row_idx.len() - 1] != i {
-                row_idx.push(i);
-            }
-        }
-        col_ptr[j + 1] = row_idx.len();
-    }
-    (col_ptr, row_idx)
+    ordering::compress_columns(&count, &mut rows)
 }
 
 impl Normal {

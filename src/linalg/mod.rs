@@ -817,6 +817,24 @@ mod tests {
     }
 
     #[test]
+    fn a_disconnected_pattern_is_factorised_whole() {
+        // two grids side by side: no top separator, so one factorisation; it still solves
+        let mut e = grid_edges(50, 40, true);
+        e.extend(grid_edges(30, 30, false).into_iter().map(|(i, j)| (i + 2000, j + 2000)));
+        let n = 2000 + 900;
+        let a = upper_pattern(n, &e);
+        let analysis = analyse(a.as_ref()).unwrap();
+        assert!(matches!(analysis, Analysis::Single { .. }));
+        let vals = spd_values(a.as_ref());
+        let mut f = SpdFactor::new(std::rc::Rc::new(analysis)).unwrap();
+        f.factor(SparseColMatRef::new(a.as_ref(), &vals)).unwrap();
+        let b: Vec<f64> = (0..n).map(|i| (i as f64 * 0.11).cos()).collect();
+        let mut x = b.clone();
+        f.solve_in_place(&mut x);
+        assert!(residual(a.as_ref(), &vals, &x, &b) < 1e-9);
+    }
+
+    #[test]
     fn two_way_split_is_refused_when_the_parts_touch_or_on_request() {
         let (nx, ny) = (60, 40);
         let n = nx * ny;

@@ -173,16 +173,36 @@ impl TriMesh {
         for (t, tri) in triangles.iter().enumerate() {
             for k in 0..3 {
                 let (a, b) = (tri[k], tri[(k + 1) % 3]);
-                half.push((a.min(b), a.max(b), t));
+                half.push((a.min(b), a.max(b), 3 * t + k));
             }
         }
-        half.sort_unstable();
+        // counting sort by the smaller vertex, then each short bucket: the order of sorting the
+        // triples, in linear time
+        let mut start = vec![0usize; n + 1];
+        for h in &half {
+            start[h.0 + 1] += 1;
+        }
+        for v in 0..n {
+            start[v + 1] += start[v];
+        }
+        let mut sorted = vec![(0usize, 0usize, 0usize); half.len()];
+        let mut fill = start.clone();
+        for &h in &half {
+            sorted[fill[h.0]] = h;
+            fill[h.0] += 1;
+        }
+        for v in 0..n {
+            sorted[start[v]..start[v + 1]].sort_unstable();
+        }
+        let half = sorted;
         let mut edges: Vec<(usize, usize)> = Vec::with_capacity(3 * nt / 2 + 1);
         let mut edge_tris: Vec<[usize; 2]> = Vec::with_capacity(3 * nt / 2 + 1);
+        // the edge of every corner's outgoing side (corner 3t + k: side k of triangle t)
+        let mut side_edge = vec![0usize; 3 * nt];
         let mut bad: Vec<String> = Vec::new();
         let mut i = 0;
         while i < half.len() {
-            let (a, b, t) = half[i];
+            let (a, b, c) = half[i];
             let mut j = i + 1;
             while j < half.len() && (half[j].0, half[j].1) == (a, b) {
                 j += 1;
@@ -190,16 +210,21 @@ impl TriMesh {
             if j - i > 2 {
                 bad.push(format!("{a}–{b} ({} triangles)", j - i));
             }
+            for h in &half[i..j] {
+                side_edge[h.2] = edges.len();
+            }
             edges.push((a, b));
-            edge_tris.push([t, if j - i >= 2 { half[i + 1].2 } else { usize::MAX }]);
+            edge_tris.push([c / 3, if j - i >= 2 { half[i + 1].2 / 3 } else { usize::MAX }]);
             i = j;
         }
         drop(half);
         if !bad.is_empty() {
             return Err(Error::input(format!("non-manifold edges (on more than two triangles): {}", list(&bad))));
         }
-        let edge_of = |a: usize, b: usize| -> usize {
-            edges.binary_search(&(a.min(b), a.max(b))).expect("every triangle edge is listed")
+        // the edge {a, b} of triangle t (its sides as read: orientation repairs reorder corners)
+        let edge_of = |t: usize, a: usize, b: usize| -> usize {
+            let key = (a.min(b), a.max(b));
+            *side_edge[3 * t..3 * t + 3].iter().find(|&&e| edges[e] == key).expect("a side of the triangle")
         };
         // manifold vertices: the corners (vertex, triangle) at a vertex are joined across its
         // interior edges; more than one group is more than one fan
@@ -255,7 +280,7 @@ impl TriMesh {
                 let tri = triangles[t];
                 for k in 0..3 {
                     let (a, b) = (tri[k], tri[(k + 1) % 3]);
-                    let [t1, t2] = edge_tris[edge_of(a, b)];
+                    let [t1, t2] = edge_tris[edge_of(t, a, b)];
                     let other = if t1 == t { t2 } else { t1 };
                     if other == usize::MAX {
                         continue;

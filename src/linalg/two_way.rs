@@ -74,7 +74,7 @@ impl Symbolic {
         let sizes_local = [la, lb];
         let mut triplets: [Vec<(usize, usize, usize)>; 2] = [Vec::new(), Vec::new()];
         let mut sep_entries = Vec::new();
-        let (cp, ri) = (a.col_ptr(), a.row_idx());
+        let ri = a.row_idx();
         for j in 0..n {
             let range = a.col_range(j);
             for (pos, &i) in (range.start..).zip(&ri[range.clone()]) {
@@ -99,7 +99,6 @@ impl Symbolic {
                 }
             }
         }
-        let _ = cp;
         let params = CholeskySymbolicParams {
             supernodal_flop_ratio_threshold: faer::sparse::linalg::SupernodalThreshold::FORCE_SUPERNODAL,
             ..Default::default()

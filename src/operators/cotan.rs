@@ -19,12 +19,8 @@ fn cross_norm(a: [f64; 3], b: [f64; 3]) -> f64 {
 /// Ref: Pinkall & Polthier 1993.
 pub fn cotan_stiffness(positions: &[[f64; 3]], triangles: &[[usize; 3]]) -> Sparse {
     let mut k = EdgeMatrix::new(positions.len(), triangles);
-    for tri in triangles {
-        for c in 0..3 {
-            let (i, j, o) = (tri[c], tri[(c + 1) % 3], tri[(c + 2) % 3]);
-            let (a, b) = (sub(positions[i], positions[o]), sub(positions[j], positions[o]));
-            k.add_edge(i, j, 0.5 * dot(a, b) / cross_norm(a, b));
-        }
+    for (i, j, w) in corner_weights(positions, triangles) {
+        k.add_edge(i, j, w);
     }
     k.finish()
 }
@@ -38,12 +34,8 @@ pub fn cotan_stiffness(positions: &[[f64; 3]], triangles: &[[usize; 3]]) -> Spar
 /// Laplacian of the representative's fills, the energy keeps [`cotan_stiffness`].
 pub fn positive_cotan_stiffness(positions: &[[f64; 3]], triangles: &[[usize; 3]]) -> Sparse {
     let mut k = EdgeMatrix::new(positions.len(), triangles);
-    for tri in triangles {
-        for c in 0..3 {
-            let (i, j, o) = (tri[c], tri[(c + 1) % 3], tri[(c + 2) % 3]);
-            let (a, b) = (sub(positions[i], positions[o]), sub(positions[j], positions[o]));
-            k.add_upper(i, j, 0.5 * dot(a, b) / cross_norm(a, b));
-        }
+    for (i, j, w) in corner_weights(positions, triangles) {
+        k.add_upper(i, j, w);
     }
     // every edge's summed weight, clamped, then the diagonal from the clamped weights
     let edges = k.upper_off_diagonal();
@@ -57,6 +49,21 @@ pub fn positive_cotan_stiffness(positions: &[[f64; 3]], triangles: &[[usize; 3]]
     }
     k.diagonal_from_off_diagonal();
     k.finish()
+}
+
+/// Every triangle's side `ij` with half the cotangent of the angle opposite it: `(i, j, ½ cot)`;
+/// an interior edge appears twice, once from each triangle.
+fn corner_weights<'a>(
+    positions: &'a [[f64; 3]],
+    triangles: &'a [[usize; 3]],
+) -> impl Iterator<Item = (usize, usize, f64)> + 'a {
+    triangles.iter().flat_map(move |tri| {
+        (0..3).map(move |c| {
+            let (i, j, o) = (tri[c], tri[(c + 1) % 3], tri[(c + 2) % 3]);
+            let (a, b) = (sub(positions[i], positions[o]), sub(positions[j], positions[o]));
+            (i, j, 0.5 * dot(a, b) / cross_norm(a, b))
+        })
+    })
 }
 
 /// A symmetric matrix on the vertex adjacency of a triangle list (every edge both ways, every
@@ -164,14 +171,8 @@ impl EdgeMatrix {
 /// Cotangent weight of every edge `(i, j, w_ij, triangles on it)`, `i < j`, sorted (a
 /// deterministic order, so that sums do not depend on hashing).
 fn edge_weights(positions: &[[f64; 3]], triangles: &[[usize; 3]]) -> Vec<(usize, usize, f64, u8)> {
-    let mut half: Vec<(usize, usize, f64)> = Vec::with_capacity(3 * triangles.len());
-    for tri in triangles {
-        for k in 0..3 {
-            let (i, j, o) = (tri[k], tri[(k + 1) % 3], tri[(k + 2) % 3]);
-            let (a, b) = (sub(positions[i], positions[o]), sub(positions[j], positions[o]));
-            half.push((i.min(j), i.max(j), 0.5 * dot(a, b) / cross_norm(a, b)));
-        }
-    }
+    let mut half: Vec<(usize, usize, f64)> =
+        corner_weights(positions, triangles).map(|(i, j, w)| (i.min(j), i.max(j), w)).collect();
     half.sort_by_key(|e| (e.0, e.1));
     let mut out: Vec<(usize, usize, f64, u8)> = Vec::with_capacity(half.len() / 2 + 1);
     for (i, j, w) in half {

@@ -1,6 +1,6 @@
 //! Polyharmonic energies of order 1..4, their blends, and sharp vertices.
 
-use super::sparse::{from_triplets, matmul, scale_cols, scale_rows, triplets, Sparse};
+use super::sparse::{from_triplets, matmul, scale_cols, scale_rows, triplets, with_pattern_of, without_zeros, Sparse};
 use crate::error::{Error, Result};
 use faer::sparse::Triplet;
 
@@ -72,6 +72,10 @@ impl Energy {
 /// `Q′_2 = K′ M⁻¹ K′` and `K′` is `K` with every edge at a sharp vertex removed. Without
 /// sharp vertices this is `K (M⁻¹ K)^{k−1}` (paper eq. 18).
 ///
+/// The products skip K's entries that are exactly zero (a grid's diagonal edges), so `Q` stores
+/// the non-zero pattern of the products plus K's own pattern: 13 entries in an interior column
+/// of a grid's bilaplacian instead of the 19 of the triangulation's 2-ring.
+///
 /// # Panics
 /// If `scale.len() != energy.terms.len()`, `m.len() != K.nrows()`, or a sharp index is out of
 /// range (callers validate first).
@@ -79,6 +83,10 @@ pub fn polyharmonic(k: &Sparse, m: &[f64], energy: &Energy, scale: &[f64]) -> Sp
     assert_eq!(scale.len(), energy.terms.len());
     let n = k.nrows();
     assert_eq!(m.len(), n);
+    // The products run on K's non-zero entries only; the result keeps K's whole pattern (every
+    // edge of the domain), where a monotone QP's constrained pairs lie.
+    let k_full = k;
+    let k = &without_zeros(k_full);
     let mut sharp = vec![false; n];
     for &v in &energy.sharp {
         sharp[v] = true;
@@ -95,7 +103,7 @@ pub fn polyharmonic(k: &Sparse, m: &[f64], energy: &Energy, scale: &[f64]) -> Sp
             continue;
         }
         let q = match order {
-            1 => k.clone(),
+            1 => k_full.clone(),
             _ => {
                 let g = scale_rows(k, &d); // D K
                 let gt = scale_cols(k, &d); // K D = Gᵀ (K symmetric)
@@ -113,7 +121,7 @@ pub fn polyharmonic(k: &Sparse, m: &[f64], energy: &Energy, scale: &[f64]) -> Sp
             all.extend(triplets(&q).into_iter().map(|t| Triplet::new(t.row, t.col, c * t.val)));
         }
     }
-    single.unwrap_or_else(|| from_triplets(n, n, &all))
+    with_pattern_of(single.unwrap_or_else(|| from_triplets(n, n, &all)), k_full)
 }
 
 /// `K` without the edges at sharp vertices, diagonal recomputed so that rows sum to zero.
@@ -181,6 +189,43 @@ mod tests {
             assert!(quadratic_form(&plain, &f) > 1.0, "order {order}");
             assert!(quadratic_form(&sharp, &f).abs() < 1e-10, "order {order}: {}", quadratic_form(&sharp, &f));
         }
+    }
+
+    #[test]
+    fn zero_weights_stay_out_of_the_products_but_every_edge_stays_in_the_pattern() {
+        use crate::domain::{Domain, Grid2d};
+        use crate::operators::{grid_mass, grid_stiffness};
+        let g = Grid2d::with_geometry(9, 7, [0.5, -2.0], [0.0, 0.0]).unwrap();
+        let (k, m) = (grid_stiffness(&g), grid_mass(&g));
+        let n = g.n_vertices();
+        let dk = k.to_dense();
+        let mut dminv = faer::Mat::<f64>::zeros(n, n);
+        for i in 0..n {
+            dminv[(i, i)] = 1.0 / m[i];
+        }
+        let expected = &dk * &dminv * &dk;
+        let q = polyharmonic(&k, &m, &Energy::order(2), &[1.0]);
+        let dq = q.to_dense();
+        for i in 0..n {
+            for j in 0..n {
+                assert!((dq[(i, j)] - expected[(i, j)]).abs() <= 1e-12 * expected[(i, j)].abs().max(1.0));
+            }
+        }
+        // an interior column: the 13-point stencil of the squared 5-point Laplacian
+        let v = g.index(4, 3);
+        let col = q.symbolic().col_ptr()[v + 1] - q.symbolic().col_ptr()[v];
+        assert_eq!(col, 13, "entries in column {v}");
+        // every edge of the triangulation is stored, the diagonal ones (weight 0) included
+        for (i, j) in g.edges() {
+            let rows = &q.symbolic().row_idx()[q.symbolic().col_ptr()[j]..q.symbolic().col_ptr()[j + 1]];
+            assert!(rows.binary_search(&i).is_ok(), "edge {i}-{j}");
+        }
+        let diagonal: Vec<(usize, usize)> = g
+            .edges()
+            .into_iter()
+            .filter(|&(i, j)| g.row_col(i).0 != g.row_col(j).0 && g.row_col(i).1 != g.row_col(j).1)
+            .collect();
+        assert!(!diagonal.is_empty() && diagonal.iter().all(|&(i, j)| dk[(i, j)] == 0.0), "diagonal weights 0");
     }
 
     #[test]

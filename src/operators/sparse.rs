@@ -100,6 +100,81 @@ pub fn quadratic_form_without_diagonal(a: &Sparse, d: &[f64], f: &[f64]) -> f64 
     s
 }
 
+/// `A` without its off-diagonal entries that are exactly zero (a structural zero adds nothing
+/// to a product but widens its pattern: on a grid split along one diagonal, the cotangent
+/// weight of every diagonal edge is exactly 0, and without them a bilaplacian has 13 entries a
+/// row instead of 19, which halves the flops of its Cholesky factor).
+pub(crate) fn without_zeros(a: &Sparse) -> Sparse {
+    let (cp, ri, v) = (a.symbolic().col_ptr(), a.symbolic().row_idx(), a.val());
+    if !(0..a.ncols()).any(|j| (cp[j]..cp[j + 1]).any(|p| v[p] == 0.0 && ri[p] != j)) {
+        return a.clone();
+    }
+    let mut col_ptr = Vec::with_capacity(a.ncols() + 1);
+    let (mut row_idx, mut val) = (Vec::with_capacity(ri.len()), Vec::with_capacity(ri.len()));
+    col_ptr.push(0);
+    for j in 0..a.ncols() {
+        for p in cp[j]..cp[j + 1] {
+            if v[p] != 0.0 || ri[p] == j {
+                row_idx.push(ri[p]);
+                val.push(v[p]);
+            }
+        }
+        col_ptr.push(row_idx.len());
+    }
+    let symbolic = faer::sparse::SymbolicSparseColMat::new_checked(a.nrows(), a.ncols(), col_ptr, None, row_idx);
+    SparseColMat::new(symbolic, val)
+}
+
+/// `A` with every position of `B`'s pattern stored (as an explicit zero where `A` has none).
+/// Both have sorted row indices in every column.
+pub(crate) fn with_pattern_of(a: Sparse, b: &Sparse) -> Sparse {
+    let (acp, ari, av) = (a.symbolic().col_ptr(), a.symbolic().row_idx(), a.val());
+    let (bcp, bri) = (b.symbolic().col_ptr(), b.symbolic().row_idx());
+    let covered = (0..a.ncols()).all(|j| {
+        let col = &ari[acp[j]..acp[j + 1]];
+        bri[bcp[j]..bcp[j + 1]].iter().all(|i| col.binary_search(i).is_ok())
+    });
+    if covered {
+        return a;
+    }
+    let mut col_ptr = Vec::with_capacity(a.ncols() + 1);
+    let (mut row_idx, mut val) = (Vec::with_capacity(ari.len()), Vec::with_capacity(ari.len()));
+    col_ptr.push(0);
+    for j in 0..a.ncols() {
+        let (mut p, mut q) = (acp[j], bcp[j]);
+        while p < acp[j + 1] || q < bcp[j + 1] {
+            let (ia, ib) = (ari.get(p).filter(|_| p < acp[j + 1]), bri.get(q).filter(|_| q < bcp[j + 1]));
+            match (ia, ib) {
+                (Some(&ia), Some(&ib)) if ia == ib => {
+                    row_idx.push(ia);
+                    val.push(av[p]);
+                    p += 1;
+                    q += 1;
+                }
+                (Some(&ia), Some(&ib)) if ia < ib => {
+                    row_idx.push(ia);
+                    val.push(av[p]);
+                    p += 1;
+                }
+                (Some(&ia), None) => {
+                    row_idx.push(ia);
+                    val.push(av[p]);
+                    p += 1;
+                }
+                (_, Some(&ib)) => {
+                    row_idx.push(ib);
+                    val.push(0.0);
+                    q += 1;
+                }
+                (None, None) => unreachable!("loop condition"),
+            }
+        }
+        col_ptr.push(row_idx.len());
+    }
+    let symbolic = faer::sparse::SymbolicSparseColMat::new_checked(a.nrows(), a.ncols(), col_ptr, None, row_idx);
+    SparseColMat::new(symbolic, val)
+}
+
 /// `A · B`.
 pub(crate) fn matmul(a: &Sparse, b: &Sparse) -> Sparse {
     sparse_sparse_matmul(a.as_ref(), b.as_ref(), 1.0, Par::Seq).expect("sparse product fits in memory")

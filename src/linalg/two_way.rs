@@ -207,6 +207,18 @@ impl TwoWay {
         Ok(TwoWay { halves: [h0, h1], sigma: Mat::zeros(ls, ls), gram: Mat::zeros(ls, ls), sigma_mem })
     }
 
+    /// Maps every page of the storage now (see [`super::Workspace`]).
+    pub(super) fn touch(&mut self) {
+        for h in &mut self.halves {
+            super::touch_pages(&mut h.values);
+            super::touch_pages(&mut h.l);
+            super::touch_pages(&mut h.work);
+            touch_mat(&mut h.t);
+        }
+        touch_mat(&mut self.sigma);
+        touch_mat(&mut self.gram);
+    }
+
     /// Factorises `N` given by `values` (aligned with the analysed pattern).
     ///
     /// # Errors
@@ -281,6 +293,14 @@ impl TwoWay {
         }
         for k in 0..ls {
             rhs[s.sep[k]] = xs[(k, 0)];
+        }
+    }
+}
+
+fn touch_mat(m: &mut Mat<f64>) {
+    for j in 0..m.ncols() {
+        for i in (0..m.nrows()).step_by(512) {
+            m[(i, j)] = std::hint::black_box(0.0);
         }
     }
 }

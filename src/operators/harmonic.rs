@@ -36,7 +36,7 @@ pub fn dirichlet_solve(k: &Sparse, fixed: &[Option<f64>]) -> Result<Vec<f64>, St
             match (slot[i], slot[j]) {
                 (usize::MAX, _) => {}
                 (si, usize::MAX) => rhs[si] -= val[p] * u[j],
-                (si, sj) if si <= sj => t.push(Triplet::new(si, sj, val[p])),
+                (si, sj) if si == sj || (si < sj && val[p] != 0.0) => t.push(Triplet::new(si, sj, val[p])),
                 _ => {}
             }
         }
@@ -51,8 +51,8 @@ pub fn dirichlet_solve(k: &Sparse, fixed: &[Option<f64>]) -> Result<Vec<f64>, St
 }
 
 /// Repeated Dirichlet problems on one Laplacian with changing fixed sets: the matrix keeps
-/// its full pattern (fixed rows and columns become identity rows and explicit zeros), so the
-/// Cholesky analysis is done once.
+/// its pattern (fixed rows and columns become identity rows and explicit zeros; entries that
+/// are exactly zero in the Laplacian are left out), so the Cholesky analysis is done once.
 pub struct Dirichlet<'a> {
     k: &'a Sparse,
     /// Upper-triangle entries of `k` as (row, column, position in `k`'s values).
@@ -67,11 +67,13 @@ impl<'a> Dirichlet<'a> {
     /// # Errors
     /// A message if the analysis fails.
     pub fn new(k: &'a Sparse) -> Result<Self, String> {
-        let (cp, ri) = (k.symbolic().col_ptr(), k.symbolic().row_idx());
+        let (cp, ri, val) = (k.symbolic().col_ptr(), k.symbolic().row_idx(), k.val());
         let mut upper = Vec::new();
         for j in 0..k.ncols() {
             for (off, &i) in ri[cp[j]..cp[j + 1]].iter().enumerate() {
-                if i <= j {
+                // an exact zero (a grid's diagonal edge) only widens the factor: a grid's
+                // Laplacian is then the 5-point stencil (7 entries a column otherwise)
+                if i == j || (i < j && val[cp[j] + off] != 0.0) {
                     upper.push((i, j, cp[j] + off));
                 }
             }

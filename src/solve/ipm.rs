@@ -82,6 +82,8 @@ impl Normal {
 pub struct Prepared {
     pattern: SymbolicSparseColMat<usize>,
     analysis: ordering::Analysis,
+    /// The factor's storage, its pages mapped in advance.
+    workspace: Option<ordering::Workspace>,
 }
 
 impl Prepared {
@@ -101,7 +103,9 @@ impl Prepared {
         let (col_ptr, row_idx) = upper_pattern(n, pairs);
         let pattern = SymbolicSparseColMat::new_checked(n, n, col_ptr, None, row_idx);
         let analysis = ordering::analyse(pattern.as_ref())?;
-        Ok(Prepared { pattern, analysis })
+        // without it the storage is made by the solver (if memory is short, for instance)
+        let workspace = ordering::Workspace::new(&analysis).ok();
+        Ok(Prepared { pattern, analysis, workspace })
     }
 
     /// The analysed pattern.
@@ -113,7 +117,9 @@ impl Prepared {
     /// Makes the analysis the one [`solve`] on this thread uses for a normal matrix of this
     /// pattern.
     pub fn install(self) {
-        LAST.with(|c| *c.borrow_mut() = Some((self.pattern, std::rc::Rc::new(self.analysis))));
+        let analysis = std::rc::Rc::new(self.analysis);
+        SPARE.with(|c| *c.borrow_mut() = self.workspace.map(|w| (analysis.clone(), w)));
+        LAST.with(|c| *c.borrow_mut() = Some((self.pattern, analysis)));
     }
 }
 
@@ -128,6 +134,9 @@ const CORRECTOR_STEP: f64 = 0.3;
 thread_local! {
     /// The last normal-equation pattern analysed on this thread (nested dissection and AMD).
     static LAST: ordering::SymbolicSlot<ordering::Analysis> = const { std::cell::RefCell::new(None) };
+    /// Storage made in advance for the factorisations of one analysis in `LAST`.
+    static SPARE: std::cell::RefCell<Option<(std::rc::Rc<ordering::Analysis>, ordering::Workspace)>> =
+        const { std::cell::RefCell::new(None) };
 }
 
 /// Solves the reduced QP; `Err(reason)` when it cannot (the caller falls back to Clarabel).
@@ -182,7 +191,11 @@ pub fn solve(
     let normal = Normal::new(r, &row_cols, &row_len);
     let analysis =
         ordering::cached_symbolic(&LAST, normal.symbolic.as_ref(), || ordering::analyse(normal.symbolic.as_ref()))?;
-    let spd = std::cell::RefCell::new(ordering::SpdFactor::new(analysis)?);
+    let spare = SPARE.with(|c| c.borrow_mut().take()).filter(|(a, _)| std::rc::Rc::ptr_eq(a, &analysis));
+    let spd = std::cell::RefCell::new(match spare {
+        Some((_, workspace)) => ordering::SpdFactor::with_workspace(analysis, workspace),
+        None => ordering::SpdFactor::new(analysis)?,
+    });
     let nnz = normal.symbolic.row_idx().len();
     let mut vals = vec![0.0f64; nnz];
     let factor = |w: &[f64], vals: &mut [f64]| -> Result<(), String> {

@@ -245,55 +245,126 @@ pub fn nested_dissection(g: &Graph, leaf_size: usize) -> Vec<usize> {
 /// [`nested_dissection`] and, when the whole graph was bisected at the top (it is connected
 /// and not a near-clique), the sizes `[a, b]` of the two parts: `perm[..a]` is one part,
 /// `perm[a..a + b]` the other, `perm[a + b..]` the separator between them, and no edge joins
-/// the two parts.
+/// the two parts. Above [`PARALLEL_DISSECTION_MIN`] vertices the two top parts are dissected
+/// side by side (the result is the same as one after the other).
 pub fn nested_dissection_split(g: &Graph, leaf_size: usize) -> (Vec<usize>, Option<[usize; 2]>) {
+    dissection(g, leaf_size, g.n() >= PARALLEL_DISSECTION_MIN)
+}
+
+fn dissection(g: &Graph, leaf_size: usize, parallel: bool) -> (Vec<usize>, Option<[usize; 2]>) {
     let n = g.n();
-    let mut top = None;
     let mut out = vec![0usize; n];
-    let mut d = Dissect {
-        g,
-        owner: vec![0; n],
-        next_part: 0,
-        stamp: vec![0; n],
-        cur: 0,
-        level: vec![0; n],
-        queue: Vec::new(),
-        local: vec![0; n],
-    };
+    let mut d = Dissect::new(g, 0);
     let leaf_size = leaf_size.max(1);
-    // (part, vertices, first output position)
-    let mut stack: Vec<(u32, Vec<usize>, usize)> = vec![(0, (0..n).collect(), 0)];
-    while let Some((p, verts, lo)) = stack.pop() {
-        let len = verts.len();
-        if len == 0 {
-            continue;
+    let all: Vec<usize> = (0..n).collect();
+    if n <= leaf_size {
+        d.run(vec![(0, all, 0)], &mut out, 0, leaf_size);
+        return (out, None);
+    }
+    // the top level is split evenly: its two parts are factorised side by side
+    let bounds = d.bfs(0, 0);
+    let connected = d.queue.len() == n;
+    let Some((pa, part_a, pb, part_b, sep)) = connected.then(|| d.bisect(0, bounds, TOP_BALANCE)).flatten() else {
+        // not connected, or (nearly) a clique: no top split
+        let mut d = Dissect::new(g, 0);
+        d.run(vec![(0, all, 0)], &mut out, 0, leaf_size);
+        return (out, None);
+    };
+    let (la, lb) = (part_a.len(), part_b.len());
+    out[la + lb..].copy_from_slice(&sep);
+    let (out_a, rest) = out.split_at_mut(la);
+    let out_b = &mut rest[..lb];
+    if parallel {
+        // the other part on another thread, with its own bookkeeping and part numbers
+        let mut d2 = Dissect { owner: d.owner.clone(), ..Dissect::new(g, u32::MAX / 2) };
+        std::thread::scope(|scope| {
+            let other = scope.spawn(move || d2.run(vec![(pb, part_b, la)], out_b, la, leaf_size));
+            d.run(vec![(pa, part_a, 0)], out_a, 0, leaf_size);
+            other.join().unwrap_or_else(|e| std::panic::resume_unwind(e));
+        });
+    } else {
+        d.run(vec![(pa, part_a, 0)], out_a, 0, leaf_size);
+        d.run(vec![(pb, part_b, la)], out_b, la, leaf_size);
+    }
+    (out, Some([la, lb]))
+}
+
+/// Graphs at least this large are dissected on two threads below the top level (1000² grid
+/// Laplacian: 1.6 s on one).
+const PARALLEL_DISSECTION_MIN: usize = 100_000;
+
+impl<'g> Dissect<'g> {
+    fn new(g: &'g Graph, first_part: u32) -> Dissect<'g> {
+        let n = g.n();
+        Dissect {
+            g,
+            owner: vec![0; n],
+            next_part: first_part,
+            stamp: vec![0; n],
+            cur: 0,
+            level: vec![0; n],
+            queue: Vec::new(),
+            local: vec![0; n],
         }
-        if len <= leaf_size {
-            d.leaf(&verts, &mut out, lo);
-            continue;
-        }
-        // BFS from any vertex; a part that is not connected is split into its components
-        let mut bounds = d.bfs(verts[0], p);
-        if d.queue.len() < len {
-            let mut at = lo;
-            for (q, c) in d.components(&verts, p) {
-                let l = c.len();
-                stack.push((q, c, at));
-                at += l;
+    }
+
+    /// Dissects the parts on `stack` (part, vertices, first output position), writing
+    /// position `i` to `out[i - base]`.
+    fn run(&mut self, mut stack: Vec<(u32, Vec<usize>, usize)>, out: &mut [usize], base: usize, leaf_size: usize) {
+        while let Some((p, verts, lo)) = stack.pop() {
+            let len = verts.len();
+            if len == 0 {
+                continue;
             }
-            continue;
+            if len <= leaf_size {
+                self.leaf(&verts, out, lo - base);
+                continue;
+            }
+            // BFS from any vertex; a part that is not connected is split into its components
+            let bounds = self.bfs(verts[0], p);
+            if self.queue.len() < len {
+                let mut at = lo;
+                for (q, c) in self.components(&verts, p) {
+                    let l = c.len();
+                    stack.push((q, c, at));
+                    at += l;
+                }
+                continue;
+            }
+            let Some((pa, part_a, pb, part_b, sep)) = self.bisect(p, bounds, 0.2) else {
+                // (nearly) a clique: nothing to dissect
+                self.leaf(&verts, out, lo - base);
+                continue;
+            };
+            let (la, lb) = (part_a.len(), part_b.len());
+            out[lo + la + lb - base..lo + len - base].copy_from_slice(&sep);
+            stack.push((pa, part_a, lo));
+            stack.push((pb, part_b, lo + la));
         }
+    }
+
+    /// Bisects the connected part `p` whose BFS from one of its vertices just gave `bounds`
+    /// (and `queue`), each side with at least `min_fraction` of it where a level allows:
+    /// `(part a, its vertices, part b, its vertices, separator)`, owners updated; `None` for a
+    /// (near) clique.
+    #[allow(clippy::type_complexity)]
+    fn bisect(
+        &mut self,
+        p: u32,
+        mut bounds: Vec<usize>,
+        min_fraction: f64,
+    ) -> Option<(u32, Vec<usize>, u32, Vec<usize>, Vec<usize>)> {
+        let len = self.queue.len();
+        let first = self.queue[0];
         // pseudo-peripheral root: repeat BFS from a minimum-degree vertex of the last level;
         // every level structure met is a candidate and the best separator level wins
         let mut ecc = bounds.len() - 2;
-        // the top level is split evenly: its two parts are factorised side by side
-        let min_fraction = if len == n { TOP_BALANCE } else { 0.2 };
-        let mut best = (best_level(&bounds, len, min_fraction), verts[0]);
-        let mut last = (verts[0], bounds.clone());
+        let mut best = (best_level(&bounds, len, min_fraction), first);
+        let mut last = (first, bounds.clone());
         for _ in 0..4 {
-            let far = &d.queue[bounds[bounds.len() - 2]..];
-            let cand = *far.iter().min_by_key(|&&v| d.g.neighbours(v).len()).expect("non-empty level");
-            let b2 = d.bfs(cand, p);
+            let far = &self.queue[bounds[bounds.len() - 2]..];
+            let cand = *far.iter().min_by_key(|&&v| self.g.neighbours(v).len()).expect("non-empty level");
+            let b2 = self.bfs(cand, p);
             let l2 = best_level(&b2, len, min_fraction);
             if l2.0 < best.0 .0 {
                 best = (l2, cand);
@@ -306,55 +377,41 @@ pub fn nested_dissection_split(g: &Graph, leaf_size: usize) -> (Vec<usize>, Opti
                 break;
             }
         }
-        let bounds = if last.0 == best.1 { last.1 } else { d.bfs(best.1, p) };
+        let bounds = if last.0 == best.1 { last.1 } else { self.bfs(best.1, p) };
         let nlev = bounds.len() - 1;
         if nlev < 3 {
-            // (nearly) a clique: nothing to dissect
-            d.leaf(&verts, &mut out, lo);
-            continue;
+            return None;
         }
-        let best = best_level(&bounds, len, min_fraction);
-        let k = best.1;
-        let (pa, pb) = (d.new_part(), d.new_part());
-        let order = std::mem::take(&mut d.queue);
+        let k = best_level(&bounds, len, min_fraction).1;
+        let (pa, pb) = (self.new_part(), self.new_part());
+        let order = std::mem::take(&mut self.queue);
         let kl = k as u32;
         let mut part_a = Vec::with_capacity(bounds[k]);
         let mut part_b = Vec::with_capacity(len - bounds[k + 1]);
         let mut sep = Vec::with_capacity(bounds[k + 1] - bounds[k]);
-        for &v in &order[..bounds[k]] {
-            part_a.push(v);
-        }
-        for &v in &order[bounds[k + 1]..] {
-            part_b.push(v);
-        }
+        part_a.extend_from_slice(&order[..bounds[k]]);
+        part_b.extend_from_slice(&order[bounds[k + 1]..]);
         // a level vertex with no neighbour beyond the level can join A
         for &v in &order[bounds[k]..bounds[k + 1]] {
-            let touches_b = d.g.neighbours(v).iter().any(|&u| d.owner[u] == p && d.level[u] > kl);
+            let touches_b = self.g.neighbours(v).iter().any(|&u| self.owner[u] == p && self.level[u] > kl);
             if touches_b {
                 sep.push(v);
             } else {
                 part_a.push(v);
             }
         }
-        d.queue = order;
+        self.queue = order;
         for &v in &part_a {
-            d.owner[v] = pa;
+            self.owner[v] = pa;
         }
         for &v in &part_b {
-            d.owner[v] = pb;
+            self.owner[v] = pb;
         }
         for &v in &sep {
-            d.owner[v] = PLACED;
+            self.owner[v] = PLACED;
         }
-        let (la, lb) = (part_a.len(), part_b.len());
-        if len == n {
-            top = Some([la, lb]);
-        }
-        out[lo + la + lb..lo + len].copy_from_slice(&sep);
-        stack.push((pa, part_a, lo));
-        stack.push((pb, part_b, lo + la));
+        Some((pa, part_a, pb, part_b, sep))
     }
-    (out, top)
 }
 
 /// The inverse of a permutation.
@@ -405,6 +462,11 @@ fn params(n: usize) -> CholeskySymbolicParams<'static> {
 
 /// Graphs below this size are ordered by AMD only.
 const ND_MIN_N: usize = 2000;
+/// Graphs at least this large are ordered by nested dissection only: AMD took 0.9–2 s at a
+/// million unknowns and its factor needed 2.3–3.4× the flops of the two-way one on the grid
+/// patterns measured (450² and 1000²: Laplacian, triangulated Laplacian, bilaplacian), 2.0–3.6×
+/// on subdivided meshes (mountain @2 and spot @3: Laplacian and bilaplacian).
+const ND_ONLY_N: usize = 200_000;
 /// Parts at most this large are ordered by AMD inside the dissection.
 const ND_LEAF: usize = 128;
 
@@ -526,7 +588,7 @@ const PARALLEL_MIN_FLOPS: f64 = 2e10;
 /// Analyses the upper-triangular pattern `a` of a symmetric positive definite matrix: nested
 /// dissection and AMD side by side, then the cheapest of AMD, nested dissection on one
 /// factorisation, and nested dissection's two halves on two threads (estimated time: flops on
-/// the critical path).
+/// the critical path). From [`ND_ONLY_N`] unknowns on, nested dissection alone.
 ///
 /// # Errors
 /// A message if faer's analysis fails.
@@ -555,6 +617,12 @@ pub fn analyse(a: SymbolicSparseColMatRef<'_, usize>) -> Result<Analysis, String
             .map(Err)
             .map_err(|e| format!("symbolic Cholesky: {e:?}"))
     };
+    if n >= ND_ONLY_N {
+        return Ok(match nd()? {
+            Ok(two) => Analysis::TwoWay(Box::new(two)),
+            Err(nd) => single(nd),
+        });
+    }
     let (amd, nd) = std::thread::scope(|scope| {
         let other = scope.spawn(amd);
         let nd = nd();
@@ -779,6 +847,19 @@ mod tests {
         let a = upper_pattern(400 + 150 + 5, &e);
         let g = Graph::from_pattern(a.as_ref());
         assert!(is_permutation(&nested_dissection(&g, 16)));
+    }
+
+    #[test]
+    fn dissection_on_two_threads_is_the_same_as_on_one() {
+        for (nx, ny, ring2) in [(120, 100, true), (90, 70, false)] {
+            let a = upper_pattern(nx * ny, &grid_edges(nx, ny, ring2));
+            let g = Graph::from_pattern(a.as_ref());
+            let (one, top1) = dissection(&g, ND_LEAF, false);
+            let (two, top2) = dissection(&g, ND_LEAF, true);
+            assert!(is_permutation(&one) && top1.is_some());
+            assert_eq!(top1, top2);
+            assert!(one == two, "{nx}x{ny}: the orderings differ");
+        }
     }
 
     #[test]

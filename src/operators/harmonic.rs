@@ -67,22 +67,32 @@ impl<'a> Dirichlet<'a> {
     /// # Errors
     /// A message if the analysis fails.
     pub fn new(k: &'a Sparse) -> Result<Self, String> {
+        let (upper, pattern) = Self::pattern(k);
+        let solver = crate::linalg::SpdSolver::new(pattern.as_ref())?;
+        Ok(Dirichlet { k, upper, pattern, solver })
+    }
+
+    /// The upper-triangle entries of `k` the solves use, as (row, column, position in `k`'s
+    /// values), and their pattern.
+    fn pattern(k: &Sparse) -> (Vec<(usize, usize, usize)>, faer::sparse::SymbolicSparseColMat<usize>) {
         let (cp, ri, val) = (k.symbolic().col_ptr(), k.symbolic().row_idx(), k.val());
         let mut upper = Vec::new();
+        let mut col_ptr = Vec::with_capacity(k.ncols() + 1);
+        let mut row_idx = Vec::new();
+        col_ptr.push(0);
         for j in 0..k.ncols() {
             for (off, &i) in ri[cp[j]..cp[j + 1]].iter().enumerate() {
                 // an exact zero (a grid's diagonal edge) only widens the factor: a grid's
                 // Laplacian is then the 5-point stencil (7 entries a column otherwise)
                 if i == j || (i < j && val[cp[j] + off] != 0.0) {
                     upper.push((i, j, cp[j] + off));
+                    row_idx.push(i);
                 }
             }
+            col_ptr.push(row_idx.len());
         }
-        let t: Vec<Triplet<usize, usize, f64>> = upper.iter().map(|&(i, j, _)| Triplet::new(i, j, 1.0)).collect();
-        let pattern = Sparse::try_new_from_triplets(k.nrows(), k.ncols(), &t).map_err(|e| format!("{e:?}"))?;
-        let pattern = pattern.symbolic().to_owned().map_err(|e| format!("{e:?}"))?;
-        let solver = crate::linalg::SpdSolver::new(pattern.as_ref())?;
-        Ok(Dirichlet { k, upper, pattern, solver })
+        let n = k.nrows();
+        (upper, faer::sparse::SymbolicSparseColMat::new_checked(n, n, col_ptr, None, row_idx))
     }
 
     /// The solution of `(K u)_i = 0` at free vertices with `u_j = fixed_j` where given.

@@ -103,8 +103,7 @@ impl Symbolic {
             supernodal_flop_ratio_threshold: faer::sparse::linalg::SupernodalThreshold::FORCE_SUPERNODAL,
             ..Default::default()
         };
-        let mut halves = Vec::with_capacity(2);
-        for (h, mut t) in triplets.into_iter().enumerate() {
+        let half = |h: usize, mut t: Vec<(usize, usize, usize)>| -> Option<Half> {
             let m = sizes_local[h] + ls;
             t.sort_unstable_by_key(|&(i, j, _)| (j, i));
             let mut col_ptr = vec![0usize; m + 1];
@@ -123,11 +122,15 @@ impl Symbolic {
                 return None;
             }
             let verts: Vec<usize> = if h == 0 { perm[..la].to_vec() } else { perm[la..la + lb].to_vec() };
-            halves.push(Half { verts, pattern, src, symbolic });
-        }
-        let h1 = halves.pop()?;
-        let h0 = halves.pop()?;
-        Some(Symbolic { n, halves: [h0, h1], sep, sep_entries })
+            Some(Half { verts, pattern, src, symbolic })
+        };
+        // the two halves side by side
+        let [t0, t1] = triplets;
+        let (h0, h1) = std::thread::scope(|scope| {
+            let other = scope.spawn(|| half(1, t1));
+            (half(0, t0), other.join().unwrap_or_else(|e| std::panic::resume_unwind(e)))
+        });
+        Some(Symbolic { n, halves: [h0?, h1?], sep, sep_entries })
     }
 
     /// Size of the separator.

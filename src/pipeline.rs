@@ -563,7 +563,8 @@ pub fn smooth<D: Smoothable + Sync>(domain: &D, h: &[f64], settings: &SmoothSett
     seconds.operators = operators_seconds;
     let gd = settings.data_weight;
     let ell = settings.smooth_length * domain.diameter();
-    // the fills' Laplacian analysis is not needed again: free it before the solver's
+    // the fills' Laplacian analysis is not needed again: free it before the solver runs (its
+    // factor's storage was already made beside the representative: measured peaks did not rise)
     crate::linalg::forget_solver_analysis();
     if let Some(prepared) = prepared {
         prepared.install();

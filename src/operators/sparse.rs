@@ -100,7 +100,8 @@ pub fn quadratic_form_without_diagonal(a: &Sparse, d: &[f64], f: &[f64]) -> f64 
     s
 }
 
-/// `A` without its off-diagonal entries that are exactly zero (a structural zero adds nothing
+/// `A` (sorted, distinct row indices in every column) without its off-diagonal entries that are
+/// exactly zero (a structural zero adds nothing
 /// to a product but widens its pattern: on a grid split along one diagonal, the cotangent
 /// weight of every diagonal edge is exactly 0, and without them a bilaplacian has 13 entries a
 /// row instead of 19, which halves the flops of its Cholesky factor).
@@ -126,7 +127,7 @@ pub(crate) fn without_zeros(a: &Sparse) -> Sparse {
 }
 
 /// `A` with every position of `B`'s pattern stored (as an explicit zero where `A` has none).
-/// Both have sorted row indices in every column.
+/// Both must have sorted, distinct row indices in every column.
 pub(crate) fn with_pattern_of(a: Sparse, b: &Sparse) -> Sparse {
     let (acp, ari, av) = (a.symbolic().col_ptr(), a.symbolic().row_idx(), a.val());
     let (bcp, bri) = (b.symbolic().col_ptr(), b.symbolic().row_idx());
@@ -204,4 +205,39 @@ pub(crate) fn mul_vec(a: &Sparse, x: &[f64]) -> Vec<f64> {
         }
     }
     y
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn dense(a: &Sparse) -> Vec<Vec<f64>> {
+        let d = a.to_dense();
+        (0..a.nrows()).map(|i| (0..a.ncols()).map(|j| d[(i, j)]).collect()).collect()
+    }
+
+    fn pattern(a: &Sparse) -> Vec<Vec<usize>> {
+        let (cp, ri) = (a.symbolic().col_ptr(), a.symbolic().row_idx());
+        (0..a.ncols()).map(|j| ri[cp[j]..cp[j + 1]].to_vec()).collect()
+    }
+
+    #[test]
+    fn zeros_leave_the_pattern_and_another_pattern_joins_it() {
+        // column 0: a row before and after B's; column 1: B's rows interleave A's; column 2 of
+        // A is empty; column 3 of B is empty
+        let t = |i, j, v| Triplet::new(i, j, v);
+        let a = from_triplets(5, 4, &[t(1, 0, 2.0), t(1, 1, 1.0), t(3, 1, 0.0), t(4, 1, 3.0), t(0, 3, 4.0)]);
+        let b = from_triplets(5, 4, &[t(0, 0, 9.0), t(4, 0, 9.0), t(0, 1, 9.0), t(3, 1, 9.0), t(2, 2, 9.0)]);
+        let u = with_pattern_of(a.clone(), &b);
+        assert_eq!(pattern(&u), vec![vec![0, 1, 4], vec![0, 1, 3, 4], vec![2], vec![0]]);
+        assert_eq!(dense(&u), dense(&a), "values are A's, the added positions hold zeros");
+        // nothing to add: the same matrix back
+        assert_eq!(pattern(&with_pattern_of(u.clone(), &a)), pattern(&u));
+        // the exact zero at (3, 1) is dropped, the diagonal kept even when zero
+        let z = from_triplets(3, 3, &[t(0, 0, 0.0), t(1, 0, 0.0), t(2, 0, 1.0), t(1, 1, 2.0), t(2, 2, 1.0)]);
+        let w = without_zeros(&z);
+        assert_eq!(pattern(&w), vec![vec![0, 2], vec![1], vec![2]]);
+        assert_eq!(dense(&w), dense(&z));
+        assert_eq!(pattern(&without_zeros(&a)), vec![vec![1], vec![1, 4], vec![], vec![0]]);
+    }
 }

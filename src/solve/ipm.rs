@@ -103,7 +103,7 @@ impl Prepared {
         let (col_ptr, row_idx) = upper_pattern(n, pairs);
         let pattern = SymbolicSparseColMat::new_checked(n, n, col_ptr, None, row_idx);
         let analysis = ordering::analyse(pattern.as_ref())?;
-        // without it the storage is made by the solver (if memory is short, for instance)
+        // without it (faer's scratch could not be allocated) the solver makes the storage
         let workspace = ordering::Workspace::new(&analysis).ok();
         Ok(Prepared { pattern, analysis, workspace })
     }
@@ -121,6 +121,12 @@ impl Prepared {
         SPARE.with(|c| *c.borrow_mut() = self.workspace.map(|w| (analysis.clone(), w)));
         LAST.with(|c| *c.borrow_mut() = Some((self.pattern, analysis)));
     }
+}
+
+/// Drops the factor storage [`Prepared::install`] made ready on this thread, for a QP that
+/// needs no solve.
+pub(super) fn forget_prepared_storage() {
+    SPARE.with(|c| *c.borrow_mut() = None);
 }
 
 /// Centrality correctors per iteration at most. Iterations without / with 2 at the same
@@ -146,6 +152,8 @@ pub fn solve(
     settings: &QpSettings,
 ) -> Result<(Vec<f64>, SolveStatus, u32), String> {
     let (n, m) = (r.n, r.m());
+    // the storage made in advance is this solve's or nobody's: not kept past an early return
+    let spare = SPARE.with(|c| c.borrow_mut().take());
     // rows as (columns, values, length)
     let mut row_cols = vec![[0usize; 2]; m];
     let mut row_vals = vec![[0.0f64; 2]; m];
@@ -191,7 +199,7 @@ pub fn solve(
     let normal = Normal::new(r, &row_cols, &row_len);
     let analysis =
         ordering::cached_symbolic(&LAST, normal.symbolic.as_ref(), || ordering::analyse(normal.symbolic.as_ref()))?;
-    let spare = SPARE.with(|c| c.borrow_mut().take()).filter(|(a, _)| std::rc::Rc::ptr_eq(a, &analysis));
+    let spare = spare.filter(|(a, _)| std::rc::Rc::ptr_eq(a, &analysis));
     let spd = std::cell::RefCell::new(match spare {
         Some((_, workspace)) => ordering::SpdFactor::with_workspace(analysis, workspace),
         None => ordering::SpdFactor::new(analysis)?,

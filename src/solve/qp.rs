@@ -127,6 +127,7 @@ pub fn solve_monotone_qp(qp: &MonotoneQp<'_>, settings: &QpSettings) -> Result<Q
     let free: Vec<usize> = (0..n).filter(|&i| qp.fixed[i].is_none()).collect();
     let mut x: Vec<f64> = qp.fixed.iter().map(|f| f.unwrap_or(0.0)).collect();
     if free.is_empty() {
+        super::ipm::forget_prepared_storage();
         return Ok(QpSolution {
             x,
             status: SolveStatus::Trivial,

@@ -563,8 +563,8 @@ pub fn smooth<D: Smoothable + Sync>(domain: &D, h: &[f64], settings: &SmoothSett
     seconds.operators = operators_seconds;
     let gd = settings.data_weight;
     let ell = settings.smooth_length * domain.diameter();
-    // the fills' Laplacian analysis is not needed again: free it before the solver runs (its
-    // factor's storage was already made beside the representative: measured peaks did not rise)
+    // the fills' Laplacian analysis is not needed again: free it before the solver runs (the
+    // solver's factor storage was made beside the representative: 1000² peak 2.93 → 3.06 GiB)
     crate::linalg::forget_solver_analysis();
     if let Some(prepared) = prepared {
         prepared.install();

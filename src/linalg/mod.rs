@@ -696,7 +696,7 @@ pub(crate) fn touch_pages(v: &mut [f64]) {
 
 /// A factorisation's numeric storage made in advance, possibly on another thread
 /// ([`Workspace::new`]), with its pages already mapped; [`SpdFactor::with_workspace`] uses it.
-pub struct Workspace(Numeric);
+pub(crate) struct Workspace(Numeric);
 
 impl Workspace {
     /// Storage for factorisations of `analysis`, every page of the factor's values (and of the
@@ -704,7 +704,7 @@ impl Workspace {
     ///
     /// # Errors
     /// A message if it cannot be allocated.
-    pub fn new(analysis: &Analysis) -> Result<Workspace, String> {
+    pub(crate) fn new(analysis: &Analysis) -> Result<Workspace, String> {
         let mut numeric = Numeric::new(analysis)?;
         numeric.touch();
         Ok(Workspace(numeric))
@@ -729,7 +729,7 @@ impl SpdFactor {
     }
 
     /// Factorisations of `analysis` in storage made for it by [`Workspace::new`].
-    pub fn with_workspace(analysis: std::rc::Rc<Analysis>, workspace: Workspace) -> SpdFactor {
+    pub(crate) fn with_workspace(analysis: std::rc::Rc<Analysis>, workspace: Workspace) -> SpdFactor {
         SpdFactor { analysis, numeric: workspace.0 }
     }
 

@@ -73,8 +73,9 @@ impl Energy {
 /// sharp vertices this is `K (M⁻¹ K)^{k−1}` (paper eq. 18).
 ///
 /// The products skip K's entries that are exactly zero (a grid's diagonal edges), so `Q` stores
-/// the structural pattern of the products of K's non-zero entries plus K's own pattern: 13 entries in an interior column
-/// of a grid's bilaplacian instead of the 19 of the triangulation's 2-ring.
+/// the structural pattern of the products of K's non-zero entries plus K's own pattern: 13
+/// entries in an interior column of a grid's bilaplacian instead of the 19 of the
+/// triangulation's 2-ring.
 ///
 /// # Panics
 /// If `scale.len() != energy.terms.len()`, `m.len() != K.nrows()`, or a sharp index is out of

@@ -83,7 +83,34 @@ pub fn constraint_edges<D: Domain>(domain: &D, u: &[f64], fixed: &[Option<f64>],
 /// Infeasible if even ε = 0 is infeasible: an edge path runs from a fixed value down to a
 /// smaller one (u disagrees with the fixed values).
 pub fn max_margin(u: &[f64], edges: &[(usize, usize)], fixed: &[Option<f64>], cap: Option<f64>) -> Result<f64> {
+    max_margin_bounded(u, edges, fixed, &[], cap)
+}
+
+/// [`max_margin`] with one-sided bounds on free vertices, `(vertex, value, upper)`: `f_v ≤
+/// value` when `upper`, else `f_v ≥ value` (a series' free end held inside the data's range).
+/// A lower bound starts paths like a fixed value; an upper bound ends them like one.
+///
+/// # Errors
+/// As [`max_margin`].
+pub fn max_margin_bounded(
+    u: &[f64],
+    edges: &[(usize, usize)],
+    fixed: &[Option<f64>],
+    bounds: &[(usize, f64, bool)],
+    cap: Option<f64>,
+) -> Result<f64> {
     let n = u.len();
+    let mut upper = vec![f64::INFINITY; n];
+    let mut lower = vec![f64::NEG_INFINITY; n];
+    for &(v, value, is_upper) in bounds {
+        if fixed[v].is_none() {
+            if is_upper {
+                upper[v] = upper[v].min(value);
+            } else {
+                lower[v] = lower[v].max(value);
+            }
+        }
+    }
     let order = sos_sort(u);
     // out-edges in compressed form
     let mut start = vec![0usize; n + 1];
@@ -100,10 +127,14 @@ pub fn max_margin(u: &[f64], edges: &[(usize, usize)], fixed: &[Option<f64>], ca
         fill[a] += 1;
     }
     let mut lo = vec![f64::NEG_INFINITY; n];
-    // Some(v) = the first fixed vertex whose bound fails at this ε
-    let mut violated = |eps: f64| -> Option<usize> {
+    // where each vertex's lower bound starts (a fixed or lower-bounded vertex)
+    let mut from = vec![usize::MAX; n];
+    // Some((a, w)) = the first fixed (or upper-bounded) vertex w whose bound fails at this ε,
+    // on a path up from a
+    let mut violated = |eps: f64| -> Option<(usize, usize)> {
         for (v, l) in lo.iter_mut().enumerate() {
-            *l = fixed[v].unwrap_or(f64::NEG_INFINITY);
+            *l = fixed[v].unwrap_or(lower[v]);
+            from[v] = v;
         }
         for &v in &order {
             let base = lo[v];
@@ -113,20 +144,25 @@ pub fn max_margin(u: &[f64], edges: &[(usize, usize)], fixed: &[Option<f64>], ca
             for &w in &succ[start[v]..start[v + 1]] {
                 let cand = base + eps;
                 match fixed[w] {
-                    Some(fw) if cand > fw => return Some(w),
+                    Some(fw) if cand > fw => return Some((from[v], w)),
                     Some(_) => {}
-                    None => lo[w] = lo[w].max(cand),
+                    None if cand > upper[w] => return Some((from[v], w)),
+                    None if cand > lo[w] => {
+                        lo[w] = cand;
+                        from[w] = from[v];
+                    }
+                    None => {}
                 }
             }
         }
         None
     };
-    if let Some(w) = violated(0.0) {
+    if let Some((a, w)) = violated(0.0) {
         return Err(Error::infeasible(format!(
-            "the constraint graph runs from a fixed value down to the smaller fixed value at vertex {w}"
+            "the representative orders a path upward from vertex {a} to vertex {w}, whose fixed value (or bound) is not higher: no function increasing along it takes these values"
         )));
     }
-    let (fmin, fmax) = crate::domain::value_range(fixed.iter().flatten());
+    let (fmin, fmax) = crate::domain::value_range(fixed.iter().flatten().chain(bounds.iter().map(|b| &b.1)));
     let span = if fmax > fmin { fmax - fmin } else { 1.0 };
     // the usual case: the cap of `choose_margin` is feasible twice over; one pass decides
     if let Some(cap) = cap.filter(|&c| c < span) {
@@ -197,6 +233,55 @@ pub fn choose_margin(max_margin: f64, range: f64, resolution: f64) -> Result<f64
     Ok(eps)
 }
 
+/// How much of the output the constraints hold: the constrained edges whose output rises by
+/// less than 10 margins are *active*; flat steps of the smoothing fight the constraints there.
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
+pub struct Activity {
+    /// Share of the free vertices with an incident active edge.
+    pub active_fraction: f64,
+    /// Connected sets of at least 3 free vertices joined by active edges (terraces: staircases
+    /// of margin-sized steps).
+    pub terraces: usize,
+    /// Vertices of the largest terrace (0 when there is none).
+    pub largest_terrace: usize,
+}
+
+/// [`Activity`] of `f` on the constrained `edges` with margin `eps` (in `f`'s units).
+pub fn activity(f: &[f64], edges: &[(usize, usize)], fixed: &[bool], eps: f64) -> Activity {
+    let n = f.len();
+    let mut parent: Vec<usize> = (0..n).collect();
+    fn root(parent: &mut [usize], mut v: usize) -> usize {
+        while parent[v] != v {
+            parent[v] = parent[parent[v]];
+            v = parent[v];
+        }
+        v
+    }
+    let mut active = vec![false; n];
+    for &(i, j) in edges {
+        if f[j] - f[i] < 10.0 * eps {
+            active[i] |= !fixed[i];
+            active[j] |= !fixed[j];
+            if !fixed[i] && !fixed[j] {
+                let (a, b) = (root(&mut parent, i), root(&mut parent, j));
+                parent[a] = b;
+            }
+        }
+    }
+    let free = fixed.iter().filter(|&&x| !x).count();
+    let mut size = vec![0usize; n];
+    for (v, _) in active.iter().enumerate().filter(|(_, &a)| a) {
+        let r = root(&mut parent, v);
+        size[r] += 1;
+    }
+    let big: Vec<usize> = size.into_iter().filter(|&s| s >= 3).collect();
+    Activity {
+        active_fraction: active.iter().filter(|&&a| a).count() as f64 / free.max(1) as f64,
+        terraces: big.len(),
+        largest_terrace: big.iter().copied().max().unwrap_or(0),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -230,6 +315,36 @@ mod tests {
         // u disagreeing with the fixed values
         let bad = [Some(1.0), None, None, None, Some(0.0)];
         assert!(max_margin(&u, &e, &bad, None).is_err());
+    }
+
+    #[test]
+    fn active_edges_and_terraces_are_counted_on_free_vertices() {
+        // 0 fixed, then a staircase 1-2-3-4 of margin steps, then a steep rise, 6 fixed
+        let eps = 1e-3;
+        let f = [0.0, 0.5, 0.5 + eps, 0.5 + 2.0 * eps, 0.5 + 3.0 * eps, 0.9, 1.0];
+        let fixed = [true, false, false, false, false, false, true];
+        let edges: Vec<(usize, usize)> = (0..6).map(|i| (i, i + 1)).collect();
+        let a = activity(&f, &edges, &fixed, eps);
+        assert_eq!((a.terraces, a.largest_terrace), (1, 4));
+        assert!((a.active_fraction - 4.0 / 5.0).abs() < 1e-12, "{a:?}");
+        // two active vertices only: no terrace; a fixed end does not join one
+        let g = [0.0, eps, 0.5, 0.6, 0.7, 0.8, 1.0];
+        let b = activity(&g, &edges, &fixed, eps);
+        assert_eq!((b.terraces, b.largest_terrace), (0, 0));
+        assert!((b.active_fraction - 1.0 / 5.0).abs() < 1e-12, "{b:?}");
+    }
+
+    #[test]
+    fn an_upper_bound_ends_paths_like_a_fixed_value() {
+        // fixed 0 at vertex 0, a free end at vertex 3 held below 0.3: 3 edges ⇒ ε_max = 0.1
+        let u = [0.0, 1.0, 2.0, 3.0];
+        let fixed = [Some(0.0), None, None, None];
+        let e = constraint_edges(&Series::uniform(4), &u, &fixed, EdgeSet::Minimal);
+        assert_eq!(max_margin(&u, &e, &fixed, None).unwrap(), f64::INFINITY);
+        let m = max_margin_bounded(&u, &e, &fixed, &[(3, 0.3, true)], None).unwrap();
+        assert!((m - 0.1).abs() < 1e-6, "{m}");
+        // a bound below the fixed value: infeasible
+        assert!(max_margin_bounded(&u, &e, &fixed, &[(3, -1.0, true)], None).is_err());
     }
 
     #[test]

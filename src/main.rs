@@ -11,7 +11,7 @@ use toposmooth::io::series_csv::SeriesCsvOptions;
 use toposmooth::operators::Energy;
 use toposmooth::pipeline::{RepresentativeChoice, SmoothSettings};
 use toposmooth::plot::MeshView;
-use toposmooth::solve::{Method, QpSettings};
+use toposmooth::solve::{Formulation, Method, QpSettings};
 use toposmooth::topology::Selection;
 use toposmooth::{Error, Result};
 
@@ -181,9 +181,9 @@ enum Command {
         /// QP solver.
         #[arg(long, value_enum, default_value_t = Solver::Structured)]
         solver: Solver,
-        /// Representative function on grids and meshes.
-        #[arg(long, value_enum, default_value_t = RepresentativeCli::Separatrix)]
-        representative: RepresentativeCli,
+        /// Representative function on grids and meshes (default: automatic).
+        #[arg(long, value_enum)]
+        representative: Option<RepresentativeCli>,
         /// Run one size in this process and print one JSON line.
         #[arg(long, hide = true)]
         single: Option<String>,
@@ -392,6 +392,13 @@ enum Solver {
 }
 
 #[derive(Clone, Copy, ValueEnum)]
+enum FormulationCli {
+    Auto,
+    Assembled,
+    Factored,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
 enum Edges {
     Minimal,
     All,
@@ -415,9 +422,11 @@ struct SmoothCli {
     /// Grids and meshes: kept extrema, saddles and separatrices as VTK PolyData (.vtp).
     #[arg(long, value_name = "VTP")]
     complex: Option<PathBuf>,
-    /// Grids and meshes: representative function.
-    #[arg(long, value_enum, default_value_t = RepresentativeCli::Separatrix)]
-    representative: RepresentativeCli,
+    /// Grids and meshes: representative function. Given, it is built or the run fails (exit 3
+    /// when the data cannot follow its order, 1 when it fails its own check); by default the
+    /// separatrix one, then harmonic, then flooded, each fallback reported.
+    #[arg(long, value_enum)]
+    representative: Option<RepresentativeCli>,
     /// Mesh plot: camera azimuth and elevation in degrees (y up).
     #[arg(long, value_name = "AZ,EL", allow_hyphen_values = true)]
     view: Option<String>,
@@ -462,9 +471,11 @@ struct SmoothCli {
     /// γL for every energy term (default: ℓ^(2k) with ℓ from --smooth-length).
     #[arg(long, value_name = "W")]
     smooth_weight: Option<f64>,
-    /// Smoothing length ℓ as a fraction of the series' extent.
-    #[arg(long, default_value_t = 0.01)]
-    smooth_length: f64,
+    /// Smoothing length ℓ as a fraction of the domain's diameter (the series' extent); by
+    /// default max(2 mean edge lengths, 1 % of the diameter), on series at most half the median
+    /// spacing of the kept extrema (the report gives ℓ and the rule).
+    #[arg(long, value_name = "FRACTION")]
+    smooth_length: Option<f64>,
     /// Constraint set.
     #[arg(long, value_enum, default_value_t = Edges::Minimal)]
     edges: Edges,
@@ -475,6 +486,11 @@ struct SmoothCli {
     /// Clarabel alone.
     #[arg(long, value_enum, default_value_t = Solver::Structured)]
     solver: Solver,
+    /// How the energy enters the solver: assembled (normal equations in double precision),
+    /// factored (FᵀF, the paper's auxiliary variables: double-double normal equations in the
+    /// structured solver), or auto (factored when the condition estimate exceeds 1e9).
+    #[arg(long, value_enum, default_value_t = FormulationCli::Auto)]
+    formulation: FormulationCli,
     /// Figure: series input (grey), output and kept extrema; grids as heat maps side by side.
     #[arg(long, value_name = "PNG")]
     plot: Option<PathBuf>,
@@ -523,7 +539,16 @@ fn smooth_args(c: SmoothCli) -> Result<SmoothArgs> {
         smooth_weight: c.smooth_weight,
         smooth_length: c.smooth_length,
         edges: edge_set(c.edges),
-        qp: QpSettings { max_iter: c.max_iter, method: method(c.solver), ..Default::default() },
+        qp: QpSettings {
+            max_iter: c.max_iter,
+            method: method(c.solver),
+            formulation: match c.formulation {
+                FormulationCli::Auto => Formulation::Auto,
+                FormulationCli::Assembled => Formulation::Assembled,
+                FormulationCli::Factored => Formulation::Factored,
+            },
+            ..Default::default()
+        },
         representative: representative_choice(c.representative),
     };
     Ok(SmoothArgs {
@@ -635,12 +660,12 @@ fn run(cli: Cli) -> Result<String> {
     }
 }
 
-fn representative_choice(r: RepresentativeCli) -> RepresentativeChoice {
-    match r {
+fn representative_choice(r: Option<RepresentativeCli>) -> Option<RepresentativeChoice> {
+    r.map(|r| match r {
         RepresentativeCli::Separatrix => RepresentativeChoice::Separatrix,
         RepresentativeCli::Harmonic => RepresentativeChoice::Harmonic,
         RepresentativeCli::Flooded => RepresentativeChoice::Flooded,
-    }
+    })
 }
 
 fn main() {

@@ -11,16 +11,21 @@
 //! # Ok::<(), toposmooth::Error>(())
 //! ```
 
-use crate::constraints::{choose_margin, constraint_edges, margin_cap, max_margin, EdgeSet};
+use crate::constraints::{
+    activity, choose_margin, constraint_edges, margin_cap, max_margin_bounded, Activity, EdgeSet,
+};
 use crate::domain::{sos_sort, Domain, Grid2d, Series, TriMesh};
 use crate::error::{Error, Result};
 use crate::operators::{
-    cotan_stiffness, dirichlet_solve, grid_mass, grid_stiffness, lumped_mass, plus_diagonal, polyharmonic,
-    positive_cotan_stiffness, quadratic_form, quadratic_form_without_diagonal, series_mass, series_stiffness, Energy,
-    Sparse,
+    cotan_stiffness, dirichlet_solve, edge_factor, gradient_factor, grid_mass, grid_stiffness, lumped_mass,
+    plus_diagonal, polyharmonic, polyharmonic_factor, positive_cotan_stiffness, quadratic_form_without_diagonal,
+    series_mass, series_stiffness, Energy, Sparse,
 };
 use crate::representative::{flooded_representative, separatrix_representative, series_representative};
-use crate::solve::{repair, solve_monotone_qp, Method, MonotoneQp, QpSettings, RepairSummary, SolveStatus};
+use crate::solve::{
+    condition_estimate, meet_margin, optimality, repair, solve_monotone_qp, Bound, Formulation, MarginSummary, Method,
+    MonotoneQp, QpSettings, RepairSummary, SolveStatus, FACTORED_ABOVE,
+};
 use crate::topology::morse_smale::MorseSmale;
 use crate::topology::{count_sos_extrema, select, KeptExtremum, KeptSet, Role, Selection};
 use crate::verify::{certify, Certificate};
@@ -47,8 +52,10 @@ pub struct Representative {
     pub u: Vec<f64>,
     /// Construction used: `linear`, `separatrix`, `harmonic` or `flooded`.
     pub kind: &'static str,
-    /// Construction used, with the reasons for any fallback.
+    /// Construction used, with its variant (one-sided saddles, released vertices).
     pub name: String,
+    /// Why each construction tried before it was not used (automatic choice only).
+    pub fallbacks: Vec<String>,
     /// The simplified Morse–Smale complex (surfaces).
     pub complex: Option<MorseSmale>,
 }
@@ -64,6 +71,11 @@ pub trait Smoothable: Domain {
     fn fill_stiffness(&self) -> Sparse {
         self.stiffness()
     }
+    /// `F₁` with `F₁ᵀF₁ = k` (the stiffness): one row per edge of positive weight, or `None`
+    /// when a weight is negative and the domain has no other square root.
+    fn stiffness_factor(&self, k: &Sparse) -> Option<Sparse> {
+        edge_factor(k)
+    }
     /// A function with exactly the kept extrema (checked by the pipeline), built by the
     /// first construction in the order `choice` prefers that is not `excluded` (kind and
     /// why: the pipeline excludes one whose order makes the constraints infeasible).
@@ -71,7 +83,7 @@ pub trait Smoothable: Domain {
         &self,
         h: &[f64],
         kept: &KeptSet,
-        choice: RepresentativeChoice,
+        choice: Option<RepresentativeChoice>,
         k: &Sparse,
         excluded: &[(&'static str, String)],
     ) -> Result<Representative>;
@@ -88,12 +100,12 @@ impl Smoothable for Series {
         &self,
         h: &[f64],
         kept: &KeptSet,
-        _: RepresentativeChoice,
+        _: Option<RepresentativeChoice>,
         _: &Sparse,
         _: &[(&'static str, String)],
     ) -> Result<Representative> {
         let u = series_representative(self, h, kept)?;
-        Ok(Representative { u, kind: "linear", name: "linear".into(), complex: None })
+        Ok(Representative { u, kind: "linear", name: "linear".into(), fallbacks: Vec::new(), complex: None })
     }
 }
 
@@ -113,14 +125,16 @@ fn harmonic_representative(h: &[f64], kept: &KeptSet, k: &Sparse) -> std::result
     dirichlet_solve(k, &fixed)
 }
 
-/// The representative on a triangulated surface: the chosen construction (the complex is
-/// built either way, for `--complex`); if it fails its check, the other one, then the flooded
-/// one (NOTES.md 9). `k` is the Laplacian of the harmonic fills (non-negative weights).
+/// The representative on a triangulated surface (the complex is built either way, for
+/// `--complex`). A construction the user chose is built or refused (its check failing is an
+/// error naming the vertices); the automatic choice tries the separatrix one, then the
+/// harmonic one, then the flooded one (NOTES.md 9), and records why each one before was not
+/// used. `k` is the Laplacian of the harmonic fills (non-negative weights).
 fn surface_representative<D: Domain>(
     domain: &D,
     h: &[f64],
     kept: &KeptSet,
-    choice: RepresentativeChoice,
+    choice: Option<RepresentativeChoice>,
     k: &Sparse,
     excluded: &[(&'static str, String)],
 ) -> Result<Representative> {
@@ -186,17 +200,22 @@ fn surface_representative<D: Domain>(
         }
         u
     };
-    let order: [&'static str; 3] = match choice {
-        RepresentativeChoice::Separatrix => ["separatrix", "harmonic", "flooded"],
-        RepresentativeChoice::Harmonic => ["harmonic", "separatrix", "flooded"],
-        RepresentativeChoice::Flooded => ["flooded", "separatrix", "harmonic"],
+    let order: &[&'static str] = match choice {
+        None => &["separatrix", "harmonic", "flooded"],
+        Some(RepresentativeChoice::Separatrix) => &["separatrix"],
+        Some(RepresentativeChoice::Harmonic) => &["harmonic"],
+        Some(RepresentativeChoice::Flooded) => &["flooded"],
     };
+    if choice.is_some() {
+        // the complex is only for --complex when the user chose the construction
+        why.clear();
+    }
     let build = |name: &str, why: &mut Vec<String>| match name {
         "separatrix" => separatrix(why),
         "harmonic" => harmonic(why),
         _ => flooded(why),
     };
-    let named = |name: &str, why: &[String]| {
+    let named = |name: &str| {
         let mut name = name.to_string();
         if name == "separatrix" && one_sided_saddles.get() > 0 {
             name = format!("separatrix with {} one-sided saddles", one_sided_saddles.get());
@@ -205,23 +224,23 @@ fn surface_representative<D: Domain>(
             name =
                 format!("{name} ({} contradicting separatrix vertices released to the harmonic fill)", released.get());
         }
-        if why.is_empty() {
-            name
-        } else {
-            format!("{name} (fallback: {})", why.join("; "))
-        }
+        name
     };
-    for kind in order {
+    for &kind in order {
         if skip(kind) {
             continue;
         }
         if let Some(u) = build(kind, &mut why) {
             // --complex writes the separatrices u was built from
             let complex = if kind == "separatrix" { merged_used.take().or(complex) } else { complex };
-            return Ok(Representative { u, kind, name: named(kind, &why), complex });
+            return Ok(Representative { u, kind, name: named(kind), fallbacks: why, complex });
         }
     }
-    Err(Error::Representative { path: None, message: why.join("; ") })
+    let message = match choice {
+        Some(_) => format!("{} (requested explicitly: not replaced by another construction)", why.join("; ")),
+        None => why.join("; "),
+    };
+    Err(Error::Representative { path: None, message })
 }
 
 impl Smoothable for TriMesh {
@@ -234,6 +253,11 @@ impl Smoothable for TriMesh {
     fn fill_stiffness(&self) -> Sparse {
         positive_cotan_stiffness(self.positions(), self.faces())
     }
+    /// One row per edge when every cotangent weight is ≥ 0, else the area-weighted triangle
+    /// gradients (three rows per triangle).
+    fn stiffness_factor(&self, k: &Sparse) -> Option<Sparse> {
+        edge_factor(k).or_else(|| Some(gradient_factor(self.positions(), self.faces())))
+    }
     /// As on grids, but the harmonic fills use [`positive_cotan_stiffness`]: cotangent
     /// weights of obtuse triangles can be negative and break the maximum principle the
     /// representative relies on (paper section 5); `k` (the energy's) is not used.
@@ -241,7 +265,7 @@ impl Smoothable for TriMesh {
         &self,
         h: &[f64],
         kept: &KeptSet,
-        choice: RepresentativeChoice,
+        choice: Option<RepresentativeChoice>,
         _k: &Sparse,
         excluded: &[(&'static str, String)],
     ) -> Result<Representative> {
@@ -260,7 +284,7 @@ impl Smoothable for Grid2d {
         &self,
         h: &[f64],
         kept: &KeptSet,
-        choice: RepresentativeChoice,
+        choice: Option<RepresentativeChoice>,
         k: &Sparse,
         excluded: &[(&'static str, String)],
     ) -> Result<Representative> {
@@ -279,14 +303,16 @@ pub struct SmoothSettings {
     pub data_weight: f64,
     /// γL for every energy term; `None` means ℓ^(2k) per order k. {None}
     pub smooth_weight: Option<f64>,
-    /// Smoothing length ℓ as a fraction of the domain's diameter. {0.01}
-    pub smooth_length: f64,
+    /// Smoothing length ℓ as a fraction of the domain's diameter; `None` chooses it from the
+    /// domain and the kept extrema ([`default_smooth_length`]). {None}
+    pub smooth_length: Option<f64>,
     /// Constraint set. {minimal}
     pub edges: EdgeSet,
     /// Solver settings.
     pub qp: QpSettings,
-    /// Representative function on surfaces. {separatrix}
-    pub representative: RepresentativeChoice,
+    /// Representative function on surfaces; `None` chooses automatically (separatrix, then
+    /// harmonic, then flooded, each fallback reported). {None}
+    pub representative: Option<RepresentativeChoice>,
 }
 
 impl Default for SmoothSettings {
@@ -296,10 +322,10 @@ impl Default for SmoothSettings {
             energy: Energy::order(2),
             data_weight: 1.0,
             smooth_weight: None,
-            smooth_length: 0.01,
+            smooth_length: None,
             edges: EdgeSet::Minimal,
             qp: QpSettings::default(),
-            representative: RepresentativeChoice::Separatrix,
+            representative: None,
         }
     }
 }
@@ -316,12 +342,17 @@ impl SmoothSettings {
                 return Err(Error::Usage(format!("--smooth-weight must be finite and > 0, got {w}")));
             }
         }
-        if !(self.smooth_length.is_finite() && self.smooth_length > 0.0) {
-            return Err(Error::Usage(format!("--smooth-length must be finite and > 0, got {}", self.smooth_length)));
+        if let Some(l) = self.smooth_length {
+            if !(l.is_finite() && l > 0.0) {
+                return Err(Error::Usage(format!("--smooth-length must be finite and > 0, got {l}")));
+            }
         }
         Ok(())
     }
 }
+
+/// Active fraction above which a run warns that the smoothing fights the constraints.
+pub const ACTIVE_WARNING: f64 = 0.25;
 
 /// Seconds per stage.
 #[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
@@ -372,6 +403,8 @@ pub struct RunSettings {
     pub smooth_weights: Vec<f64>,
     /// ℓ as a fraction of the diameter, and in the domain's units.
     pub smooth_length: [f64; 2],
+    /// How ℓ was chosen.
+    pub smooth_length_rule: String,
     /// Constraint set.
     pub edge_set: EdgeSet,
     /// Margin ε (in the field's units) and the largest feasible one (a lower bound, twice the
@@ -382,8 +415,8 @@ pub struct RunSettings {
     pub u_margin: f64,
     /// Solver settings as requested.
     pub solver: QpSettings,
-    /// Representative requested (surfaces).
-    pub representative: RepresentativeChoice,
+    /// Representative requested (surfaces; `null`: automatic).
+    pub representative: Option<RepresentativeChoice>,
 }
 
 /// Everything a run measured, written by `--report`.
@@ -419,14 +452,148 @@ pub struct Report {
     pub solver: Method,
     /// Why the structured solver handed over to Clarabel, if it did.
     pub solver_fallback: Option<String>,
-    /// What the repair changed.
+    /// What the repair of strictness changed (after the margin was met, nothing).
     pub repair: RepairSummary,
-    /// Which representative was used (and why a fallback was needed).
+    /// What meeting the margin exactly changed (the solver meets it to its tolerance).
+    pub margin_repair: MarginSummary,
+    /// How close the output is to the QP's optimum.
+    pub fit: FitReport,
+    /// How much of the output the constraints hold (active edges: a rise below 10 margins).
+    pub activity: Activity,
+    /// Which representative was used.
     pub representative: String,
+    /// Why each automatic choice before it was not used (empty when the first one was).
+    pub representative_fallbacks: Vec<String>,
     /// Certificate of u (items 1, 2, 4).
     pub representative_certificate: Certificate,
     /// Certificate of the output (items 1–4).
     pub certificate: Certificate,
+}
+
+/// How close the output is to the optimum of the QP it solves (SPEC.md, end of "Exit status"),
+/// in the units of [`EnergyReport`]: `J(f) = Σ γ_k w_k E_k(f) + γD Σ M_ii (f_i − h_i)²`.
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
+pub struct FitReport {
+    /// Ĝ ≥ J(f) − J*, from the multipliers and the residual (no solve); `null` when some free
+    /// vertex has no data weight.
+    pub gap: Option<f64>,
+    /// Ĝ ÷ the data term of f.
+    pub gap_over_data: Option<f64>,
+    /// ‖f − f*‖_M ≤ √(Ĝ / γD) (mass-weighted; `null` when the output is not feasible for the
+    /// QP as written, see `why_no_bound`).
+    pub distance_bound: Option<f64>,
+    /// The bound as a root-mean-square distance (÷ √ΣM) relative to the value range: what
+    /// "optimal to" means in the summary.
+    pub relative_distance_bound: Option<f64>,
+    /// The smallest slack `f_j − f_i − ε` over the constrained edges (and bounds), in the
+    /// field's units.
+    pub min_slack: f64,
+    /// `max(0, −min_slack)`: how far the output violates the QP's rows.
+    pub primal_residual: f64,
+    /// `√(rᵀM⁻¹r / (4 γD))` for the stationarity residual r = ∇J(f) + Aᵀz (in √J units).
+    pub dual_residual: f64,
+    /// Complementarity `sᵀz` (J units).
+    pub complementarity: f64,
+    /// Condition estimate of the QP's matrix scaled by the data term (`1 + 4^k (ℓ/h)^{2k}`
+    /// for one order k; `null` without a data weight everywhere).
+    pub condition: Option<f64>,
+    /// `assembled` or `factored`.
+    pub formulation: Formulation,
+    /// Why no distance is claimed, if none is.
+    pub why_no_bound: Option<String>,
+}
+
+impl FitReport {
+    /// One line for the summary: "optimal to X of the range" or why not.
+    pub fn summary(&self) -> String {
+        let cond = self.condition.map(|c| format!(", condition {c:.1e}")).unwrap_or_default();
+        let form = match self.formulation {
+            Formulation::Factored => ", factored",
+            _ => "",
+        };
+        match (self.relative_distance_bound, self.gap_over_data) {
+            (Some(d), Some(g)) => format!(
+                "optimal to {d:.1e} of the range (RMS distance to the QP's optimum, certified: gap bound {:.2e} = {g:.1e} × the data term{cond}{form})",
+                self.gap.unwrap_or(0.0)
+            ),
+            (None, Some(g)) => format!(
+                "gap bound {:.2e} = {g:.1e} × the data term, no distance claimed: {}{cond}{form}",
+                self.gap.unwrap_or(0.0),
+                self.why_no_bound.as_deref().unwrap_or("")
+            ),
+            _ => format!("no optimality bound: {}{cond}{form}", self.why_no_bound.as_deref().unwrap_or("")),
+        }
+    }
+}
+
+/// The QP in the field's units, for [`fit_report`].
+struct FitInputs<'a> {
+    p: &'a Sparse,
+    data_diag: &'a [f64],
+    h: &'a [f64],
+    fixed: &'a [bool],
+    edges: &'a [(usize, usize)],
+    bounds: &'a [Bound],
+}
+
+/// The gap bound of the certified output `f` in the field's units: the solver's multipliers
+/// (and auxiliary variables) mapped from values scaled to [0, 1] (by `range`, margin `eps`
+/// scaled, data weight `gd`, mass `m`).
+fn fit_report(
+    qp: &FitInputs<'_>,
+    f: &[f64],
+    sol: &crate::solve::QpSolution,
+    factor: Option<&Sparse>,
+    (range, eps, gd, m): (f64, f64, f64, &[f64]),
+) -> FitReport {
+    let n = f.len();
+    let q: Vec<f64> = (0..n).map(|i| -qp.data_diag[i] * qp.h[i]).collect();
+    let fixed: Vec<Option<f64>> = (0..n).map(|i| qp.fixed[i].then_some(qp.h[i])).collect();
+    let problem = MonotoneQp {
+        p: qp.p,
+        q: &q,
+        fixed: &fixed,
+        edges: qp.edges,
+        margin: eps * range,
+        bounds: qp.bounds,
+        data: Some(qp.data_diag),
+        hint: None,
+        factor: sol.y.as_ref().and(factor),
+        condition: sol.condition,
+    };
+    // multipliers and t = F f scale with the values (f = lo + range·x; F·1 = 0 up to the
+    // rounding of F's entries, which is left in ½‖F f − y‖²: carried into y it would enter ρ
+    // through Fᵀ, amplified by ‖F‖)
+    let z: Vec<f64> = sol.z.iter().map(|v| v * range).collect();
+    let y: Option<Vec<f64>> = sol.y.as_ref().map(|y| y.iter().map(|t| t * range).collect());
+    let o = optimality(&problem, f, &z, y.as_deref());
+    let bounded = o.gap.is_finite();
+    let mass: f64 = (0..n).filter(|&i| !qp.fixed[i]).map(|i| m[i]).sum();
+    // J = 2φ + const, so Ĝ_J = 2 Ĝ_φ; ‖f − f*‖_M = ‖f − f*‖_D / √γD ≤ √(2 Ĝ_φ / γD)
+    let distance = o.distance.filter(|_| gd > 0.0).map(|d| d / gd.sqrt());
+    let why_no_bound = if !bounded {
+        Some("a free vertex has no data weight (P ⪰ γD·M does not bound the gap)".to_string())
+    } else if o.min_slack < 0.0 {
+        Some(format!(
+            "the output violates a constraint row by {:.1e} (rounding at the margin), so it is not feasible for the QP as written",
+            -o.min_slack
+        ))
+    } else {
+        None
+    };
+    FitReport {
+        gap: bounded.then_some(2.0 * o.gap),
+        gap_over_data: (bounded && o.data > 0.0).then(|| o.gap / o.data),
+        distance_bound: distance,
+        relative_distance_bound: distance.map(|d| d / mass.max(f64::MIN_POSITIVE).sqrt() / range),
+        min_slack: o.min_slack,
+        primal_residual: (-o.min_slack).max(0.0),
+        dual_residual: o.dual_residual,
+        complementarity: 2.0 * o.complementarity,
+        condition: sol.condition,
+        formulation: sol.formulation,
+        why_no_bound,
+    }
 }
 
 /// A certified result.
@@ -452,6 +619,7 @@ struct Operators {
     factor: Option<Sparse>,
     p: Sparse,
     q: Vec<f64>,
+    condition: Option<f64>,
 }
 
 /// Smooths `h` on `domain` keeping exactly the selected extrema; returns only certified output.
@@ -476,6 +644,10 @@ pub fn smooth<D: Smoothable + Sync>(domain: &D, h: &[f64], settings: &SmoothSett
     let (input_minima, input_maxima) = count_sos_extrema(domain, h);
     seconds.persistence = t.elapsed().as_secs_f64();
 
+    let (ell, smooth_length_rule) = match settings.smooth_length {
+        Some(fraction) => (fraction * domain.diameter(), format!("--smooth-length {fraction} of the diameter")),
+        None => default_smooth_length(domain, &kept),
+    };
     let k = domain.stiffness();
     let (lo, hi) = crate::domain::value_range(h);
     let range = hi - lo;
@@ -503,17 +675,33 @@ pub fn smooth<D: Smoothable + Sync>(domain: &D, h: &[f64], settings: &SmoothSett
             seconds.representative += t.elapsed().as_secs_f64() - seconds.complex - seconds.simplify;
             let t = Instant::now();
             let edges = constraint_edges(domain, &rep.u, &fixed, settings.edges);
-            let margins = max_margin(&rep.u, &edges, &fixed, Some(margin_cap(1.0, resolution)))
+            let bounds = free_end_bounds(domain, &rep.u, &kept.roles, (lo, hi));
+            let scaled: Vec<(usize, f64, bool)> =
+                bounds.iter().map(|b| (b.vertex, (b.value - lo) / range, b.upper)).collect();
+            let margins = max_margin_bounded(&rep.u, &edges, &fixed, &scaled, Some(margin_cap(1.0, resolution)))
                 .and_then(|eps_max| Ok((eps_max, choose_margin(eps_max, 1.0, resolution)?)));
             seconds.constraints += t.elapsed().as_secs_f64();
             match margins {
                 Ok((eps_max, eps)) => {
-                    return Ok((rep.u, rep.name, rep.complex, representative_certificate, edges, eps_max, eps));
+                    let name = (rep.name, rep.fallbacks);
+                    return Ok((rep.u, name, rep.complex, representative_certificate, edges, bounds, eps_max, eps));
                 }
                 Err(e @ Error::Infeasible { .. })
-                    if settings.selection.by_persistence() && rep.kind != "linear" && rep.kind != "flooded" =>
+                    if settings.representative.is_none()
+                        && settings.selection.by_persistence()
+                        && rep.kind != "linear"
+                        && rep.kind != "flooded" =>
                 {
                     excluded.push((rep.kind, e.to_string()));
+                }
+                Err(Error::Infeasible { path, message }) if settings.representative.is_some() => {
+                    return Err(Error::Infeasible {
+                        path,
+                        message: format!(
+                            "the {} representative the data cannot follow: {message} (requested explicitly: not replaced by another construction)",
+                            rep.kind
+                        ),
+                    })
                 }
                 Err(e) => return Err(e),
             }
@@ -523,7 +711,6 @@ pub fn smooth<D: Smoothable + Sync>(domain: &D, h: &[f64], settings: &SmoothSett
     // are built on the other core while the complex and the representative are.
     let operators = || -> Result<Operators> {
         let m = domain.mass();
-        let ell = settings.smooth_length * domain.diameter();
         let weights: Vec<f64> = settings
             .energy
             .terms
@@ -533,15 +720,23 @@ pub fn smooth<D: Smoothable + Sync>(domain: &D, h: &[f64], settings: &SmoothSett
         let q_energy = polyharmonic(&k, &m, &settings.energy, &weights);
         let gd = settings.data_weight;
         let data_diag: Vec<f64> = m.iter().map(|mi| gd * mi).collect();
-        let factor = match settings.qp.method {
-            Method::ClarabelAuxiliary => Some(energy_factor(&k, &m, &settings.energy, &weights, &q_energy)?),
-            _ => None,
-        };
         // P = energy + data diagonal, in the energy's storage (one matrix of the size of a
         // bilaplacian less: 300 MiB at a million vertices)
         let p = plus_diagonal(q_energy, &data_diag);
         let q: Vec<f64> = (0..n).map(|i| -gd * m[i] * z[i]).collect();
-        Ok(Operators { m, weights, data_diag, factor, p, q })
+        // the factored form where the assembled one would lose the digits the gap needs
+        let condition = condition_estimate(&p, &data_diag, &fixed);
+        let factored = match (settings.qp.method, settings.qp.formulation) {
+            (Method::ClarabelAuxiliary, _) | (_, Formulation::Factored) => true,
+            (_, Formulation::Assembled) => false,
+            (_, Formulation::Auto) => condition.is_some_and(|c| c > FACTORED_ABOVE),
+        };
+        let factor = if factored {
+            domain.stiffness_factor(&k).and_then(|k1| polyharmonic_factor(&k, &k1, &m, &settings.energy, &weights))
+        } else {
+            None
+        };
+        Ok(Operators { m, weights, data_diag, factor, p, q, condition })
     };
     let (representative_result, (operators_result, operators_seconds, prepared)) = std::thread::scope(|scope| {
         let background = scope.spawn(|| {
@@ -550,7 +745,7 @@ pub fn smooth<D: Smoothable + Sync>(domain: &D, h: &[f64], settings: &SmoothSett
             let seconds = t.elapsed().as_secs_f64();
             let prepared = match (&ops, settings.qp.method) {
                 // a failed analysis is redone (and reported) by the solver itself
-                (Ok(o), Method::Structured) => crate::solve::prepare(&o.p, &fixed).ok(),
+                (Ok(o), Method::Structured) if o.factor.is_none() => crate::solve::prepare(&o.p, &fixed).ok(),
                 _ => None,
             };
             (ops, seconds, prepared)
@@ -558,11 +753,19 @@ pub fn smooth<D: Smoothable + Sync>(domain: &D, h: &[f64], settings: &SmoothSett
         let rep = representative_stage();
         (rep, background.join().unwrap_or_else(|e| std::panic::resume_unwind(e)))
     });
-    let (u, representative, complex, representative_certificate, edges, eps_max, eps) = representative_result?;
-    let Operators { m, weights, data_diag, factor, p, q } = operators_result?;
+    let (
+        u,
+        (representative, representative_fallbacks),
+        complex,
+        representative_certificate,
+        edges,
+        bounds,
+        eps_max,
+        eps,
+    ) = representative_result?;
+    let Operators { m, weights, data_diag, factor, p, q, condition } = operators_result?;
     seconds.operators = operators_seconds;
     let gd = settings.data_weight;
-    let ell = settings.smooth_length * domain.diameter();
     // the fills' Laplacian analysis is not needed again: free it before the solver runs (the
     // solver's factor storage was made beside the representative: 1000² peak 2.93 → 3.06 GiB)
     crate::linalg::forget_solver_analysis();
@@ -573,14 +776,18 @@ pub fn smooth<D: Smoothable + Sync>(domain: &D, h: &[f64], settings: &SmoothSett
     let t = Instant::now();
     let hint: Vec<f64> = u.iter().map(|v| (v - lo) / range).collect();
     let u_margin = edges.iter().map(|&(i, j)| u[j] - u[i]).fold(f64::INFINITY, f64::min);
+    let scaled_bounds: Vec<Bound> = bounds.iter().map(|b| Bound { value: (b.value - lo) / range, ..*b }).collect();
     let qp = MonotoneQp {
         p: &p,
         q: &q,
         fixed: &fixed,
         edges: &edges,
         margin: eps,
+        bounds: &scaled_bounds,
+        data: Some(&data_diag),
         hint: Some(&hint),
-        factored: factor.as_ref().map(|f| (f, &data_diag[..])),
+        factor: factor.as_ref(),
+        condition,
     };
     let sol = solve_monotone_qp(&qp, &settings.qp)?;
     seconds.solve = t.elapsed().as_secs_f64();
@@ -594,6 +801,10 @@ pub fn smooth<D: Smoothable + Sync>(domain: &D, h: &[f64], settings: &SmoothSett
         }
     }
     let order = sos_sort(&u);
+    // the solver meets its rows to its tolerance: the margin is met exactly first, so that the
+    // point is feasible for the QP as written and its gap bound a distance bound; if that
+    // cannot be done, strictness alone
+    let margin_summary = meet_margin(&mut f, &is_fixed, &edges, &order, eps * range, &bounds);
     let repair_summary = repair(&mut f, &is_fixed, &edges, &order, 0.25 * eps * range);
     seconds.repair = t.elapsed().as_secs_f64();
 
@@ -613,6 +824,25 @@ pub fn smooth<D: Smoothable + Sync>(domain: &D, h: &[f64], settings: &SmoothSett
         });
     }
 
+    let fit = fit_report(
+        &FitInputs { p: &p, data_diag: &data_diag, h, fixed: &is_fixed, edges: &edges, bounds: &bounds },
+        &f,
+        &sol,
+        factor.as_ref(),
+        (range, eps, gd, &m),
+    );
+    let constraint_activity = activity(&f, &edges, &is_fixed, eps * range);
+    let mut warnings = kept.warnings.clone();
+    for why in &representative_fallbacks {
+        warnings.push(format!("representative fallback (the {representative} one is used): {why}"));
+    }
+    if constraint_activity.active_fraction > ACTIVE_WARNING {
+        warnings.push(format!(
+            "{:.0} % of the free vertices sit on an active constraint (largest terrace {} vertices): where the smoothing fights the constraints, lower --smooth-length; where the selection cancels large features, the output is held flat there by design",
+            100.0 * constraint_activity.active_fraction,
+            constraint_activity.largest_terrace
+        ));
+    }
     let smoothness = quadratic_form_without_diagonal(&p, &data_diag, &f);
     let data: f64 = gd * (0..n).map(|i| m[i] * (f[i] - h[i]).powi(2)).sum::<f64>();
     let sq: f64 = (0..n).map(|i| (f[i] - h[i]).powi(2)).sum();
@@ -627,7 +857,8 @@ pub fn smooth<D: Smoothable + Sync>(domain: &D, h: &[f64], settings: &SmoothSett
             energy: settings.energy.clone(),
             data_weight: gd,
             smooth_weights: weights,
-            smooth_length: [settings.smooth_length, ell],
+            smooth_length: [ell / domain.diameter(), ell],
+            smooth_length_rule,
             edge_set: settings.edges,
             margin: [eps * range, eps_max * range],
             u_margin,
@@ -636,7 +867,7 @@ pub fn smooth<D: Smoothable + Sync>(domain: &D, h: &[f64], settings: &SmoothSett
         },
         constraints: edges.len(),
         kept: kept.kept.clone(),
-        warnings: kept.warnings.clone(),
+        warnings,
         seconds,
         energy: EnergyReport { smoothness, data, total: smoothness + data },
         rms_deviation: (sq / n as f64).sqrt(),
@@ -646,50 +877,86 @@ pub fn smooth<D: Smoothable + Sync>(domain: &D, h: &[f64], settings: &SmoothSett
         solver: sol.method,
         solver_fallback: sol.fallback.clone(),
         repair: repair_summary,
+        margin_repair: margin_summary,
+        fit,
+        activity: constraint_activity,
         representative,
+        representative_fallbacks,
         representative_certificate,
         certificate,
     };
     Ok(Smoothed { output: f, u, roles: kept.roles, report, complex })
 }
 
-/// `F` with `FᵀF` equal to the energy matrix, for the appendix formulation: order 2 only,
-/// `F = √γ M^{−1/2} K` (checked against `q_energy` on a test vector).
-fn energy_factor(k: &Sparse, m: &[f64], energy: &Energy, weights: &[f64], q_energy: &Sparse) -> Result<Sparse> {
-    if energy.terms.len() != 1 || energy.terms[0].0 != 2 || !energy.sharp.is_empty() {
-        return Err(Error::Usage(
-            "--solver clarabel-auxiliary supports a single order-2 energy without --sharp".into(),
-        ));
-    }
-    let w = weights[0] * energy.terms[0].1;
-    let mut triplets = Vec::new();
-    let (cp, ri, val) = (k.symbolic().col_ptr(), k.symbolic().row_idx(), k.val());
-    for j in 0..k.ncols() {
-        for p in cp[j]..cp[j + 1] {
-            triplets.push(faer::sparse::Triplet::new(ri[p], j, (w / m[ri[p]]).sqrt() * val[p]));
-        }
-    }
-    let f = Sparse::try_new_from_triplets(k.nrows(), k.ncols(), &triplets)
-        .map_err(|e| Error::input(format!("energy factor: {e:?}")))?;
-    let x: Vec<f64> = (0..k.ncols()).map(|i| ((i * 7919) % 101) as f64 / 101.0).collect();
-    let fx: Vec<f64> = {
-        let mut y = vec![0.0; f.nrows()];
-        let (cp, ri, val) = (f.symbolic().col_ptr(), f.symbolic().row_idx(), f.val());
-        for j in 0..f.ncols() {
-            for p in cp[j]..cp[j + 1] {
-                y[ri[p]] += val[p] * x[j];
+/// Fraction of the diameter the default smoothing length starts from.
+pub const SMOOTH_LENGTH_FRACTION: f64 = 0.01;
+/// The default ℓ is at least this many mean edge lengths (sample spacings).
+pub const SMOOTH_LENGTH_EDGES: f64 = 2.0;
+/// On series the default ℓ is at most this fraction of the median spacing of consecutive
+/// kept extrema.
+pub const SMOOTH_LENGTH_KEPT_SPACING: f64 = 0.5;
+
+/// The default smoothing length and the rule that set it (SPEC.md, "Defaults"):
+/// `ℓ = max(2 h̄, 1 % of the diameter)` with `h̄` the mean edge length (sample spacing); on a
+/// series the 1 % is capped at half the median x-distance between consecutive kept extrema,
+/// so that dense kept extrema are not smoothed against (the filter `1/(1 + (ℓω)^{2k})` passes
+/// wavelengths above `2πℓ`; a kept oscillation of half-period S needs `πℓ < S`).
+pub fn default_smooth_length<D: Domain>(domain: &D, kept: &KeptSet) -> (f64, String) {
+    let edges = domain.edges();
+    let mean_edge = edges
+        .iter()
+        .map(|&(i, j)| {
+            let (a, b) = (domain.point(i), domain.point(j));
+            ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
+        })
+        .sum::<f64>()
+        / edges.len().max(1) as f64;
+    let diameter = domain.diameter();
+    let floor = SMOOTH_LENGTH_EDGES * mean_edge;
+    let mut base = SMOOTH_LENGTH_FRACTION * diameter;
+    let mut why = format!("1 % of the diameter ({})", short(base));
+    if domain.pairing_rule() == crate::domain::PairingRule::Path {
+        let mut at: Vec<f64> = kept.kept.iter().map(|k| domain.point(k.index)[0]).collect();
+        at.sort_by(f64::total_cmp);
+        let mut gaps: Vec<f64> = at.windows(2).map(|w| w[1] - w[0]).collect();
+        if !gaps.is_empty() {
+            gaps.sort_by(f64::total_cmp);
+            let median = gaps[gaps.len() / 2];
+            let cap = SMOOTH_LENGTH_KEPT_SPACING * median;
+            if cap < base {
+                base = cap;
+                why = format!("half the median spacing of the kept extrema ({})", short(median));
             }
         }
-        y
-    };
-    let (a, b) = (fx.iter().map(|v| v * v).sum::<f64>(), quadratic_form(q_energy, &x));
-    if (a - b).abs() > 1e-8 * b.abs().max(1e-300) {
-        return Err(Error::Representative {
-            path: None,
-            message: format!("internal error: FᵀF differs from the energy matrix ({a} vs {b})"),
-        });
     }
-    Ok(f)
+    if base < floor {
+        (floor, format!("2 mean edge lengths ({}; {why} is shorter)", short(mean_edge)))
+    } else {
+        (base, why)
+    }
+}
+
+/// `x` to 4 significant digits.
+fn short(x: f64) -> String {
+    if x == 0.0 || !x.is_finite() {
+        return format!("{x}");
+    }
+    let decimals = (3 - x.abs().log10().floor() as i32).clamp(0, 12) as usize;
+    format!("{x:.decimals$}")
+}
+
+/// The bounds that keep a series' free ends inside `[lo, hi]`, the input's range (SPEC.md,
+/// certificate item 2), where they can bind: an end above its neighbour in u (it rises from a
+/// kept minimum) stays below `hi`, one below its neighbour above `lo`.
+fn free_end_bounds<D: Domain>(domain: &D, u: &[f64], roles: &[Role], (lo, hi): (f64, f64)) -> Vec<Bound> {
+    (0..roles.len())
+        .filter(|&v| roles[v] == Role::End)
+        .filter_map(|v| {
+            let w = domain.neighbors(v).next()?;
+            let upper = crate::domain::sos_less(u, w, v);
+            Some(Bound { vertex: v, value: if upper { hi } else { lo }, upper })
+        })
+        .collect()
 }
 
 /// Two adjacent fixed vertices of different roles must differ in value (SPEC.md).

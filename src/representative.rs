@@ -40,7 +40,10 @@ pub fn series_representative(series: &Series, h: &[f64], kept: &KeptSet) -> Resu
     }
     let (lo, hi) = crate::domain::value_range(h);
     let slope = (hi - lo) / series.diameter();
-    // free ends: the end opposite in type to the nearest kept extremum
+    // free ends: the end opposite in type to the nearest kept extremum, inside [lo, hi]
+    let end_value = |stretch: &[f64], anchor: f64, role: Role, fallback: f64| {
+        end_value(stretch, anchor, role, fallback).clamp(lo, hi)
+    };
     let (first, first_role) = anchors[0];
     if first > 0 {
         let end = end_value(&h[..=first], h[first], first_role, slope * (x[first] - x[0]));

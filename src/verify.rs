@@ -73,7 +73,8 @@ impl Certificate {
 ///
 /// * `Min`/`Max`: strict local minimum/maximum (item 1);
 /// * `Other`: regular, i.e. a strictly lower and a strictly higher neighbour (item 2);
-/// * `End` (a series' free end): a strict extremum (item 2);
+/// * `End` (a series' free end): a strict extremum, inside `[min, max]` of `input` when it is
+///   given (item 2);
 /// * `Fixed`: exempt.
 ///
 /// Item 5 (the values as written and read back) is this function applied to the file's values.
@@ -83,6 +84,8 @@ pub fn certify<D: Domain>(domain: &D, f: &[f64], roles: &[Role], input: Option<&
     assert_eq!(roles.len(), n);
     let mut failures = Vec::new();
     let (mut strict_minima, mut strict_maxima, mut flat) = (0, 0, 0);
+    // a series' free end must lie inside the input's range (item 2)
+    let range = input.map(crate::domain::value_range);
     let mut fail = |item: u8, vertex: usize, reason: String| failures.push(Failure { item, vertex, reason });
     for v in 0..n {
         if !f[v].is_finite() {
@@ -124,6 +127,11 @@ pub fn certify<D: Domain>(domain: &D, f: &[f64], roles: &[Role], input: Option<&
                 },
             ),
             Role::End if !(is_min || is_max) => fail(2, v, "free end is not a strict extremum".into()),
+            Role::End => {
+                if let Some((lo, hi)) = range.filter(|&(lo, hi)| !(lo <= f[v] && f[v] <= hi)) {
+                    fail(2, v, format!("free end value {} lies outside the input's range [{lo}, {hi}]", f[v]));
+                }
+            }
             _ => {}
         }
         if let Some(h) = input {
@@ -316,6 +324,15 @@ mod tests {
         moved[2] = 1e-300;
         let c = certify(&s, &moved, &roles, Some(&good));
         assert!(c.failures.iter().any(|f| f.item == 3 && f.vertex == 2));
+        let mut beyond = good;
+        beyond[0] = 2.5; // the free end above the input's maximum (2.0)
+        let c = certify(&s, &beyond, &roles, Some(&good));
+        assert!(
+            c.failures.iter().any(|f| f.item == 2 && f.vertex == 0 && f.reason.contains("outside")),
+            "{}",
+            c.summary()
+        );
+        assert!(certify(&s, &beyond, &roles, None).passed, "without the input no range is known");
         let mut nan = good;
         nan[1] = f64::NAN;
         assert!(certify(&s, &nan, &roles, None).failures.iter().any(|f| f.item == 4));

@@ -191,13 +191,20 @@ fn appendix_formulation_reaches_the_same_optimum() {
         let worst = x.output.iter().zip(&y.output).map(|(p, q)| (p - q).abs()).fold(0.0, f64::max);
         assert!(worst < 1e-4, "outputs differ by {worst}");
     }
-    // blends are not factored: a usage error, not a silent switch
-    let settings = SmoothSettings {
-        energy: toposmooth::operators::Energy::parse("1:1,2:1").unwrap(),
-        qp: QpSettings { method: Method::ClarabelAuxiliary, ..Default::default() },
-        ..Default::default()
+    // blends are factored too: the same optimum as the assembled energy
+    let blend = |method| {
+        let settings = SmoothSettings {
+            energy: toposmooth::operators::Energy::parse("1:1,2:1,3:0.5").unwrap(),
+            selection: Selection::Relative(0.2),
+            qp: QpSettings { method, ..Default::default() },
+            ..Default::default()
+        };
+        smooth(&g, &h, &settings).unwrap()
     };
-    assert_eq!(smooth(&g, &h, &settings).unwrap_err().exit_code(), 2);
+    let (a, c) = (blend(Method::Structured), blend(Method::ClarabelAuxiliary));
+    assert_eq!(c.report.fit.formulation, toposmooth::solve::Formulation::Factored);
+    let worst = a.output.iter().zip(&c.output).map(|(p, q)| (p - q).abs()).fold(0.0, f64::max);
+    assert!(worst < 1e-4, "blend outputs differ by {worst}");
 }
 
 /// The measurement behind docs/grids.md section 5 (representatives on 400 random grids):
@@ -208,7 +215,8 @@ fn appendix_formulation_reaches_the_same_optimum() {
 fn representatives_on_random_grids() {
     use toposmooth::pipeline::RepresentativeChoice;
     let mut summed = Vec::new();
-    for choice in [RepresentativeChoice::Separatrix, RepresentativeChoice::Flooded] {
+    // the automatic choice (separatrix, with fallbacks) and the flooded one asked for
+    for choice in [None, Some(RepresentativeChoice::Flooded)] {
         let (mut rms, mut iterations) = (0.0, 0u64);
         let mut kinds = std::collections::BTreeMap::new();
         for seed in 0..400u64 {
@@ -236,7 +244,7 @@ fn representatives_on_random_grids() {
             *kinds.entry(out.report.representative.split(' ').next().unwrap().to_string()).or_insert(0) += 1;
         }
         eprintln!("{choice:?}: {kinds:?}, summed RMS {rms:.1}, {iterations} iterations");
-        if choice == RepresentativeChoice::Separatrix {
+        if choice.is_none() {
             assert!(kinds.get("separatrix").copied().unwrap_or(0) >= 330, "{kinds:?}");
         } else {
             assert_eq!(kinds.get("flooded"), Some(&400), "{kinds:?}");

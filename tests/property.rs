@@ -84,7 +84,7 @@ proptest! {
         all_edges in any::<bool>(),
         seed in 0u64..1000,
         data_weight in prop_oneof![Just(0.0), Just(1.0), Just(100.0)],
-        smooth_length in prop_oneof![Just(0.001), Just(0.01), Just(0.2)],
+        smooth_length in prop_oneof![Just(None), Just(Some(0.001)), Just(Some(0.01)), Just(Some(0.2))],
     ) {
         let series = coordinates(h.len(), seed);
         let constant = h.iter().all(|&v| v == h[0]);
@@ -174,7 +174,7 @@ mod grids {
             };
             let settings = SmoothSettings {
                 selection,
-                representative: if harmonic { RepresentativeChoice::Harmonic } else { RepresentativeChoice::Separatrix },
+                representative: harmonic.then_some(RepresentativeChoice::Harmonic),
                 edges: if all_edges { EdgeSet::All } else { EdgeSet::Minimal },
                 ..Default::default()
             };
@@ -190,6 +190,11 @@ mod grids {
                             prop_assert_eq!(out.output[v].to_bits(), hv.to_bits());
                         }
                     }
+                }
+                // an explicit harmonic representative is built or refused: exit 3 when the
+                // data cannot follow its order, 1 when it fails its own check (a flat fill)
+                Err(e) if harmonic && e.exit_code() == 1 => {
+                    prop_assert!(e.to_string().contains("harmonic representative"), "{}", e)
                 }
                 Err(e) => prop_assert_eq!(e.exit_code(), 3, "{}", e),
             }

@@ -261,8 +261,11 @@ fn one_function<D: Smoothable>(
                 fixed,
                 edges: &edges,
                 margin: eps,
+                bounds: &[],
+                data: None,
                 hint: Some(&out.u),
-                factored: None,
+                factor: None,
+                condition: None,
             };
             let sol = solve_monotone_qp(&qp, &settings.qp)?;
             let mut f = sol.x;

@@ -30,7 +30,7 @@ pub struct BenchArgs {
     /// QP solver.
     pub method: Method,
     /// Representative function on grids and meshes.
-    pub representative: RepresentativeChoice,
+    pub representative: Option<RepresentativeChoice>,
 }
 
 /// Uniform numbers in [0, 1) from a seed (splitmix64).
@@ -236,14 +236,16 @@ pub fn bench(args: &BenchArgs) -> Result<String> {
                     Method::Structured => "structured",
                 },
             ])
-            .args([
-                "--representative",
-                match args.representative {
-                    RepresentativeChoice::Separatrix => "separatrix",
-                    RepresentativeChoice::Harmonic => "harmonic",
-                    RepresentativeChoice::Flooded => "flooded",
-                },
-            ])
+            .args(args.representative.iter().flat_map(|r| {
+                [
+                    "--representative",
+                    match r {
+                        RepresentativeChoice::Separatrix => "separatrix",
+                        RepresentativeChoice::Harmonic => "harmonic",
+                        RepresentativeChoice::Flooded => "flooded",
+                    },
+                ]
+            }))
             .output()
             .map_err(|source| Error::Io { path: exe.clone(), source })?;
         if !child.status.success() {

@@ -207,16 +207,19 @@ fn smooth_series(args: &SmoothArgs, input: &Path, data: SeriesCsv, start: Instan
 /// The certificate, deviation and solver lines of `smooth`'s summary (series and grids).
 pub(super) fn fit_and_solver_lines(r: &Report) -> String {
     format!(
-        "{}; RMS deviation {}, max deviation {}\nsolver {:?} {:?} in {} iterations{}, {} constraints, margin {:.3e}; repair changed {} vertices\n",
+        "{}; RMS deviation {}, max deviation {}\n{}\nsolver {:?} {:?} in {} iterations{}, {} constraints, margin {:.3e}; margin met exactly by moving {} vertices (at most {:.1e}); strictness repair changed {} vertices\n",
         r.certificate.summary(),
         sig6(r.rms_deviation),
         sig6(r.max_deviation),
+        r.fit.summary(),
         r.solver,
         r.solver_status,
         r.solver_iterations,
         r.solver_fallback.as_ref().map(|w| format!(" (structured solver gave up: {w})")).unwrap_or_default(),
         r.constraints,
         r.settings.margin[0],
+        r.margin_repair.changed_vertices,
+        r.margin_repair.max_change,
         r.repair.changed_vertices
     )
 }

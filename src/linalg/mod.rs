@@ -653,6 +653,31 @@ pub fn analyse(a: SymbolicSparseColMatRef<'_, usize>) -> Result<Analysis, String
     })
 }
 
+/// The cheaper of AMD and nested dissection for one simplicial factorisation of `a` (never
+/// supernodal, whose dense kernels faer provides for native floats only, nor the two-way
+/// split): for factorisations in double-double arithmetic.
+///
+/// # Errors
+/// A message if faer's analysis fails.
+pub fn analyse_simplicial(a: SymbolicSparseColMatRef<'_, usize>) -> Result<SymbolicCholesky<usize>, String> {
+    let n = a.ncols();
+    let params = |_| CholeskySymbolicParams {
+        supernodal_flop_ratio_threshold: faer::sparse::linalg::SupernodalThreshold::FORCE_SIMPLICIAL,
+        ..Default::default()
+    };
+    let amd = factorize_symbolic_cholesky(a, Side::Upper, SymmetricOrdering::Amd, params(n))
+        .map_err(|e| format!("symbolic Cholesky: {e:?}"))?;
+    if n < ND_MIN_N {
+        return Ok(amd);
+    }
+    let (perm, _) = dissection(&Graph::from_pattern(a), ND_LEAF, false);
+    let inv = inverse(&perm);
+    let p = PermRef::new_checked(&perm, &inv, n);
+    let nd = factorize_symbolic_cholesky(a, Side::Upper, SymmetricOrdering::Custom(p), params(n))
+        .map_err(|e| format!("symbolic Cholesky: {e:?}"))?;
+    Ok(if factor_flops(&nd) < factor_flops(&amd) { nd } else { amd })
+}
+
 /// Numeric storage for one [`Analysis`].
 enum Numeric {
     Single { l: Vec<f64>, mem: MemBuffer },

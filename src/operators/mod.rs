@@ -26,8 +26,8 @@ mod sparse;
 pub use cotan::{
     cotan_stiffness, grid_mass, grid_stiffness, lumped_mass, negative_cotan_edges, positive_cotan_stiffness,
 };
-pub use gradient::gradient_operator;
+pub use gradient::{gradient_factor, gradient_operator};
 pub use harmonic::{dirichlet_solve, Dirichlet};
-pub use polyharmonic::{polyharmonic, Energy};
+pub use polyharmonic::{edge_factor, polyharmonic, polyharmonic_factor, Energy};
 pub use series::{series_mass, series_stiffness};
 pub use sparse::{plus_diagonal, quadratic_form, quadratic_form_without_diagonal, scaled_plus_diagonal, Sparse};

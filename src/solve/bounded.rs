@@ -89,7 +89,7 @@ pub fn solve_bounded_partition(
     let pm = CscMatrix::new_from_triplets(nvar, nvar, pi, pj, pv);
     let am = CscMatrix::new_from_triplets(b.len(), nvar, ar, ac, av);
     let cones = [ZeroConeT(eq), NonnegativeConeT(2 * nvar)];
-    let (x, status, it) = run(&pm, &q, &am, &b, &cones, settings)?;
+    let (x, _, status, it) = run(&pm, &q, &am, &b, &cones, settings)?;
     for h in 0..hs {
         for v in 0..n {
             if slot[h][v] != usize::MAX {

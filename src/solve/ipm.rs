@@ -10,19 +10,19 @@
 //! `(n + m) × (n + m)` KKT system. Starting from the representative u (feasible for every
 //! row) the iteration count stays low. Whatever it returns, the certificate decides.
 
-use super::qp::{QpSettings, ReducedQp, SolveStatus};
+use super::qp::{Outcome, QpSettings, ReducedQp, SolveStatus};
 use crate::linalg as ordering;
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMat, SymbolicSparseColMatRef};
 
 /// Upper-triangular pattern of `N` and where each contribution lands in its value array.
-struct Normal {
-    symbolic: SymbolicSparseColMat<usize>,
+pub(super) struct Normal {
+    pub(super) symbolic: SymbolicSparseColMat<usize>,
     /// Position of each P triplet.
-    pos_p: Vec<usize>,
+    pub(super) pos_p: Vec<usize>,
     /// Per row: positions of (c1,c1), (c2,c2), (c1,c2) (the last two unused for one-entry rows).
-    pos_row: Vec<[usize; 3]>,
+    pub(super) pos_row: Vec<[usize; 3]>,
     /// Position of each diagonal entry.
-    pos_diag: Vec<usize>,
+    pub(super) pos_diag: Vec<usize>,
 }
 
 /// Upper-triangular pattern, every diagonal entry included, of the pairs `(i, j)` with
@@ -49,7 +49,7 @@ fn upper_pattern(n: usize, pairs: impl Iterator<Item = (usize, usize)> + Clone) 
 }
 
 impl Normal {
-    fn new(r: &ReducedQp, row_cols: &[[usize; 2]], row_len: &[u8]) -> Normal {
+    pub(super) fn new(r: &ReducedQp, row_cols: &[[usize; 2]], row_len: &[u8]) -> Normal {
         let n = r.n;
         let rows = row_cols.iter().zip(row_len).filter(|(_, &l)| l == 2).map(|(c, _)| (c[0].min(c[1]), c[0].max(c[1])));
         let (col_ptr, row_idx) = upper_pattern(n, r.p.iter().map(|&(i, j, _)| (i, j)).chain(rows));
@@ -145,81 +145,144 @@ thread_local! {
         const { std::cell::RefCell::new(None) };
 }
 
-/// Solves the reduced QP; `Err(reason)` when it cannot (the caller falls back to Clarabel).
-pub fn solve(
-    r: &ReducedQp,
-    hint: Option<&[f64]>,
-    settings: &QpSettings,
-) -> Result<(Vec<f64>, SolveStatus, u32), String> {
-    let (n, m) = (r.n, r.m());
-    // the storage made in advance is this solve's or nobody's: not kept past an early return
-    let spare = SPARE.with(|c| c.borrow_mut().take());
-    // rows as (columns, values, length)
-    let mut row_cols = vec![[0usize; 2]; m];
-    let mut row_vals = vec![[0.0f64; 2]; m];
-    let mut row_len = vec![0u8; m];
-    for k in 0..r.a_row.len() {
-        let row = r.a_row[k];
-        let l = row_len[row] as usize;
-        if l >= 2 {
-            return Err(format!("row {row} has more than two entries"));
-        }
-        row_cols[row][l] = r.a_col[k];
-        row_vals[row][l] = r.a_val[k];
-        row_len[row] += 1;
+/// The arithmetic of an interior-point run: `f64`, or double-double (`fx128`) for the factored
+/// form of an ill-conditioned QP, where every residual and right-hand side must keep the digits
+/// that `P`'s condition number takes from the solve.
+pub(super) trait Real:
+    Copy
+    + PartialOrd
+    + std::ops::Add<Output = Self>
+    + std::ops::Sub<Output = Self>
+    + std::ops::Mul<Output = Self>
+    + std::ops::Div<Output = Self>
+    + std::ops::Neg<Output = Self>
+    + std::ops::AddAssign
+{
+    fn of(x: f64) -> Self;
+    fn to_f64(self) -> f64;
+}
+
+impl Real for f64 {
+    fn of(x: f64) -> Self {
+        x
     }
-    let ax = |x: &[f64], out: &mut [f64]| {
-        for k in 0..m {
-            let mut s = row_vals[k][0] * x[row_cols[k][0]];
-            if row_len[k] == 2 {
-                s += row_vals[k][1] * x[row_cols[k][1]];
+    fn to_f64(self) -> f64 {
+        self
+    }
+}
+
+impl Real for faer::fx128 {
+    fn of(x: f64) -> Self {
+        faer::fx128::from(x)
+    }
+    fn to_f64(self) -> f64 {
+        self.0 + self.1
+    }
+}
+
+fn max<T: Real>(a: T, b: T) -> T {
+    if b > a {
+        b
+    } else {
+        a
+    }
+}
+
+/// The constraint rows of a reduced QP: one or two entries each.
+pub(super) struct Rows {
+    pub(super) cols: Vec<[usize; 2]>,
+    pub(super) vals: Vec<[f64; 2]>,
+    pub(super) len: Vec<u8>,
+}
+
+impl Rows {
+    fn new(r: &ReducedQp) -> Result<Rows, String> {
+        let m = r.m();
+        let mut rows = Rows { cols: vec![[0; 2]; m], vals: vec![[0.0; 2]; m], len: vec![0; m] };
+        for k in 0..r.a_row.len() {
+            let row = r.a_row[k];
+            let l = rows.len[row] as usize;
+            if l >= 2 {
+                return Err(format!("row {row} has more than two entries"));
             }
-            out[k] = s;
+            rows.cols[row][l] = r.a_col[k];
+            rows.vals[row][l] = r.a_val[k];
+            rows.len[row] += 1;
         }
-    };
-    let atz = |z: &[f64], out: &mut [f64]| {
-        out.iter_mut().for_each(|v| *v = 0.0);
-        for k in 0..m {
-            out[row_cols[k][0]] += row_vals[k][0] * z[k];
-            if row_len[k] == 2 {
-                out[row_cols[k][1]] += row_vals[k][1] * z[k];
+        Ok(rows)
+    }
+
+    /// `out = A x`.
+    fn ax<T: Real>(&self, x: &[T], out: &mut [T]) {
+        for (k, o) in out.iter_mut().enumerate() {
+            let [c0, c1] = self.cols[k];
+            let [v0, v1] = self.vals[k];
+            *o = if self.len[k] == 2 { T::of(v0) * x[c0] + T::of(v1) * x[c1] } else { T::of(v0) * x[c0] };
+        }
+    }
+
+    /// `out = Aᵀ z`.
+    fn atz<T: Real>(&self, z: &[T], out: &mut [T]) {
+        out.iter_mut().for_each(|v| *v = T::of(0.0));
+        for (k, &zk) in z.iter().enumerate() {
+            let [c0, c1] = self.cols[k];
+            let [v0, v1] = self.vals[k];
+            out[c0] += T::of(v0) * zk;
+            if self.len[k] == 2 {
+                out[c1] += T::of(v1) * zk;
             }
         }
-    };
-    let px = |x: &[f64], out: &mut [f64]| {
-        out.iter_mut().for_each(|v| *v = 0.0);
-        for &(i, j, v) in &r.p {
+    }
+}
+
+/// The objective's part of the Newton system: its gradient at the iterate and the
+/// factorisation of `P + AᵀWA`.
+pub(super) trait Objective<T: Real> {
+    /// `out = ∇φ(x)`.
+    fn gradient(&mut self, x: &[T], out: &mut [T]);
+    /// Factorises `P + Aᵀ diag(w) A`.
+    fn factor(&mut self, rows: &Rows, w: &[T]) -> Result<(), String>;
+    /// Overwrites `rhs` with the last factorised matrix's inverse times it.
+    fn solve_in_place(&mut self, rhs: &mut [T]);
+    /// The auxiliary variables `t = F x + g` (factored form), rounded.
+    fn auxiliary(&self, x: &[T]) -> Option<Vec<f64>>;
+}
+
+/// `P` assembled; normal equations in double precision.
+struct Assembled<'r> {
+    r: &'r ReducedQp,
+    normal: Normal,
+    spd: ordering::SpdFactor,
+    vals: Vec<f64>,
+}
+
+impl Objective<f64> for Assembled<'_> {
+    fn gradient(&mut self, x: &[f64], out: &mut [f64]) {
+        out.iter_mut().zip(&self.r.q).for_each(|(o, q)| *o = *q);
+        for &(i, j, v) in &self.r.p {
             out[i] += v * x[j];
             if i != j {
                 out[j] += v * x[i];
             }
         }
-    };
+    }
 
-    let normal = Normal::new(r, &row_cols, &row_len);
-    let analysis =
-        ordering::cached_symbolic(&LAST, normal.symbolic.as_ref(), || ordering::analyse(normal.symbolic.as_ref()))?;
-    let spare = spare.filter(|(a, _)| std::rc::Rc::ptr_eq(a, &analysis));
-    let spd = std::cell::RefCell::new(match spare {
-        Some((_, workspace)) => ordering::SpdFactor::with_workspace(analysis, workspace),
-        None => ordering::SpdFactor::new(analysis)?,
-    });
-    let nnz = normal.symbolic.row_idx().len();
-    let mut vals = vec![0.0f64; nnz];
-    let factor = |w: &[f64], vals: &mut [f64]| -> Result<(), String> {
+    /// With a growing diagonal shift if the matrix is not numerically positive definite.
+    fn factor(&mut self, rows: &Rows, w: &[f64]) -> Result<(), String> {
+        let (normal, vals) = (&self.normal, &mut self.vals);
         let mut reg = 0.0;
         for attempt in 0..4 {
             vals.iter_mut().for_each(|v| *v = 0.0);
-            for (k, &(_, _, v)) in r.p.iter().enumerate() {
+            for (k, &(_, _, v)) in self.r.p.iter().enumerate() {
                 vals[normal.pos_p[k]] += v;
             }
-            for k in 0..m {
+            for (k, &wk) in w.iter().enumerate() {
                 let [p1, p2, p12] = normal.pos_row[k];
-                let [a1, a2] = row_vals[k];
-                vals[p1] += w[k] * a1 * a1;
-                if row_len[k] == 2 {
-                    vals[p2] += w[k] * a2 * a2;
-                    vals[p12] += w[k] * a1 * a2;
+                let [a1, a2] = rows.vals[k];
+                vals[p1] += wk * a1 * a1;
+                if rows.len[k] == 2 {
+                    vals[p2] += wk * a2 * a2;
+                    vals[p12] += wk * a1 * a2;
                 }
             }
             if reg > 0.0 {
@@ -228,100 +291,223 @@ pub fn solve(
                 }
             }
             let mat = SparseColMatRef::new(normal.symbolic.as_ref(), vals);
-            match spd.borrow_mut().factor(mat) {
+            match self.spd.factor(mat) {
                 Ok(()) => return Ok(()),
                 Err(_) => reg = if attempt == 0 { 1e-12 } else { reg * 1e3 },
             }
         }
         Err("the normal matrix is not positive definite".into())
-    };
-    let solve_with = |rhs: &mut [f64]| {
-        spd.borrow_mut().solve_in_place(rhs);
-    };
+    }
 
-    let mut x: Vec<f64> = hint.map(|h| h.to_vec()).unwrap_or_else(|| vec![0.0; n]);
+    fn solve_in_place(&mut self, rhs: &mut [f64]) {
+        self.spd.solve_in_place(rhs);
+    }
+
+    fn auxiliary(&self, _: &[f64]) -> Option<Vec<f64>> {
+        None
+    }
+}
+
+/// The largest relative change of the iterate in one step at which the solver may stop (the
+/// values are scaled to [0, 1]: 1e-5 of the range, ten default margins).
+const STEP_TOLERANCE: f64 = 1e-5;
+/// Iterations without a halving of the best gap bound after which the solver stops with
+/// what it has (the bound has reached its rounding floor).
+const STALL_ITERATIONS: u32 = 8;
+
+/// Solves the reduced QP; `Err(reason)` when it cannot (the caller falls back to Clarabel).
+///
+/// Stops when the rows are met to `settings.tolerance`, the last step moved no value by more
+/// than [`STEP_TOLERANCE`], and — with a data term — the gap bound
+/// `Ĝ = Σ max(s, 0) z + ½ Σ ρ²/d` (s = b − Ax, ρ = ∇φ + Aᵀz, d the data diagonal: P ⪰
+/// diag(d)) is below `settings.gap_tolerance` × the data term; without one, when the mean
+/// complementarity is 10× below the feasibility tolerance. The factored form runs in
+/// double-double throughout.
+pub(super) fn solve(r: &ReducedQp, hint: Option<&[f64]>, settings: &QpSettings) -> Result<Outcome, String> {
+    // the storage made in advance is this solve's or nobody's: not kept past an early return
+    let spare = SPARE.with(|c| c.borrow_mut().take());
+    let rows = Rows::new(r)?;
+    match &r.factor {
+        Some(factor) => {
+            drop(spare);
+            let mut objective = super::factored::Normal::new(r, factor, &rows.cols, &rows.len)?;
+            run::<faer::fx128, _>(r, &rows, &mut objective, hint, settings)
+        }
+        None => {
+            let normal = Normal::new(r, &rows.cols, &rows.len);
+            let analysis = ordering::cached_symbolic(&LAST, normal.symbolic.as_ref(), || {
+                ordering::analyse(normal.symbolic.as_ref())
+            })?;
+            let spare = spare.filter(|(a, _)| std::rc::Rc::ptr_eq(a, &analysis));
+            let spd = match spare {
+                Some((_, workspace)) => ordering::SpdFactor::with_workspace(analysis, workspace),
+                None => ordering::SpdFactor::new(analysis)?,
+            };
+            let vals = vec![0.0f64; normal.symbolic.row_idx().len()];
+            let mut objective = Assembled { r, normal, spd, vals };
+            run::<f64, _>(r, &rows, &mut objective, hint, settings)
+        }
+    }
+}
+
+/// The interior-point iteration in arithmetic `T`.
+fn run<T: Real, O: Objective<T>>(
+    r: &ReducedQp,
+    rows: &Rows,
+    objective: &mut O,
+    hint: Option<&[f64]>,
+    settings: &QpSettings,
+) -> Result<Outcome, String> {
+    let (n, m) = (r.n, r.m());
+    let zero = T::of(0.0);
+    let of = T::of;
+    let b: Vec<T> = r.b.iter().map(|&v| of(v)).collect();
+    let mut x: Vec<T> = match hint {
+        Some(h) => h.iter().map(|&v| of(v)).collect(),
+        None => vec![zero; n],
+    };
+    let finish = |x: &[T], z: &[T], status: SolveStatus, iterations: u32, objective: &O| Outcome {
+        x: x.iter().map(|v| v.to_f64()).collect(),
+        z: z.iter().map(|v| v.to_f64()).collect(),
+        y: objective.auxiliary(x),
+        status,
+        iterations,
+    };
     if m == 0 {
-        factor(&[], &mut vals)?;
-        let mut rhs: Vec<f64> = r.q.iter().map(|v| -v).collect();
-        solve_with(&mut rhs);
-        return Ok((rhs, SolveStatus::Solved, 1));
+        objective.factor(rows, &[])?;
+        let mut rhs = vec![zero; n];
+        objective.gradient(&x, &mut rhs);
+        rhs.iter_mut().for_each(|v| *v = -*v);
+        objective.solve_in_place(&mut rhs);
+        for i in 0..n {
+            x[i] += rhs[i];
+        }
+        return Ok(finish(&x, &[], SolveStatus::Solved, 1, objective));
     }
     // starting point: slacks of x (shifted to be positive), multipliers below, then balanced
-    let mut s = vec![0.0; m];
-    ax(&x, &mut s);
-    for (sk, bk) in s.iter_mut().zip(&r.b) {
-        *sk = bk - *sk;
+    let mut s = vec![zero; m];
+    rows.ax(&x, &mut s);
+    for (sk, bk) in s.iter_mut().zip(&b) {
+        *sk = *bk - *sk;
     }
     // multipliers at the scale of the objective's gradient at the start, which they must
     // balance (each row of A has entries ±1): 3 × mean |P x + q|. Against unit multipliers
     // this cut the iterations from 14 to 7 (mountain distance), 27 to 15 (Kármán vorticity),
     // 15 to 11 (300² noisy grid).
-    let mut g = vec![0.0; n];
-    px(&x, &mut g);
-    let gmean = g.iter().zip(&r.q).map(|(a, b)| (a + b).abs()).sum::<f64>() / n.max(1) as f64;
+    let mut g = vec![zero; n];
+    objective.gradient(&x, &mut g);
+    let gmean = g.iter().map(|a| a.to_f64().abs()).sum::<f64>() / n.max(1) as f64;
     let z0 = (3.0 * gmean).max(1e-12);
-    let mut z = vec![z0; m];
-    let smin = s.iter().cloned().fold(f64::INFINITY, f64::min);
+    let mut z = vec![of(z0); m];
+    let smin = s.iter().map(|v| v.to_f64()).fold(f64::INFINITY, f64::min);
     if smin <= 0.0 {
-        s.iter_mut().for_each(|v| *v += -1.5 * smin + 1e-3);
+        s.iter_mut().for_each(|v| *v += of(-1.5 * smin + 1e-3));
     }
-    let sz: f64 = s.iter().zip(&z).map(|(a, b)| a * b).sum();
-    let (ssum, zsum): (f64, f64) = (s.iter().sum(), z.iter().sum());
-    s.iter_mut().for_each(|v| *v += 0.5 * sz / zsum);
-    z.iter_mut().for_each(|v| *v += 0.5 * sz / ssum);
+    let sz: f64 = s.iter().zip(&z).map(|(a, b)| (*a * *b).to_f64()).sum();
+    let (ssum, zsum): (f64, f64) = (s.iter().map(|v| v.to_f64()).sum(), z.iter().map(|v| v.to_f64()).sum());
+    s.iter_mut().for_each(|v| *v += of(0.5 * sz / zsum));
+    z.iter_mut().for_each(|v| *v += of(0.5 * sz / ssum));
 
     let bnorm = 1.0 + r.b.iter().fold(0.0f64, |a, v| a.max(v.abs()));
     let qnorm = 1.0 + r.q.iter().fold(0.0f64, |a, v| a.max(v.abs()));
     let tol = settings.tolerance;
-    // The mean complementarity must fall 10× below the feasibility tolerance: the objective is
-    // flat along many directions, and with the correctors μ ≤ tol was reached while the gap
-    // sᵀz was still 5× larger than without them (Kármán street, 5 %: energy 583.876 against
-    // Clarabel's 583.532, 583.603 before the correctors; now 583.570 in 13 iterations, 15
-    // before).
+    // without a data term: the mean complementarity 10× below the feasibility tolerance (the
+    // objective is flat along many directions; with the correctors μ ≤ tol was reached while
+    // sᵀz was still 5× larger than without them)
     let tol_mu = 0.1 * tol;
-    let (mut rd, mut rp, mut tmp_n, mut tmp_m) = (vec![0.0; n], vec![0.0; m], vec![0.0; n], vec![0.0; m]);
-    let (mut dx, mut ds, mut dz, mut rc) = (vec![0.0; n], vec![0.0; m], vec![0.0; m], vec![0.0; m]);
-    let (mut dx2, mut ds2, mut dz2, mut rc2) = (vec![0.0; n], vec![0.0; m], vec![0.0; m], vec![0.0; m]);
-    let mut w = vec![0.0; m];
-    let step =
-        |v: &[f64], d: &[f64]| v.iter().zip(d).fold(1.0f64, |a, (&v, &d)| if d < 0.0 { a.min(-v / d) } else { a });
+    let has_data = r.gap_bound;
+    let d: Vec<T> = r.d.iter().map(|&v| of(v)).collect();
+    let q_free: Vec<T> = r.q_free.iter().map(|&v| of(v)).collect();
+    let d_sum: f64 = r.d.iter().sum();
+    let (mut rd, mut rp, mut tmp_n, mut tmp_m) = (vec![zero; n], vec![zero; m], vec![zero; n], vec![zero; m]);
+    let (mut dx, mut ds, mut dz, mut rc) = (vec![zero; n], vec![zero; m], vec![zero; m], vec![zero; m]);
+    let (mut dx2, mut ds2, mut dz2, mut rc2) = (vec![zero; n], vec![zero; m], vec![zero; m], vec![zero; m]);
+    let mut slack = vec![zero; m];
+    let mut w = vec![zero; m];
+    let step = |v: &[T], d: &[T]| {
+        v.iter().zip(d).fold(1.0f64, |a, (&v, &d)| if d < zero { a.min((-v / d).to_f64()) } else { a })
+    };
     let mut last = (f64::INFINITY, f64::INFINITY, f64::INFINITY);
+    let mut last_step = f64::INFINITY;
+    let (mut best_gap, mut best_at) = (f64::INFINITY, 0u32);
+    // the outcome if the next factorisation fails: the point reached, when it already meets
+    // the targets except for the step (z/s beyond 10¹⁶ × the data diagonal cancels in double
+    // precision once the gap is tiny)
+    let mut fallback_status: Option<SolveStatus>;
     for it in 0..settings.max_iter {
         // residuals
-        px(&x, &mut rd);
-        atz(&z, &mut tmp_n);
+        objective.gradient(&x, &mut rd);
+        rows.atz(&z, &mut tmp_n);
         for i in 0..n {
-            rd[i] += r.q[i] + tmp_n[i];
+            rd[i] += tmp_n[i];
         }
-        ax(&x, &mut rp);
+        rows.ax(&x, &mut slack);
         for k in 0..m {
-            rp[k] += s[k] - r.b[k];
+            rp[k] = slack[k] + s[k] - b[k];
+            slack[k] = b[k] - slack[k];
         }
-        let mu = s.iter().zip(&z).map(|(a, b)| a * b).sum::<f64>() / m as f64;
-        let pres = rp.iter().fold(0.0f64, |a, v| a.max(v.abs())) / bnorm;
-        let dres = rd.iter().fold(0.0f64, |a, v| a.max(v.abs())) / qnorm;
+        let mu_t = s.iter().zip(&z).fold(zero, |a, (&s, &z)| a + s * z) / of(m as f64);
+        let mu = mu_t.to_f64();
+        let pres = rp.iter().fold(0.0f64, |a, v| a.max(v.to_f64().abs())) / bnorm;
+        let dres = rd.iter().fold(0.0f64, |a, v| a.max(v.to_f64().abs())) / qnorm;
         last = (pres, dres, mu);
         if !(pres.is_finite() && dres.is_finite() && mu.is_finite()) {
             return Err(format!("non-finite iterate at iteration {it}"));
         }
-        if pres <= tol && dres <= tol && mu <= tol_mu {
-            return Ok((x, SolveStatus::Solved, it));
+        let xmax = x.iter().fold(0.0f64, |a, v| a.max(v.to_f64().abs()));
+        let small_step = last_step <= STEP_TOLERANCE * (1.0 + xmax);
+        if has_data {
+            let comp = slack.iter().zip(&z).fold(zero, |a, (&s, &z)| a + max(s, zero) * z);
+            let stat = rd.iter().zip(&d).fold(zero, |a, (&g, &d)| a + g * g / d);
+            let gap = (comp + of(0.5) * stat).to_f64();
+            let data = (0..n).fold(zero, |a, i| {
+                let e = d[i] * x[i] + q_free[i];
+                a + e * e / d[i]
+            });
+            let data = (0.5 * data.to_f64()).max(1e-20 * d_sum);
+            if pres <= tol && small_step && gap <= settings.gap_tolerance * data {
+                return Ok(finish(&x, &z, SolveStatus::Solved, it, objective));
+            }
+            fallback_status = if pres > tol {
+                None
+            } else if gap <= settings.gap_tolerance * data {
+                Some(SolveStatus::Solved)
+            } else if gap <= 1e2 * settings.gap_tolerance * data {
+                Some(SolveStatus::AlmostSolved)
+            } else {
+                None
+            };
+            if gap < 0.5 * best_gap {
+                (best_gap, best_at) = (gap, it);
+            } else if pres <= tol && it >= best_at + STALL_ITERATIONS && gap <= 1e2 * settings.gap_tolerance * data {
+                // the bound has reached its rounding floor, within 100× the target
+                return Ok(finish(&x, &z, SolveStatus::AlmostSolved, it, objective));
+            }
+        } else if pres <= tol && dres <= tol && mu <= tol_mu {
+            return Ok(finish(&x, &z, SolveStatus::Solved, it, objective));
+        } else {
+            fallback_status = None;
         }
         for k in 0..m {
             w[k] = z[k] / s[k];
         }
-        factor(&w, &mut vals)?;
+        if let Err(e) = objective.factor(rows, &w) {
+            return match fallback_status {
+                Some(status) => Ok(finish(&x, &z, status, it, objective)),
+                None => Err(e),
+            };
+        }
         // one Newton direction for complementarity target rc (s∘z − rc → 0)
-        let mut direction = |rc: &[f64], dx: &mut Vec<f64>, ds: &mut Vec<f64>, dz: &mut Vec<f64>| {
+        let mut direction = |rc: &[T], dx: &mut Vec<T>, ds: &mut Vec<T>, dz: &mut Vec<T>| {
             for k in 0..m {
                 tmp_m[k] = w[k] * rp[k] - rc[k] / s[k];
             }
-            atz(&tmp_m, dx);
+            rows.atz(&tmp_m, dx);
             for i in 0..n {
                 dx[i] = -rd[i] - dx[i];
             }
-            solve_with(dx);
-            ax(dx, ds);
+            objective.solve_in_place(dx);
+            rows.ax(dx, ds);
             for k in 0..m {
                 let adx = ds[k];
                 dz[k] = w[k] * (adx + rp[k]) - rc[k] / s[k];
@@ -334,31 +520,33 @@ pub fn solve(
         }
         direction(&rc, &mut dx, &mut ds, &mut dz);
         let alpha_aff = step(&s, &ds).min(step(&z, &dz)).min(1.0);
-        let mu_aff = (0..m).map(|k| (s[k] + alpha_aff * ds[k]) * (z[k] + alpha_aff * dz[k])).sum::<f64>() / m as f64;
+        let a_aff = of(alpha_aff);
+        let mu_aff = (0..m).fold(zero, |a, k| a + (s[k] + a_aff * ds[k]) * (z[k] + a_aff * dz[k])).to_f64() / m as f64;
         let sigma = (mu_aff / mu).powi(3).min(1.0);
+        let sigma_mu = of(sigma) * mu_t;
         // corrector
         for k in 0..m {
-            rc[k] = s[k] * z[k] + ds[k] * dz[k] - sigma * mu;
+            rc[k] = s[k] * z[k] + ds[k] * dz[k] - sigma_mu;
         }
         direction(&rc, &mut dx, &mut ds, &mut dz);
         let mut alpha_max = step(&s, &ds).min(step(&z, &dz));
         // Gondzio's multiple centrality correctors: aim at a longer step, push the
         // complementarity products of that trial point back into [0.1, 10] × σμ and keep the
         // corrected direction if its step grows. One solve each, no factorisation.
-        let (lo, hi) = (0.1 * sigma * mu, 10.0 * sigma * mu);
+        let (lo, hi) = (of(0.1) * sigma_mu, of(10.0) * sigma_mu);
         for _ in 0..CORRECTORS {
             if alpha_max >= 1.0 {
                 break;
             }
-            let trial = (alpha_max + CORRECTOR_STEP).min(1.0);
+            let trial = of((alpha_max + CORRECTOR_STEP).min(1.0));
             for k in 0..m {
                 let v = (s[k] + trial * ds[k]) * (z[k] + trial * dz[k]);
                 let t = if v < lo {
                     lo - v
                 } else if v > hi {
-                    (hi - v).max(-hi)
+                    max(hi - v, -hi)
                 } else {
-                    0.0
+                    zero
                 };
                 rc2[k] = rc[k] - t;
             }
@@ -378,17 +566,21 @@ pub fn solve(
         if alpha < 1e-12 {
             return Err(format!("step length {alpha:e} at iteration {it}"));
         }
+        let a = of(alpha);
+        last_step = 0.0;
         for i in 0..n {
-            x[i] += alpha * dx[i];
+            let dxi = a * dx[i];
+            last_step = last_step.max(dxi.to_f64().abs());
+            x[i] += dxi;
         }
         for k in 0..m {
-            s[k] += alpha * ds[k];
-            z[k] += alpha * dz[k];
+            s[k] += a * ds[k];
+            z[k] += a * dz[k];
         }
     }
     let (pres, dres, mu) = last;
-    if pres <= 1e3 * tol && dres <= 1e3 * tol && mu <= 1e3 * tol {
-        return Ok((x, SolveStatus::AlmostSolved, settings.max_iter));
+    if pres <= 1e3 * tol && (has_data || (dres <= 1e3 * tol && mu <= 1e3 * tol)) {
+        return Ok(finish(&x, &z, SolveStatus::AlmostSolved, settings.max_iter, objective));
     }
     Err(format!(
         "no convergence in {} iterations (primal {pres:.1e}, dual {dres:.1e}, gap {mu:.1e})",

@@ -6,11 +6,19 @@
 
 mod bounded;
 mod clarabel;
+mod condition;
+mod factored;
 mod ipm;
+mod optimality;
 mod qp;
 mod repair;
 
 pub use bounded::solve_bounded_partition;
+pub use condition::condition_estimate;
 pub use ipm::Prepared;
-pub use qp::{prepare, solve_monotone_qp, Method, MonotoneQp, QpSettings, QpSolution, ReducedQp, SolveStatus};
-pub use repair::{repair, RepairSummary};
+pub use optimality::{optimality, Optimality};
+pub use qp::{
+    constraint_rows, prepare, solve_monotone_qp, Bound, Formulation, Method, MonotoneQp, QpSettings, QpSolution,
+    ReducedQp, Row, SolveStatus, FACTORED_ABOVE,
+};
+pub use repair::{meet_margin, repair, MarginSummary, RepairSummary};

@@ -4,12 +4,23 @@ use super::ipm::Prepared;
 use crate::error::Result;
 use crate::operators::Sparse;
 
-/// The problem: `min ½ fᵀ P f + qᵀ f` s.t. `f_i = fixed_i` where given and
-/// `f_j − f_i ≥ margin` for every `(i, j)` in `edges`.
+/// A one-sided bound on one entry: `f_v ≤ value` (`upper`) or `f_v ≥ value`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Bound {
+    /// The entry.
+    pub vertex: usize,
+    /// The bound.
+    pub value: f64,
+    /// `f_v ≤ value` when true, `f_v ≥ value` when false.
+    pub upper: bool,
+}
+
+/// The problem: `min ½ fᵀ P f + qᵀ f` s.t. `f_i = fixed_i` where given,
+/// `f_j − f_i ≥ margin` for every `(i, j)` in `edges`, and the `bounds`.
 pub struct MonotoneQp<'a> {
     /// `#V × #V` symmetric positive semi-definite (positive definite on the free block).
     pub p: &'a Sparse,
-    /// Linear term, `#V`.
+    /// Linear term, `#V`. With `data`, `q = −diag(data)·c` for the data's target `c`.
     pub q: &'a [f64],
     /// Fixed values, `#V` (`None` = free).
     pub fixed: &'a [Option<f64>],
@@ -17,12 +28,21 @@ pub struct MonotoneQp<'a> {
     pub edges: &'a [(usize, usize)],
     /// ε > 0.
     pub margin: f64,
+    /// One-sided bounds on free entries (bounds on fixed entries are ignored).
+    pub bounds: &'a [Bound],
+    /// The data term's diagonal `d` (`#V`, ≥ 0): `P = Q + diag(d)` with `Q ⪰ 0`, so `P ⪰
+    /// diag(d)`. With `d > 0` at every free entry the optimality gap is bounded without a
+    /// solve ([`super::optimality`]) and the solver stops on it.
+    pub data: Option<&'a [f64]>,
     /// A point that satisfies every constraint (the representative u), `#V`, if known: the
     /// structured solver starts there.
     pub hint: Option<&'a [f64]>,
-    /// `P = FᵀF + diag(d)` as `(F, d)`, for [`Method::ClarabelAuxiliary`] (the paper's
-    /// appendix: auxiliary variables `t = F f` make the quadratic part the identity).
-    pub factored: Option<(&'a Sparse, &'a [f64])>,
+    /// `F` with `P = FᵀF + diag(data)` (`rows × #V`), for the factored formulation: the
+    /// paper's appendix, auxiliary variables `t = F f`, with the square root of `P`'s
+    /// condition number.
+    pub factor: Option<&'a Sparse>,
+    /// [`super::condition_estimate`] of this problem if already known (else estimated here).
+    pub condition: Option<f64>,
 }
 
 /// Which interior-point solver runs.
@@ -32,29 +52,62 @@ pub enum Method {
     /// The structured solver of [`super::ipm`] (normal equations, faer Cholesky with the
     /// symbolic analysis done once); Clarabel takes over if it does not converge.
     Structured,
-    /// Clarabel on the full KKT system.
+    /// Clarabel on the full KKT system, in the formulation the structured solver would use.
     Clarabel,
-    /// Clarabel on the paper's appendix formulation: variables `(f, t)` with `t = F f` as
-    /// equality constraints and `P = diag(d) ⊕ I` (needs [`MonotoneQp::factored`]).
+    /// Clarabel on the factored formulation whatever the conditioning (the paper's appendix:
+    /// variables `(f, t)` with `t = F f` as equality constraints; needs
+    /// [`MonotoneQp::factor`]).
     #[serde(rename = "clarabel-auxiliary")]
     ClarabelAuxiliary,
 }
+
+/// How the objective enters the solver.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Formulation {
+    /// Factored when `P`'s condition estimate exceeds [`FACTORED_ABOVE`] and a factor is
+    /// given, else assembled.
+    #[default]
+    Auto,
+    /// `P` as one matrix: normal equations in double precision.
+    Assembled,
+    /// `P = FᵀF + diag(d)`: the structured solver forms its normal matrix from `F` in
+    /// double-double arithmetic and keeps the iterate in it; Clarabel gets the auxiliary
+    /// variables `t = F f`.
+    Factored,
+}
+
+/// Condition estimate of `diag(d)^{-½} P diag(d)^{-½}` above which [`Formulation::Auto`]
+/// chooses the factored form: the assembled normal equations lose about
+/// `log10(κ) − 16 + 8` of the 8 digits the gap needs beyond the data term's.
+pub const FACTORED_ABOVE: f64 = 1e9;
 
 /// Solver settings.
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]
 pub struct QpSettings {
     /// Largest number of interior-point iterations. {200}
     pub max_iter: u32,
-    /// Feasibility tolerance on the scaled problem; the structured solver also needs the mean
-    /// complementarity 10× below it. {1e-9}
+    /// Feasibility tolerance on the scaled problem (values in [0, 1]). {1e-9}
     pub tolerance: f64,
+    /// The structured solver stops when the gap bound is below this fraction of the data
+    /// term (without a data term: of the objective's range, by the mean complementarity).
+    /// {1e-7}
+    pub gap_tolerance: f64,
     /// Solver. {structured}
     pub method: Method,
+    /// Formulation. {auto}
+    pub formulation: Formulation,
 }
 
 impl Default for QpSettings {
     fn default() -> Self {
-        QpSettings { max_iter: 200, tolerance: 1e-9, method: Method::Structured }
+        QpSettings {
+            max_iter: 200,
+            tolerance: 1e-9,
+            gap_tolerance: 1e-7,
+            method: Method::Structured,
+            formulation: Formulation::Auto,
+        }
     }
 }
 
@@ -78,14 +131,63 @@ pub enum SolveStatus {
 pub struct QpSolution {
     /// `#V` values.
     pub x: Vec<f64>,
+    /// Multipliers (≥ 0) of the constraint rows in [`constraint_rows`] order, in the units of
+    /// the problem as given.
+    pub z: Vec<f64>,
+    /// With the factored formulation: the auxiliary variables `t ≈ F f` (the equality rows'
+    /// multipliers), for the gap bound.
+    pub y: Option<Vec<f64>>,
     /// Solver outcome.
     pub status: SolveStatus,
     /// Interior-point iterations.
     pub iterations: u32,
     /// The solver that produced the point.
     pub method: Method,
+    /// The formulation used ([`Formulation::Assembled`] or [`Formulation::Factored`]).
+    pub formulation: Formulation,
+    /// Condition estimate of `diag(d)^{-½} P diag(d)^{-½}` on the free entries (with a data
+    /// term): `1 + λ_max(diag(d)⁻¹ Q)`, by power iteration.
+    pub condition: Option<f64>,
     /// Why the structured solver handed over to Clarabel, if it did.
     pub fallback: Option<String>,
+}
+
+/// One constraint row of a [`MonotoneQp`] (fixed values substituted when it is reduced).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Row {
+    /// `f_j − f_i ≥ margin`.
+    Pair(usize, usize),
+    /// `f_v ≥ value`.
+    Lower(usize, f64),
+    /// `f_v ≤ value`.
+    Upper(usize, f64),
+}
+
+/// The rows that constrain a free entry, in the order of the solver's multipliers: the
+/// edges with a free end, then the bounds of free entries.
+pub fn constraint_rows(qp: &MonotoneQp<'_>) -> Vec<Row> {
+    let free = |v: usize| qp.fixed[v].is_none();
+    qp.edges
+        .iter()
+        .filter(|&&(i, j)| free(i) || free(j))
+        .map(|&(i, j)| Row::Pair(i, j))
+        .chain(qp.bounds.iter().filter(|b| free(b.vertex)).map(|b| {
+            if b.upper {
+                Row::Upper(b.vertex, b.value)
+            } else {
+                Row::Lower(b.vertex, b.value)
+            }
+        }))
+        .collect()
+}
+
+/// The factored objective on the free variables: `½‖F x + g‖² + ½ xᵀ diag(d) x + q_dᵀ x`
+/// (`q_d` is [`ReducedQp::q_free`]), scaled like [`ReducedQp`].
+pub struct ReducedFactor {
+    /// `F` restricted to the free columns.
+    pub f: Sparse,
+    /// `F_X x_X`: the fixed columns' contribution.
+    pub g: Vec<f64>,
 }
 
 /// The QP on the free variables: `min ½ xᵀ P x + qᵀ x` s.t. `A x ≤ b`, objective scaled so
@@ -105,6 +207,17 @@ pub struct ReducedQp {
     pub a_val: Vec<f64>,
     /// Right-hand side, one per row.
     pub b: Vec<f64>,
+    /// The data diagonal on the free variables (zeros without a data term).
+    pub d: Vec<f64>,
+    /// `q` on the free variables without the fixed ones' coupling `P_FX x_X`: the data term's
+    /// linear part `−d ∘ c`, so that the data term is `½ Σ (d x + q_free)² / d` up to a
+    /// constant.
+    pub q_free: Vec<f64>,
+    /// Whether `d > 0` at every free variable: `P ⪰ diag(d)` then bounds the gap without a
+    /// solve.
+    pub gap_bound: bool,
+    /// The factored form, when the formulation is factored.
+    pub factor: Option<ReducedFactor>,
     /// The factor the objective was divided by.
     pub scale: f64,
 }
@@ -119,51 +232,86 @@ impl ReducedQp {
 /// Solves the monotone QP.
 ///
 /// # Errors
-/// [`crate::Error::NoSolution`] when no solver returns a usable point.
+/// [`crate::Error::NoSolution`] when no solver returns a usable point; a usage error for
+/// [`Method::ClarabelAuxiliary`] or [`Formulation::Factored`] without a factor.
 pub fn solve_monotone_qp(qp: &MonotoneQp<'_>, settings: &QpSettings) -> Result<QpSolution> {
     let n = qp.q.len();
     assert_eq!(qp.fixed.len(), n);
     assert_eq!(qp.p.nrows(), n);
     let free: Vec<usize> = (0..n).filter(|&i| qp.fixed[i].is_none()).collect();
     let mut x: Vec<f64> = qp.fixed.iter().map(|f| f.unwrap_or(0.0)).collect();
+    let rows = constraint_rows(qp);
     if free.is_empty() {
         super::ipm::forget_prepared_storage();
         return Ok(QpSolution {
             x,
+            z: vec![0.0; rows.len()],
+            y: None,
             status: SolveStatus::Trivial,
             iterations: 0,
             method: settings.method,
+            formulation: Formulation::Assembled,
+            condition: None,
             fallback: None,
         });
     }
-    let reduced = reduce(qp, &free);
+    let mut reduced = reduce(qp, &free);
+    let condition = qp.condition.or_else(|| super::condition::estimate(&reduced));
+    let wants_factored = match (settings.method, settings.formulation) {
+        (Method::ClarabelAuxiliary, _) | (_, Formulation::Factored) => true,
+        (_, Formulation::Assembled) => false,
+        (_, Formulation::Auto) => condition.is_some_and(|c| c > FACTORED_ABOVE),
+    };
+    let forced = settings.method == Method::ClarabelAuxiliary || settings.formulation == Formulation::Factored;
+    let formulation = match (wants_factored, qp.factor) {
+        (true, Some(f)) => {
+            reduced.factor = Some(reduce_factor(qp, f, &free, reduced.scale));
+            Formulation::Factored
+        }
+        (true, None) if forced => {
+            return Err(crate::Error::Usage(
+                "the factored formulation needs the energy as FᵀF (not available for this energy)".into(),
+            ))
+        }
+        _ => Formulation::Assembled,
+    };
+    if formulation == Formulation::Factored {
+        super::ipm::forget_prepared_storage();
+    }
     let hint: Option<Vec<f64>> = qp.hint.map(|h| free.iter().map(|&i| h[i]).collect());
     let mut fallback = None;
-    let (xf, status, iterations, method) = match settings.method {
+    let clarabel = |reduced: &ReducedQp| super::clarabel::solve(reduced, settings);
+    let (out, method) = match settings.method {
         Method::Structured => match super::ipm::solve(&reduced, hint.as_deref(), settings) {
-            Ok((xf, status, it)) => (xf, status, it, Method::Structured),
+            Ok(out) => (out, Method::Structured),
             Err(why) => {
                 fallback = Some(why);
-                let (xf, status, it) = super::clarabel::solve(&reduced, settings)?;
-                (xf, status, it, Method::Clarabel)
+                (clarabel(&reduced)?, Method::Clarabel)
             }
         },
-        Method::Clarabel => {
-            let (xf, status, it) = super::clarabel::solve(&reduced, settings)?;
-            (xf, status, it, Method::Clarabel)
-        }
-        Method::ClarabelAuxiliary => {
-            let Some((f, d)) = qp.factored else {
-                return Err(crate::Error::Usage("the auxiliary formulation needs P given as FᵀF + diag(d)".into()));
-            };
-            let (xf, status, it) = super::clarabel::solve_auxiliary(&reduced, f, d, qp, &free, settings)?;
-            (xf, status, it, Method::ClarabelAuxiliary)
-        }
+        Method::Clarabel | Method::ClarabelAuxiliary => (clarabel(&reduced)?, settings.method),
     };
     for (k, &i) in free.iter().enumerate() {
-        x[i] = xf[k];
+        x[i] = out.x[k];
     }
-    Ok(QpSolution { x, status, iterations, method, fallback })
+    // multipliers and auxiliary variables back in the problem's units
+    let z = out.z.iter().map(|v| v.max(0.0) * reduced.scale).collect();
+    let y = out.y.map(|y| y.iter().map(|v| v * reduced.scale.sqrt()).collect());
+    Ok(QpSolution { x, z, y, status: out.status, iterations: out.iterations, method, formulation, condition, fallback })
+}
+
+/// What a solver returns on a [`ReducedQp`].
+pub(super) struct Outcome {
+    /// The free variables.
+    pub x: Vec<f64>,
+    /// Multipliers of the rows.
+    pub z: Vec<f64>,
+    /// Auxiliary variables `t = F x + g` (factored formulation).
+    pub y: Option<Vec<f64>>,
+    /// How it ended.
+    pub status: SolveStatus,
+    /// Iterations.
+    pub iterations: u32,
 }
 
 /// The structured solver's analysis of the normal matrix of a QP with energy `p` and fixed
@@ -187,7 +335,7 @@ pub fn prepare(p: &Sparse, fixed: &[Option<f64>]) -> std::result::Result<Prepare
     Prepared::new(p.symbolic(), &slot, n)
 }
 
-/// Eliminates the fixed variables: `P_FF`, `q_F + P_FX x_X`, and one row per constrained edge.
+/// Eliminates the fixed variables: `P_FF`, `q_F + P_FX x_X`, one row per constraint row.
 fn reduce(qp: &MonotoneQp<'_>, free: &[usize]) -> ReducedQp {
     let n = qp.q.len();
     let mut slot = vec![usize::MAX; n];
@@ -214,33 +362,81 @@ fn reduce(qp: &MonotoneQp<'_>, free: &[usize]) -> ReducedQp {
     let scale = (diag / nf as f64).max(f64::MIN_POSITIVE);
     p.iter_mut().for_each(|t| t.2 /= scale);
     q.iter_mut().for_each(|v| *v /= scale);
-    // f_j − f_i ≥ ε  ⇔  f_i − f_j ≤ −ε
-    let mut r = ReducedQp { n: nf, p, q, a_row: vec![], a_col: vec![], a_val: vec![], b: vec![], scale };
-    for &(i, j) in qp.edges {
-        let row = r.b.len();
+    let d: Vec<f64> = free.iter().map(|&i| qp.data.map_or(0.0, |d| d[i]) / scale).collect();
+    let q_free: Vec<f64> = free.iter().map(|&i| qp.q[i] / scale).collect();
+    let gap_bound = d.iter().all(|&v| v > 0.0);
+    let mut r = ReducedQp {
+        n: nf,
+        p,
+        q,
+        a_row: vec![],
+        a_col: vec![],
+        a_val: vec![],
+        b: vec![],
+        d,
+        q_free,
+        gap_bound,
+        factor: None,
+        scale,
+    };
+    for row in constraint_rows(qp) {
+        let at = r.b.len();
         let mut push = |col: usize, v: f64| {
-            r.a_row.push(row);
+            r.a_row.push(at);
             r.a_col.push(col);
             r.a_val.push(v);
         };
-        match (qp.fixed[i], qp.fixed[j]) {
-            (Some(_), Some(_)) => continue,
-            (None, None) => {
-                push(slot[i], 1.0);
-                push(slot[j], -1.0);
-                r.b.push(-qp.margin);
+        // f_j − f_i ≥ ε  ⇔  f_i − f_j ≤ −ε
+        match row {
+            Row::Pair(i, j) => match (qp.fixed[i], qp.fixed[j]) {
+                (None, None) => {
+                    push(slot[i], 1.0);
+                    push(slot[j], -1.0);
+                    r.b.push(-qp.margin);
+                }
+                (Some(fi), _) => {
+                    push(slot[j], -1.0);
+                    r.b.push(-qp.margin - fi);
+                }
+                (None, Some(fj)) => {
+                    push(slot[i], 1.0);
+                    r.b.push(fj - qp.margin);
+                }
+            },
+            Row::Upper(v, c) => {
+                push(slot[v], 1.0);
+                r.b.push(c);
             }
-            (Some(fi), None) => {
-                push(slot[j], -1.0);
-                r.b.push(-qp.margin - fi);
-            }
-            (None, Some(fj)) => {
-                push(slot[i], 1.0);
-                r.b.push(fj - qp.margin);
+            Row::Lower(v, c) => {
+                push(slot[v], -1.0);
+                r.b.push(-c);
             }
         }
     }
     r
+}
+
+/// The factored objective on the free variables, scaled like the reduced QP (`F / √scale`).
+fn reduce_factor(qp: &MonotoneQp<'_>, f: &Sparse, free: &[usize], scale: f64) -> ReducedFactor {
+    let n = qp.q.len();
+    let mut slot = vec![usize::MAX; n];
+    for (k, &i) in free.iter().enumerate() {
+        slot[i] = k;
+    }
+    let root = scale.sqrt();
+    let mut g = vec![0.0; f.nrows()];
+    let mut t = Vec::new();
+    let (cp, ri, val) = (f.symbolic().col_ptr(), f.symbolic().row_idx(), f.val());
+    for j in 0..n {
+        for k in cp[j]..cp[j + 1] {
+            match qp.fixed[j] {
+                Some(v) => g[ri[k]] += val[k] * v / root,
+                None => t.push(faer::sparse::Triplet::new(ri[k], slot[j], val[k] / root)),
+            }
+        }
+    }
+    let f = Sparse::try_new_from_triplets(f.nrows(), free.len(), &t).expect("factor triplets in range");
+    ReducedFactor { f, g }
 }
 
 #[cfg(test)]
@@ -279,8 +475,18 @@ mod tests {
         fixed[n - 1] = Some(2.0);
         // every edge increasing to the right and upwards: a monotone ramp, feasible
         let hint: Vec<f64> = (0..n).map(|i| -1.0 + 3.0 * ((i % nx) + (i / nx)) as f64 / (nx + ny - 2) as f64).collect();
-        let qp =
-            MonotoneQp { p: &p, q: &q, fixed: &fixed, edges: &edges, margin: 1e-6, hint: Some(&hint), factored: None };
+        let qp = MonotoneQp {
+            p: &p,
+            q: &q,
+            fixed: &fixed,
+            edges: &edges,
+            margin: 1e-6,
+            hint: Some(&hint),
+            bounds: &[],
+            data: None,
+            factor: None,
+            condition: None,
+        };
         let free: Vec<usize> = (0..n).filter(|&i| fixed[i].is_none()).collect();
         let reduced = reduce(&qp, &free);
         let prepared = prepare(&p, &fixed).unwrap();
@@ -313,7 +519,18 @@ mod tests {
         let edges = [(0, 1), (1, 2), (2, 3)];
         for method in [Method::Structured, Method::Clarabel] {
             for hint in [None, Some(&[0.0, 1.0, 2.0, 3.0][..])] {
-                let qp = MonotoneQp { p: &p, q: &q, fixed: &fixed, edges: &edges, margin: 1e-6, hint, factored: None };
+                let qp = MonotoneQp {
+                    p: &p,
+                    q: &q,
+                    fixed: &fixed,
+                    edges: &edges,
+                    margin: 1e-6,
+                    hint,
+                    bounds: &[],
+                    data: None,
+                    factor: None,
+                    condition: None,
+                };
                 let sol = solve_monotone_qp(&qp, &QpSettings { method, ..Default::default() }).unwrap();
                 assert_eq!(sol.method, method, "{:?}", sol.fallback);
                 assert!(matches!(sol.status, SolveStatus::Solved | SolveStatus::AlmostSolved));

@@ -99,6 +99,26 @@ pub fn max_margin_bounded(
     bounds: &[(usize, f64, bool)],
     cap: Option<f64>,
 ) -> Result<f64> {
+    max_margin_or_conflict(u, edges, fixed, bounds, cap).map_err(|(a, w)| {
+        Error::infeasible(format!(
+            "the representative orders a path upward from vertex {a} to vertex {w}, whose fixed value (or bound) is not higher: no function increasing along it takes these values"
+        ))
+    })
+}
+
+/// [`max_margin_bounded`], or the conflict that makes even ε = 0 infeasible: `(a, w)`, a
+/// fixed (or lower-bounded) vertex and a fixed (or upper-bounded) vertex joined by a path the
+/// order of u runs up, whose values do not rise.
+///
+/// # Errors
+/// The conflicting pair.
+pub fn max_margin_or_conflict(
+    u: &[f64],
+    edges: &[(usize, usize)],
+    fixed: &[Option<f64>],
+    bounds: &[(usize, f64, bool)],
+    cap: Option<f64>,
+) -> std::result::Result<f64, (usize, usize)> {
     let n = u.len();
     let mut upper = vec![f64::INFINITY; n];
     let mut lower = vec![f64::NEG_INFINITY; n];
@@ -157,10 +177,8 @@ pub fn max_margin_bounded(
         }
         None
     };
-    if let Some((a, w)) = violated(0.0) {
-        return Err(Error::infeasible(format!(
-            "the representative orders a path upward from vertex {a} to vertex {w}, whose fixed value (or bound) is not higher: no function increasing along it takes these values"
-        )));
+    if let Some(pair) = violated(0.0) {
+        return Err(pair);
     }
     let (fmin, fmax) = crate::domain::value_range(fixed.iter().flatten().chain(bounds.iter().map(|b| &b.1)));
     let span = if fmax > fmin { fmax - fmin } else { 1.0 };

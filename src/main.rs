@@ -472,7 +472,7 @@ struct SmoothCli {
     #[arg(long, value_name = "W")]
     smooth_weight: Option<f64>,
     /// Smoothing length ℓ as a fraction of the domain's diameter (the series' extent); by
-    /// default max(2 mean edge lengths, 1 % of the diameter), on series at most half the median
+    /// default max(2 mean edge lengths, 1 % of the diameter), on series at most 0.3 × the median
     /// spacing of the kept extrema (the report gives ℓ and the rule).
     #[arg(long, value_name = "FRACTION")]
     smooth_length: Option<f64>,

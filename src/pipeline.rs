@@ -12,14 +12,14 @@
 //! ```
 
 use crate::constraints::{
-    activity, choose_margin, constraint_edges, margin_cap, max_margin_bounded, Activity, EdgeSet,
+    activity, choose_margin, constraint_edges, margin_cap, max_margin_or_conflict, Activity, EdgeSet,
 };
 use crate::domain::{sos_sort, Domain, Grid2d, Series, TriMesh};
 use crate::error::{Error, Result};
 use crate::operators::{
     cotan_stiffness, dirichlet_solve, edge_factor, gradient_factor, grid_mass, grid_stiffness, lumped_mass,
     plus_diagonal, polyharmonic, polyharmonic_factor, positive_cotan_stiffness, quadratic_form_without_diagonal,
-    series_mass, series_stiffness, Energy, Sparse,
+    series_mass, series_stiffness, Energy, Factor, Sparse,
 };
 use crate::representative::{flooded_representative, separatrix_representative, series_representative};
 use crate::solve::{
@@ -73,7 +73,7 @@ pub trait Smoothable: Domain {
     }
     /// `F₁` with `F₁ᵀF₁ = k` (the stiffness): one row per edge of positive weight, or `None`
     /// when a weight is negative and the domain has no other square root.
-    fn stiffness_factor(&self, k: &Sparse) -> Option<Sparse> {
+    fn stiffness_factor(&self, k: &Sparse) -> Option<Factor> {
         edge_factor(k)
     }
     /// A function with exactly the kept extrema (checked by the pipeline), built by the
@@ -255,7 +255,7 @@ impl Smoothable for TriMesh {
     }
     /// One row per edge when every cotangent weight is ≥ 0, else the area-weighted triangle
     /// gradients (three rows per triangle).
-    fn stiffness_factor(&self, k: &Sparse) -> Option<Sparse> {
+    fn stiffness_factor(&self, k: &Sparse) -> Option<Factor> {
         edge_factor(k).or_else(|| Some(gradient_factor(self.positions(), self.faces())))
     }
     /// As on grids, but the harmonic fills use [`positive_cotan_stiffness`]: cotangent
@@ -543,7 +543,7 @@ fn fit_report(
     qp: &FitInputs<'_>,
     f: &[f64],
     sol: &crate::solve::QpSolution,
-    factor: Option<&Sparse>,
+    factor: Option<&Factor>,
     (range, eps, gd, m): (f64, f64, f64, &[f64]),
 ) -> FitReport {
     let n = f.len();
@@ -616,7 +616,7 @@ struct Operators {
     m: Vec<f64>,
     weights: Vec<f64>,
     data_diag: Vec<f64>,
-    factor: Option<Sparse>,
+    factor: Option<Factor>,
     p: Sparse,
     q: Vec<f64>,
     condition: Option<f64>,
@@ -678,7 +678,23 @@ pub fn smooth<D: Smoothable + Sync>(domain: &D, h: &[f64], settings: &SmoothSett
             let bounds = free_end_bounds(domain, &rep.u, &kept.roles, (lo, hi));
             let scaled: Vec<(usize, f64, bool)> =
                 bounds.iter().map(|b| (b.vertex, (b.value - lo) / range, b.upper)).collect();
-            let margins = max_margin_bounded(&rep.u, &edges, &fixed, &scaled, Some(margin_cap(1.0, resolution)))
+            let describe = |v: usize| {
+                let what = match kept.roles[v] {
+                    Role::Min => "kept minimum",
+                    Role::Max => "kept maximum",
+                    Role::End => "free end",
+                    _ => "vertex",
+                };
+                format!("{what} {v} (value {})", h[v])
+            };
+            let margins = max_margin_or_conflict(&rep.u, &edges, &fixed, &scaled, Some(margin_cap(1.0, resolution)))
+                .map_err(|(a, w)| {
+                    Error::infeasible(format!(
+                        "its order runs a path upward from the {} to the {}, which is not higher: no strict function with the kept values follows it",
+                        describe(a),
+                        describe(w)
+                    ))
+                })
                 .and_then(|eps_max| Ok((eps_max, choose_margin(eps_max, 1.0, resolution)?)));
             seconds.constraints += t.elapsed().as_secs_f64();
             match margins {
@@ -698,7 +714,7 @@ pub fn smooth<D: Smoothable + Sync>(domain: &D, h: &[f64], settings: &SmoothSett
                     return Err(Error::Infeasible {
                         path,
                         message: format!(
-                            "the {} representative the data cannot follow: {message} (requested explicitly: not replaced by another construction)",
+                            "the data cannot follow the {} representative: {message} (it was requested explicitly, so no other construction replaces it)",
                             rep.kind
                         ),
                     })
@@ -893,14 +909,15 @@ pub const SMOOTH_LENGTH_FRACTION: f64 = 0.01;
 /// The default ℓ is at least this many mean edge lengths (sample spacings).
 pub const SMOOTH_LENGTH_EDGES: f64 = 2.0;
 /// On series the default ℓ is at most this fraction of the median spacing of consecutive
-/// kept extrema.
-pub const SMOOTH_LENGTH_KEPT_SPACING: f64 = 0.5;
+/// kept extrema (below 1/π: the kept oscillation stays in the pass band at every order).
+pub const SMOOTH_LENGTH_KEPT_SPACING: f64 = 0.3;
 
 /// The default smoothing length and the rule that set it (SPEC.md, "Defaults"):
 /// `ℓ = max(2 h̄, 1 % of the diameter)` with `h̄` the mean edge length (sample spacing); on a
-/// series the 1 % is capped at half the median x-distance between consecutive kept extrema,
-/// so that dense kept extrema are not smoothed against (the filter `1/(1 + (ℓω)^{2k})` passes
-/// wavelengths above `2πℓ`; a kept oscillation of half-period S needs `πℓ < S`).
+/// series the 1 % is capped at 0.3 × the median x-distance S between consecutive kept extrema,
+/// so that dense kept extrema are not smoothed against: without constraints the energy is the
+/// low-pass filter `1/(1 + (ℓω)^{2k})`, and a kept oscillation of half-period S (ω = π/S) stays
+/// in its pass band at every order when `πℓ < S`.
 pub fn default_smooth_length<D: Domain>(domain: &D, kept: &KeptSet) -> (f64, String) {
     let edges = domain.edges();
     let mean_edge = edges
@@ -925,7 +942,7 @@ pub fn default_smooth_length<D: Domain>(domain: &D, kept: &KeptSet) -> (f64, Str
             let cap = SMOOTH_LENGTH_KEPT_SPACING * median;
             if cap < base {
                 base = cap;
-                why = format!("half the median spacing of the kept extrema ({})", short(median));
+                why = format!("0.3 × the median spacing of the kept extrema ({})", short(median));
             }
         }
     }

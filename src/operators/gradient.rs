@@ -34,10 +34,10 @@ pub fn gradient_operator(positions: &[[f64; 3]], triangles: &[[usize; 3]]) -> (S
 /// `F = A^{½} G` (`3·#T × #V`): `FᵀF = K`, the cotangent stiffness, for any triangles (obtuse
 /// ones too, where [`super::edge_factor`] has no real square root). The first-order factor of
 /// a mesh's energy in the factored form.
-pub fn gradient_factor(positions: &[[f64; 3]], triangles: &[[usize; 3]]) -> Sparse {
+pub fn gradient_factor(positions: &[[f64; 3]], triangles: &[[usize; 3]]) -> super::Factor {
     let (g, areas) = gradient_operator(positions, triangles);
     let root: Vec<f64> = (0..g.nrows()).map(|r| areas[r / 3].sqrt()).collect();
-    super::sparse::scale_rows(&g, &root)
+    super::Factor::exact(super::sparse::scale_rows(&g, &root))
 }
 
 #[cfg(test)]

@@ -17,6 +17,7 @@
 //! ```
 
 mod cotan;
+mod factor;
 mod gradient;
 mod harmonic;
 mod polyharmonic;
@@ -26,8 +27,9 @@ mod sparse;
 pub use cotan::{
     cotan_stiffness, grid_mass, grid_stiffness, lumped_mass, negative_cotan_edges, positive_cotan_stiffness,
 };
+pub use factor::{edge_factor, polyharmonic_factor, Factor};
 pub use gradient::{gradient_factor, gradient_operator};
 pub use harmonic::{dirichlet_solve, Dirichlet};
-pub use polyharmonic::{edge_factor, polyharmonic, polyharmonic_factor, Energy};
+pub use polyharmonic::{polyharmonic, Energy};
 pub use series::{series_mass, series_stiffness};
 pub use sparse::{plus_diagonal, quadratic_form, quadratic_form_without_diagonal, scaled_plus_diagonal, Sparse};

@@ -125,146 +125,8 @@ pub fn polyharmonic(k: &Sparse, m: &[f64], energy: &Energy, scale: &[f64]) -> Sp
     with_pattern_of(single.unwrap_or_else(|| from_triplets(n, n, &all)), k_full)
 }
 
-/// `F` with `FᵀF = Q` for the energy [`polyharmonic`] assembles from the same arguments, the
-/// rows of every term stacked: the paper's appendix form, whose condition number is the square
-/// root of `Q`'s. `k_factor` is a first-order factor, `k_factorᵀ k_factor = K` (one row per
-/// edge from [`edge_factor`], or per triangle gradient component on meshes).
-///
-/// Per order, with `S` dropping sharp vertices and `F₁′` the factor of `K′` (the rows of
-/// `k_factor` that touch no sharp vertex):
-/// `F₁ = k_factor`, `F₂ = S M^{-½} K`, `F₃ = F₁′ S M⁻¹ K`, `F₄ = M^{-½} K′ S M⁻¹ K`,
-/// each term scaled by `√(weight · scale)`.
-///
-/// `None` when a term needs `F₁′` but `k_factor`'s rows are not single edges (a mesh whose
-/// cotangent weights are not all ≥ 0, with sharp vertices and an order ≥ 3): `K′` removes
-/// edges, which a triangle's gradient cannot.
-pub fn polyharmonic_factor(k: &Sparse, k_factor: &Sparse, m: &[f64], energy: &Energy, scale: &[f64]) -> Option<Sparse> {
-    assert_eq!(scale.len(), energy.terms.len());
-    let n = k.nrows();
-    let k = &without_zeros(k);
-    let mut sharp = vec![false; n];
-    for &v in &energy.sharp {
-        sharp[v] = true;
-    }
-    let d: Vec<f64> = (0..n).map(|i| if sharp[i] { 0.0 } else { 1.0 / m[i] }).collect();
-    let root_minv: Vec<f64> = m.iter().map(|x| 1.0 / x.sqrt()).collect();
-    let root_d: Vec<f64> = (0..n).map(|i| if sharp[i] { 0.0 } else { root_minv[i] }).collect();
-    let edge_rows = is_edge_factor(k_factor);
-    let cut_factor = || -> Option<Sparse> {
-        if energy.sharp.is_empty() {
-            return Some(k_factor.clone());
-        }
-        if !edge_rows {
-            return None;
-        }
-        let keep: Vec<bool> = row_supports(k_factor).iter().map(|r| r.iter().all(|&v| !sharp[v])).collect();
-        Some(select_rows(k_factor, &keep))
-    };
-    let mut blocks = Vec::new();
-    for (&(order, w), &s) in energy.terms.iter().zip(scale) {
-        let c = w * s;
-        if c == 0.0 {
-            continue;
-        }
-        let g = scale_rows(k, &d); // S M⁻¹ K
-        let f = match order {
-            1 => k_factor.clone(),
-            2 => scale_rows(k, &root_d),
-            3 => matmul(&cut_factor()?, &g),
-            _ => {
-                let k_cut = if energy.sharp.is_empty() { k.clone() } else { cut_edges(k, &sharp) };
-                scale_rows(&matmul(&k_cut, &g), &root_minv)
-            }
-        };
-        blocks.push((without_zeros_rows(&f), c.sqrt()));
-    }
-    Some(stack_rows(&blocks, n))
-}
-
-/// `F` with one row `√w (e_i − e_j)` per edge of positive weight `w = −K_ij`: `FᵀF = K` for a
-/// stiffness whose off-diagonal entries are all ≤ 0 and whose rows sum to zero (series,
-/// grids, meshes without obtuse angles). `None` if an off-diagonal entry is positive.
-pub fn edge_factor(k: &Sparse) -> Option<Sparse> {
-    let (cp, ri, v) = (k.symbolic().col_ptr(), k.symbolic().row_idx(), k.val());
-    let mut t = Vec::new();
-    let mut row = 0;
-    for j in 0..k.ncols() {
-        for p in cp[j]..cp[j + 1] {
-            let i = ri[p];
-            if i < j {
-                if v[p] > 0.0 {
-                    return None;
-                }
-                if v[p] < 0.0 {
-                    let r = (-v[p]).sqrt();
-                    t.push(Triplet::new(row, i, r));
-                    t.push(Triplet::new(row, j, -r));
-                    row += 1;
-                }
-            }
-        }
-    }
-    Some(from_triplets(row, k.ncols(), &t))
-}
-
-/// Whether every row of `f` has at most two entries of opposite sign and equal magnitude (an
-/// [`edge_factor`] row).
-fn is_edge_factor(f: &Sparse) -> bool {
-    row_supports(f).iter().all(|r| r.len() <= 2)
-}
-
-/// The columns of each row.
-fn row_supports(f: &Sparse) -> Vec<Vec<usize>> {
-    let mut rows = vec![Vec::new(); f.nrows()];
-    let (cp, ri) = (f.symbolic().col_ptr(), f.symbolic().row_idx());
-    for j in 0..f.ncols() {
-        for &i in &ri[cp[j]..cp[j + 1]] {
-            rows[i].push(j);
-        }
-    }
-    rows
-}
-
-/// The rows of `f` with `keep[row]`, renumbered in order.
-fn select_rows(f: &Sparse, keep: &[bool]) -> Sparse {
-    let mut slot = vec![usize::MAX; f.nrows()];
-    let mut n = 0;
-    for (r, &k) in keep.iter().enumerate() {
-        if k {
-            slot[r] = n;
-            n += 1;
-        }
-    }
-    let t: Vec<_> =
-        triplets(f).into_iter().filter(|t| keep[t.row]).map(|t| Triplet::new(slot[t.row], t.col, t.val)).collect();
-    from_triplets(n, f.ncols(), &t)
-}
-
-/// `f` without its exact zeros and its empty rows.
-fn without_zeros_rows(f: &Sparse) -> Sparse {
-    let mut used = vec![false; f.nrows()];
-    for t in triplets(f) {
-        if t.val != 0.0 {
-            used[t.row] = true;
-        }
-    }
-    let t: Vec<_> = triplets(f).into_iter().filter(|t| t.val != 0.0).collect();
-    select_rows(&from_triplets(f.nrows(), f.ncols(), &t), &used)
-}
-
-/// The blocks `c · F` one below the other.
-fn stack_rows(blocks: &[(Sparse, f64)], ncols: usize) -> Sparse {
-    let mut t = Vec::new();
-    let mut base = 0;
-    for (f, c) in blocks {
-        t.extend(triplets(f).into_iter().map(|e| Triplet::new(base + e.row, e.col, c * e.val)));
-        base += f.nrows();
-    }
-    from_triplets(base, ncols, &t)
-}
-
 /// `K` without the edges at sharp vertices, diagonal recomputed so that rows sum to zero.
-fn cut_edges(k: &Sparse, sharp: &[bool]) -> Sparse {
+pub(super) fn cut_edges(k: &Sparse, sharp: &[bool]) -> Sparse {
     let n = k.nrows();
     let mut diag = vec![0.0; n];
     let mut t = Vec::new();
@@ -390,8 +252,8 @@ mod tests {
     #[test]
     fn the_factor_squares_to_the_energy_at_every_order_blend_and_with_sharp_samples() {
         let (k, m) = setup(vec![0.0, 0.3, 1.0, 1.2, 2.0, 3.5, 4.0, 4.1, 5.0, 6.5]);
-        let k1 = edge_factor(&k).expect("a series has positive weights");
-        assert_factor_matches(&k, &k1, "K");
+        let k1 = crate::operators::edge_factor(&k).expect("a series has positive weights");
+        assert_factor_matches(&k, &k1.matrix, "K");
         let mut energies: Vec<Energy> = (1..=4).map(Energy::order).collect();
         energies.push(Energy::parse("1:0.2,2:1,4:0.5").unwrap());
         for mut e in energies {
@@ -399,8 +261,8 @@ mod tests {
             for sharp in [vec![], vec![0, 4, 9]] {
                 e.sharp = sharp;
                 let q = polyharmonic(&k, &m, &e, &scale);
-                let f = polyharmonic_factor(&k, &k1, &m, &e, &scale).expect("edge rows");
-                assert_factor_matches(&q, &f, &format!("{:?} sharp {:?}", e.terms, e.sharp));
+                let f = crate::operators::polyharmonic_factor(&k, &k1, &m, &e, &scale).expect("edge rows");
+                assert_factor_matches(&q, &f.matrix, &format!("{:?} sharp {:?}", e.terms, e.sharp));
             }
         }
     }
@@ -408,26 +270,28 @@ mod tests {
     #[test]
     fn grids_use_edge_rows_and_obtuse_meshes_gradient_rows() {
         use crate::domain::{shapes, Grid2d};
-        use crate::operators::{cotan_stiffness, gradient_factor, grid_mass, grid_stiffness, lumped_mass};
+        use crate::operators::{
+            cotan_stiffness, edge_factor, gradient_factor, grid_mass, grid_stiffness, lumped_mass, polyharmonic_factor,
+        };
         let g = Grid2d::with_geometry(7, 5, [0.5, -2.0], [0.0, 0.0]).unwrap();
         let (k, m) = (grid_stiffness(&g), grid_mass(&g));
         let k1 = edge_factor(&k).expect("a grid's 5-point weights are positive");
-        assert_eq!(k1.nrows(), 6 * 5 + 7 * 4, "one row per axis edge, none for the zero diagonals");
+        assert_eq!(k1.matrix.nrows(), 6 * 5 + 7 * 4, "one row per axis edge, none for the zero diagonals");
         for order in 1..=4 {
             let e = Energy::order(order);
             let q = polyharmonic(&k, &m, &e, &[1.3]);
-            assert_factor_matches(&q, &polyharmonic_factor(&k, &k1, &m, &e, &[1.3]).unwrap(), "grid");
+            assert_factor_matches(&q, &polyharmonic_factor(&k, &k1, &m, &e, &[1.3]).unwrap().matrix, "grid");
         }
         // a disk triangulated with obtuse triangles: negative cotangent weights
         let disk = shapes::disk(3, 7, &[]);
         let (p, t) = (disk.positions(), disk.faces());
         let (k, m) = (cotan_stiffness(p, t), lumped_mass(p, t));
         let k1 = gradient_factor(p, t);
-        assert_factor_matches(&k, &k1, "mesh K");
+        assert_factor_matches(&k, &k1.matrix, "mesh K");
         for order in 1..=4 {
             let mut e = Energy::order(order);
             let q = polyharmonic(&k, &m, &e, &[1.0]);
-            assert_factor_matches(&q, &polyharmonic_factor(&k, &k1, &m, &e, &[1.0]).unwrap(), "mesh");
+            assert_factor_matches(&q, &polyharmonic_factor(&k, &k1, &m, &e, &[1.0]).unwrap().matrix, "mesh");
             e.sharp = vec![0];
             let cut = polyharmonic_factor(&k, &k1, &m, &e, &[1.0]);
             assert_eq!(cut.is_none(), order == 3, "order {order}: F₁′ needs edge rows");

@@ -8,16 +8,34 @@
 //! digits, and the iterate is kept to that precision too; the auxiliary variables `t = F x + g`
 //! come out rounded, for the gap bound of the factored form (`½‖F x + g − t‖²` is then the
 //! rounding of `t` alone).
+//!
+//! Each solve is mixed-precision iterative refinement: the normal matrix rounded to double is
+//! factorised by the crate's Cholesky (supernodal, two-way), and the residual of every
+//! correction is formed in double-double, until it is below 10⁻²⁶ of the right-hand side. Where
+//! that stalls (the rounded matrix is not positive definite, or its errors exceed its smallest
+//! eigenvalues: κ beyond about 10¹⁴), the normal matrix is factorised in double-double itself
+//! (simplicial: faer's dense kernels are for native floats only), from then on.
 
 use super::ipm::{Normal as Pattern, Objective, Rows};
 use super::qp::{ReducedFactor, ReducedQp};
 use crate::linalg;
-use crate::operators::Sparse;
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::fx128;
 use faer::sparse::linalg::cholesky::{LltRef, SymbolicCholesky};
 use faer::sparse::SparseColMatRef;
 use faer::{Conj, Par, Side, Spec};
+
+/// Refinement steps per solve before it counts as stalled.
+const REFINEMENT_STEPS: usize = 12;
+/// Relative residual at which a refined solve stops.
+const REFINED: f64 = 1e-26;
+
+/// The double-double factorisation, made the first time refinement stalls.
+struct Exact {
+    symbolic: SymbolicCholesky<usize>,
+    l: Vec<fx128>,
+    mem: MemBuffer,
+}
 
 /// The factored objective and its normal matrix, in double-double.
 pub(super) struct Normal<'r> {
@@ -27,17 +45,15 @@ pub(super) struct Normal<'r> {
     pattern: Pattern,
     /// `F_FᵀF_F + diag(d)` on the pattern.
     base: Vec<fx128>,
+    /// The normal matrix of the last factorisation, and rounded to double.
     vals: Vec<fx128>,
-    symbolic: SymbolicCholesky<usize>,
-    l: Vec<fx128>,
-    mem: MemBuffer,
+    rounded: Vec<f64>,
+    /// Its double-precision Cholesky factor (`None` when the rounded matrix is not positive
+    /// definite).
+    spd: linalg::SpdFactor,
+    spd_ok: bool,
+    exact: Option<Exact>,
     t: std::cell::RefCell<Vec<fx128>>,
-}
-
-/// The product of two doubles, exactly.
-fn product(a: f64, b: f64) -> fx128 {
-    let p = a * b;
-    fx128::from(p) + fx128::from(a.mul_add(b, -p))
 }
 
 impl<'r> Normal<'r> {
@@ -61,15 +77,19 @@ impl<'r> Normal<'r> {
                 .map_err(|_| format!("the factor couples variables {i} and {j}, which the assembled energy does not"))
         };
         let mut base = vec![fx128::from(0.0); ri.len()];
-        let ft: Sparse = f.f.as_ref().transpose().to_col_major().map_err(|e| format!("{e:?}"))?;
-        let (tcp, tri, tv) = (ft.symbolic().col_ptr(), ft.symbolic().row_idx(), ft.val());
-        for row in 0..ft.ncols() {
-            let entries = tcp[row]..tcp[row + 1];
-            for a in entries.clone() {
-                for b in entries.clone() {
-                    let (i, j) = (tri[a], tri[b]);
+        // the rows of F: (column, double-double entry)
+        let mut rows: Vec<Vec<(usize, fx128)>> = vec![Vec::new(); f.f.nrows()];
+        let (fcp, fri) = (f.f.symbolic().col_ptr(), f.f.symbolic().row_idx());
+        for j in 0..f.f.ncols() {
+            for p in fcp[j]..fcp[j + 1] {
+                rows[fri[p]].push((j, f.entry(p)));
+            }
+        }
+        for row in &rows {
+            for &(i, a) in row {
+                for &(j, b) in row {
                     if i <= j {
-                        base[find(i, j)?] += product(tv[a], tv[b]);
+                        base[find(i, j)?] += a * b;
                     }
                 }
             }
@@ -77,89 +97,68 @@ impl<'r> Normal<'r> {
         for (j, &d) in r.d.iter().enumerate() {
             base[pattern.pos_diag[j]] += fx128::from(d);
         }
-        let symbolic = linalg::analyse_simplicial(pattern.symbolic.as_ref())?;
-        let mem = MemBuffer::try_new(StackReq::any_of(&[
-            symbolic.factorize_numeric_llt_scratch::<fx128>(Par::Seq, Spec::default()),
-            symbolic.solve_in_place_scratch::<fx128>(1, Par::Seq),
-        ]))
-        .map_err(|_| "out of memory for the double-double Cholesky workspace".to_string())?;
-        let l = vec![fx128::from(0.0); symbolic.len_val()];
+        let analysis = std::rc::Rc::new(linalg::analyse(pattern.symbolic.as_ref())?);
+        let spd = linalg::SpdFactor::new(analysis)?;
         Ok(Normal {
             f,
             d: r.d.iter().map(|&v| fx128::from(v)).collect(),
             q: r.q_free.iter().map(|&v| fx128::from(v)).collect(),
             vals: base.clone(),
+            rounded: vec![0.0; base.len()],
             base,
             pattern,
-            symbolic,
-            l,
-            mem,
+            spd,
+            spd_ok: false,
+            exact: None,
             t: std::cell::RefCell::new(vec![fx128::from(0.0); f.f.nrows()]),
         })
     }
 
-    /// `t = F x + g`.
-    fn auxiliary_into(&self, x: &[fx128], t: &mut [fx128]) {
-        let f = &self.f.f;
-        for (t, &g) in t.iter_mut().zip(&self.f.g) {
-            *t = fx128::from(g);
-        }
-        let (cp, ri, v) = (f.symbolic().col_ptr(), f.symbolic().row_idx(), f.val());
+    /// `y = N x` for the last normal matrix (upper triangle stored), in double-double.
+    fn multiply(&self, x: &[fx128], y: &mut [fx128]) {
+        y.iter_mut().for_each(|v| *v = fx128::from(0.0));
+        let (cp, ri) = (self.pattern.symbolic.col_ptr(), self.pattern.symbolic.row_idx());
         for (j, &xj) in x.iter().enumerate() {
-            for p in cp[j]..cp[j + 1] {
-                t[ri[p]] += fx128::from(v[p]) * xj;
+            for (&i, &a) in ri[cp[j]..cp[j + 1]].iter().zip(&self.vals[cp[j]..cp[j + 1]]) {
+                y[i] += a * xj;
+                if i != j {
+                    y[j] += a * x[i];
+                }
             }
         }
     }
-}
 
-impl Objective<fx128> for Normal<'_> {
-    /// `Fᵀ(F x + g) + d∘x + q_d`.
-    fn gradient(&mut self, x: &[fx128], out: &mut [fx128]) {
-        let mut t = std::mem::take(&mut *self.t.borrow_mut());
-        self.auxiliary_into(x, &mut t);
-        let f = &self.f.f;
-        let (cp, ri, v) = (f.symbolic().col_ptr(), f.symbolic().row_idx(), f.val());
-        for (j, o) in out.iter_mut().enumerate() {
-            let mut acc = self.q[j] + self.d[j] * x[j];
-            for p in cp[j]..cp[j + 1] {
-                acc += fx128::from(v[p]) * t[ri[p]];
-            }
-            *o = acc;
+    /// Factorises the last normal matrix in double-double (once refinement has stalled).
+    fn factor_exact(&mut self) -> Result<(), String> {
+        if self.exact.is_none() {
+            let symbolic = linalg::analyse_simplicial(self.pattern.symbolic.as_ref())?;
+            let mem = MemBuffer::try_new(StackReq::any_of(&[
+                symbolic.factorize_numeric_llt_scratch::<fx128>(Par::Seq, Spec::default()),
+                symbolic.solve_in_place_scratch::<fx128>(1, Par::Seq),
+            ]))
+            .map_err(|_| "out of memory for the double-double Cholesky workspace".to_string())?;
+            let l = vec![fx128::from(0.0); symbolic.len_val()];
+            self.exact = Some(Exact { symbolic, l, mem });
         }
-        *self.t.borrow_mut() = t;
-    }
-
-    /// `F_FᵀF_F + diag(d) + Aᵀ diag(w) A`, with a growing diagonal shift if it is not
-    /// numerically positive definite.
-    fn factor(&mut self, rows: &Rows, w: &[fx128]) -> Result<(), String> {
+        let e = self.exact.as_mut().expect("made above");
         let mut reg = 0.0;
         for attempt in 0..4 {
-            self.vals.copy_from_slice(&self.base);
-            for (k, &wk) in w.iter().enumerate() {
-                let [p1, p2, p12] = self.pattern.pos_row[k];
-                let [a1, a2] = rows.vals[k];
-                self.vals[p1] += wk * fx128::from(a1 * a1);
-                if rows.len[k] == 2 {
-                    self.vals[p2] += wk * fx128::from(a2 * a2);
-                    self.vals[p12] += wk * fx128::from(a1 * a2);
-                }
-            }
+            let mut vals = self.vals.clone();
             if reg > 0.0 {
                 for &d in &self.pattern.pos_diag {
-                    self.vals[d] += fx128::from(reg);
+                    vals[d] += fx128::from(reg);
                 }
             }
-            let a = SparseColMatRef::new(self.pattern.symbolic.as_ref(), &self.vals);
-            let ok = self
+            let a = SparseColMatRef::new(self.pattern.symbolic.as_ref(), &vals);
+            let ok = e
                 .symbolic
                 .factorize_numeric_llt(
-                    &mut self.l,
+                    &mut e.l,
                     a,
                     Side::Upper,
                     Default::default(),
                     Par::Seq,
-                    MemStack::new(&mut self.mem),
+                    MemStack::new(&mut e.mem),
                     Spec::default(),
                 )
                 .is_ok();
@@ -171,15 +170,107 @@ impl Objective<fx128> for Normal<'_> {
         Err("the double-double normal matrix is not positive definite".into())
     }
 
+    /// `t = F x + g`.
+    fn auxiliary_into(&self, x: &[fx128], t: &mut [fx128]) {
+        let f = &self.f.f;
+        for (t, &g) in t.iter_mut().zip(&self.f.g) {
+            *t = fx128::from(g);
+        }
+        let (cp, ri) = (f.symbolic().col_ptr(), f.symbolic().row_idx());
+        for (j, &xj) in x.iter().enumerate() {
+            for p in cp[j]..cp[j + 1] {
+                t[ri[p]] += self.f.entry(p) * xj;
+            }
+        }
+    }
+}
+
+impl Objective<fx128> for Normal<'_> {
+    /// `Fᵀ(F x + g) + d∘x + q_d`.
+    fn gradient(&mut self, x: &[fx128], out: &mut [fx128]) {
+        let mut t = std::mem::take(&mut *self.t.borrow_mut());
+        self.auxiliary_into(x, &mut t);
+        let f = &self.f.f;
+        let (cp, ri) = (f.symbolic().col_ptr(), f.symbolic().row_idx());
+        for (j, o) in out.iter_mut().enumerate() {
+            let mut acc = self.q[j] + self.d[j] * x[j];
+            for p in cp[j]..cp[j + 1] {
+                acc += self.f.entry(p) * t[ri[p]];
+            }
+            *o = acc;
+        }
+        *self.t.borrow_mut() = t;
+    }
+
+    /// `F_FᵀF_F + diag(d) + Aᵀ diag(w) A` in double-double, and its rounding factorised in
+    /// double (or in double-double once refinement has stalled).
+    fn factor(&mut self, rows: &Rows, w: &[fx128]) -> Result<(), String> {
+        self.vals.copy_from_slice(&self.base);
+        for (k, &wk) in w.iter().enumerate() {
+            let [p1, p2, p12] = self.pattern.pos_row[k];
+            let [a1, a2] = rows.vals[k];
+            self.vals[p1] += wk * fx128::from(a1 * a1);
+            if rows.len[k] == 2 {
+                self.vals[p2] += wk * fx128::from(a2 * a2);
+                self.vals[p12] += wk * fx128::from(a1 * a2);
+            }
+        }
+        if self.exact.is_some() {
+            return self.factor_exact();
+        }
+        for (r, v) in self.rounded.iter_mut().zip(&self.vals) {
+            *r = v.0 + v.1;
+        }
+        let a = SparseColMatRef::new(self.pattern.symbolic.as_ref(), &self.rounded);
+        self.spd_ok = self.spd.factor(a).is_ok();
+        if !self.spd_ok {
+            return self.factor_exact();
+        }
+        Ok(())
+    }
+
     fn solve_in_place(&mut self, rhs: &mut [fx128]) {
         let n = rhs.len();
-        let m = faer::MatMut::from_column_major_slice_mut(rhs, n, 1);
-        LltRef::new(&self.symbolic, &self.l).solve_in_place_with_conj(
-            Conj::No,
-            m,
-            Par::Seq,
-            MemStack::new(&mut self.mem),
-        );
+        if self.exact.is_none() && self.spd_ok {
+            let norm = |v: &[fx128]| v.iter().fold(0.0f64, |a, x| a.max((x.0 + x.1).abs()));
+            let target = REFINED * norm(rhs);
+            let mut x = vec![fx128::from(0.0); n];
+            let mut r = rhs.to_vec();
+            let mut nx = vec![fx128::from(0.0); n];
+            let mut d = vec![0.0f64; n];
+            let mut last = f64::INFINITY;
+            for _ in 0..REFINEMENT_STEPS {
+                for (di, ri) in d.iter_mut().zip(&r) {
+                    *di = ri.0 + ri.1;
+                }
+                self.spd.solve_in_place(&mut d);
+                for (xi, &di) in x.iter_mut().zip(&d) {
+                    *xi += fx128::from(di);
+                }
+                self.multiply(&x, &mut nx);
+                for i in 0..n {
+                    r[i] = rhs[i] - nx[i];
+                }
+                let now = norm(&r);
+                if now <= target {
+                    rhs.copy_from_slice(&x);
+                    return;
+                }
+                if now > 0.5 * last {
+                    break;
+                }
+                last = now;
+            }
+            // stalled: the double factor is too far from the matrix; exact from now on
+            if self.factor_exact().is_err() {
+                rhs.copy_from_slice(&x);
+                return;
+            }
+        }
+        if let Some(e) = &mut self.exact {
+            let m = faer::MatMut::from_column_major_slice_mut(rhs, n, 1);
+            LltRef::new(&e.symbolic, &e.l).solve_in_place_with_conj(Conj::No, m, Par::Seq, MemStack::new(&mut e.mem));
+        }
     }
 
     fn auxiliary(&self, x: &[fx128]) -> Option<Vec<f64>> {

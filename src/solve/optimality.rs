@@ -63,13 +63,14 @@ pub fn optimality(qp: &MonotoneQp<'_>, f: &[f64], z: &[f64], y: Option<&[f64]>) 
     let mut auxiliary_residual = 0.0;
     match (y, qp.factor) {
         (Some(y), Some(factor)) => {
-            assert_eq!(y.len(), factor.nrows());
-            let (cp, ri, v) = (factor.symbolic().col_ptr(), factor.symbolic().row_idx(), factor.val());
+            let m = &factor.matrix;
+            assert_eq!(y.len(), m.nrows());
+            let (cp, ri) = (m.symbolic().col_ptr(), m.symbolic().row_idx());
             // F f − y
             let mut r: Vec<fx128> = y.iter().map(|&t| -dd(t)).collect();
             for j in 0..n {
                 for p in cp[j]..cp[j + 1] {
-                    r[ri[p]] += product(v[p], f[j]);
+                    r[ri[p]] += factor.entry(p) * dd(f[j]);
                 }
             }
             auxiliary_residual = r.iter().map(|t| round(*t * *t)).sum::<f64>().sqrt();
@@ -78,7 +79,7 @@ pub fn optimality(qp: &MonotoneQp<'_>, f: &[f64], z: &[f64], y: Option<&[f64]>) 
                 let d = qp.data.map_or(0.0, |d| d[j]);
                 let mut acc = product(d, f[j]) + dd(qp.q[j]);
                 for p in cp[j]..cp[j + 1] {
-                    acc += product(v[p], y[ri[p]]);
+                    acc += factor.entry(p) * dd(y[ri[p]]);
                 }
                 rho[j] = acc;
             }

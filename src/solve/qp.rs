@@ -2,7 +2,7 @@
 
 use super::ipm::Prepared;
 use crate::error::Result;
-use crate::operators::Sparse;
+use crate::operators::{Factor, Sparse};
 
 /// A one-sided bound on one entry: `f_v ≤ value` (`upper`) or `f_v ≥ value`.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -40,7 +40,7 @@ pub struct MonotoneQp<'a> {
     /// `F` with `P = FᵀF + diag(data)` (`rows × #V`), for the factored formulation: the
     /// paper's appendix, auxiliary variables `t = F f`, with the square root of `P`'s
     /// condition number.
-    pub factor: Option<&'a Sparse>,
+    pub factor: Option<&'a Factor>,
     /// [`super::condition_estimate`] of this problem if already known (else estimated here).
     pub condition: Option<f64>,
 }
@@ -184,10 +184,19 @@ pub fn constraint_rows(qp: &MonotoneQp<'_>) -> Vec<Row> {
 /// The factored objective on the free variables: `½‖F x + g‖² + ½ xᵀ diag(d) x + q_dᵀ x`
 /// (`q_d` is [`ReducedQp::q_free`]), scaled like [`ReducedQp`].
 pub struct ReducedFactor {
-    /// `F` restricted to the free columns.
+    /// `F` restricted to the free columns, rounded to double.
     pub f: Sparse,
+    /// The remainder of each stored entry of `f` (double-double entries).
+    pub lo: Vec<f64>,
     /// `F_X x_X`: the fixed columns' contribution.
     pub g: Vec<f64>,
+}
+
+impl ReducedFactor {
+    /// Stored entry `p` of `f` in double-double.
+    pub fn entry(&self, p: usize) -> faer::fx128 {
+        faer::fx128::from(self.f.val()[p]) + faer::fx128::from(self.lo[p])
+    }
 }
 
 /// The QP on the free variables: `min ½ xᵀ P x + qᵀ x` s.t. `A x ≤ b`, objective scaled so
@@ -265,6 +274,12 @@ pub fn solve_monotone_qp(qp: &MonotoneQp<'_>, settings: &QpSettings) -> Result<Q
     let forced = settings.method == Method::ClarabelAuxiliary || settings.formulation == Formulation::Factored;
     let formulation = match (wants_factored, qp.factor) {
         (true, Some(f)) => {
+            // scaled by the data term rather than by P's diagonal: the variables' own block
+            // (d) then has unit size beside Clarabel's static regularisation, F carries √κ
+            let d_mean = reduced.d.iter().sum::<f64>() / reduced.n as f64;
+            if d_mean > 0.0 {
+                rescale(&mut reduced, d_mean);
+            }
             reduced.factor = Some(reduce_factor(qp, f, &free, reduced.scale));
             Formulation::Factored
         }
@@ -416,27 +431,51 @@ fn reduce(qp: &MonotoneQp<'_>, free: &[usize]) -> ReducedQp {
     r
 }
 
-/// The factored objective on the free variables, scaled like the reduced QP (`F / √scale`).
-fn reduce_factor(qp: &MonotoneQp<'_>, f: &Sparse, free: &[usize], scale: f64) -> ReducedFactor {
+/// Divides the objective of `r` by a further `by` (its `scale` becomes `scale · by`).
+fn rescale(r: &mut ReducedQp, by: f64) {
+    r.p.iter_mut().for_each(|t| t.2 /= by);
+    for v in r.q.iter_mut().chain(r.d.iter_mut()).chain(r.q_free.iter_mut()) {
+        *v /= by;
+    }
+    r.scale *= by;
+}
+
+/// The factored objective on the free variables, scaled like the reduced QP (`F / √scale`),
+/// in double-double.
+fn reduce_factor(qp: &MonotoneQp<'_>, f: &Factor, free: &[usize], scale: f64) -> ReducedFactor {
+    use faer::fx128;
     let n = qp.q.len();
     let mut slot = vec![usize::MAX; n];
     for (k, &i) in free.iter().enumerate() {
         slot[i] = k;
     }
-    let root = scale.sqrt();
-    let mut g = vec![0.0; f.nrows()];
-    let mut t = Vec::new();
-    let (cp, ri, val) = (f.symbolic().col_ptr(), f.symbolic().row_idx(), f.val());
+    let inv_root = fx128::from(1.0) / fx128::from(scale).sqrt();
+    let m = &f.matrix;
+    let mut g = vec![fx128::from(0.0); m.nrows()];
+    let (cp, ri) = (m.symbolic().col_ptr(), m.symbolic().row_idx());
+    let mut col_ptr = vec![0usize];
+    let (mut row_idx, mut val, mut lo) = (Vec::new(), Vec::new(), Vec::new());
     for j in 0..n {
-        for k in cp[j]..cp[j + 1] {
-            match qp.fixed[j] {
-                Some(v) => g[ri[k]] += val[k] * v / root,
-                None => t.push(faer::sparse::Triplet::new(ri[k], slot[j], val[k] / root)),
+        match qp.fixed[j] {
+            Some(v) => {
+                for p in cp[j]..cp[j + 1] {
+                    g[ri[p]] += f.entry(p) * fx128::from(v) * inv_root;
+                }
+            }
+            None => {
+                for (p, &i) in (cp[j]..cp[j + 1]).zip(&ri[cp[j]..cp[j + 1]]) {
+                    let e = f.entry(p) * inv_root;
+                    let hi = e.0 + e.1;
+                    row_idx.push(i);
+                    val.push(hi);
+                    lo.push((e - fx128::from(hi)).0);
+                }
+                col_ptr.push(row_idx.len());
             }
         }
     }
-    let f = Sparse::try_new_from_triplets(f.nrows(), free.len(), &t).expect("factor triplets in range");
-    ReducedFactor { f, g }
+    let symbolic = faer::sparse::SymbolicSparseColMat::new_checked(m.nrows(), free.len(), col_ptr, None, row_idx);
+    ReducedFactor { f: Sparse::new(symbolic, val), lo, g: g.iter().map(|v| v.0 + v.1).collect() }
 }
 
 #[cfg(test)]

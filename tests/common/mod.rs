@@ -2,6 +2,8 @@
 //! definition (SPEC.md "Extrema") and shares no code with the crate's certificate.
 #![allow(dead_code)]
 
+pub mod reference;
+
 /// Strict minima, strict maxima and non-regular, non-extremal vertices of a series.
 pub struct Counted {
     pub minima: Vec<usize>,

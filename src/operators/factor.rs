@@ -1,0 +1,258 @@
+//! The energy as `FᵀF` (the paper's appendix form, auxiliary variables `t = F f`), with `F`'s
+//! entries in double-double.
+//!
+//! The factored form is for the QPs whose assembled matrix is too ill-conditioned for double
+//! precision (κ beyond 10⁹). There the rounding of `F`'s own entries matters too: `F = M^{-½} K
+//! M⁻¹ K` computed in double carries relative errors of 10⁻¹⁶ per entry, which perturb the
+//! energy of a smooth function by about `10⁻¹⁶ ‖F‖ ‖F f‖ ‖f‖` — at κ = 10¹² already a millionth
+//! of the data term. So `F` is formed from the stiffness and the mass in double-double: the
+//! QP it defines is the one `K` and `M` (as computed from the geometry) define, to 32 digits.
+
+use super::polyharmonic::{cut_edges, Energy};
+use super::sparse::{without_zeros, Sparse};
+use faer::fx128;
+
+/// A sparse matrix with double-double entries: `matrix` holds them rounded to double, `lo` the
+/// remainder of each stored entry.
+#[derive(Clone, Debug)]
+pub struct Factor {
+    /// The entries rounded to double (the pattern is this matrix's).
+    pub matrix: Sparse,
+    /// `entry − rounded`, one per stored entry of `matrix`.
+    pub lo: Vec<f64>,
+}
+
+impl Factor {
+    /// Stored entry `p` (an index into `matrix`'s values) in double-double.
+    pub fn entry(&self, p: usize) -> fx128 {
+        fx128::from(self.matrix.val()[p]) + fx128::from(self.lo[p])
+    }
+
+    /// A factor whose entries are doubles.
+    pub fn exact(matrix: Sparse) -> Factor {
+        let lo = vec![0.0; matrix.val().len()];
+        Factor { matrix, lo }
+    }
+
+    fn from_dd(m: &Dd) -> Factor {
+        let mut col_ptr = vec![0usize];
+        let (mut row_idx, mut val, mut lo) = (Vec::new(), Vec::new(), Vec::new());
+        for col in &m.cols {
+            for &(i, v) in col {
+                row_idx.push(i);
+                let hi = v.0 + v.1;
+                val.push(hi);
+                lo.push((v - fx128::from(hi)).0);
+            }
+            col_ptr.push(row_idx.len());
+        }
+        let symbolic = faer::sparse::SymbolicSparseColMat::new_checked(m.nrows, m.cols.len(), col_ptr, None, row_idx);
+        Factor { matrix: Sparse::new(symbolic, val), lo }
+    }
+}
+
+/// Compressed columns with double-double values, rows sorted.
+struct Dd {
+    nrows: usize,
+    cols: Vec<Vec<(usize, fx128)>>,
+}
+
+impl Dd {
+    fn of(a: &Sparse) -> Dd {
+        let (cp, ri, v) = (a.symbolic().col_ptr(), a.symbolic().row_idx(), a.val());
+        Dd {
+            nrows: a.nrows(),
+            cols: (0..a.ncols()).map(|j| (cp[j]..cp[j + 1]).map(|p| (ri[p], fx128::from(v[p]))).collect()).collect(),
+        }
+    }
+
+    /// `diag(d) · self`, exact zeros dropped.
+    fn scale_rows(&self, d: &[fx128]) -> Dd {
+        let zero = fx128::from(0.0);
+        Dd {
+            nrows: self.nrows,
+            cols: self
+                .cols
+                .iter()
+                .map(|c| c.iter().map(|&(i, v)| (i, d[i] * v)).filter(|&(_, v)| v != zero).collect())
+                .collect(),
+        }
+    }
+
+    /// `self · b`.
+    fn mul(&self, b: &Dd) -> Dd {
+        let zero = fx128::from(0.0);
+        let mut acc = vec![zero; self.nrows];
+        let mut seen = vec![false; self.nrows];
+        let mut rows = Vec::new();
+        let cols = b
+            .cols
+            .iter()
+            .map(|bc| {
+                rows.clear();
+                for &(k, bkj) in bc {
+                    for &(i, aik) in &self.cols[k] {
+                        if !seen[i] {
+                            seen[i] = true;
+                            rows.push(i);
+                        }
+                        acc[i] += aik * bkj;
+                    }
+                }
+                rows.sort_unstable();
+                let col: Vec<(usize, fx128)> = rows.iter().map(|&i| (i, acc[i])).filter(|&(_, v)| v != zero).collect();
+                for &i in &rows {
+                    acc[i] = zero;
+                    seen[i] = false;
+                }
+                col
+            })
+            .collect();
+        Dd { nrows: self.nrows, cols }
+    }
+
+    /// The rows with `keep[row]`, renumbered in order.
+    fn select_rows(&self, keep: &[bool]) -> Dd {
+        let mut slot = vec![usize::MAX; self.nrows];
+        let mut n = 0;
+        for (r, &k) in keep.iter().enumerate() {
+            if k {
+                slot[r] = n;
+                n += 1;
+            }
+        }
+        Dd {
+            nrows: n,
+            cols: self
+                .cols
+                .iter()
+                .map(|c| c.iter().filter(|e| keep[e.0]).map(|&(i, v)| (slot[i], v)).collect())
+                .collect(),
+        }
+    }
+
+    /// Without its empty rows.
+    fn without_empty_rows(&self) -> Dd {
+        let mut used = vec![false; self.nrows];
+        for c in &self.cols {
+            for &(i, _) in c {
+                used[i] = true;
+            }
+        }
+        self.select_rows(&used)
+    }
+
+    /// The columns of each row.
+    fn row_supports(&self) -> Vec<Vec<usize>> {
+        let mut rows = vec![Vec::new(); self.nrows];
+        for (j, c) in self.cols.iter().enumerate() {
+            for &(i, _) in c {
+                rows[i].push(j);
+            }
+        }
+        rows
+    }
+}
+
+/// `F` with one row `√w (e_i − e_j)` per edge of positive weight `w = −K_ij`: `FᵀF = K` (to
+/// double-double) for a stiffness whose off-diagonal entries are all ≤ 0 and whose rows sum to
+/// zero (series, grids, meshes without obtuse angles). `None` if an off-diagonal entry is
+/// positive.
+pub fn edge_factor(k: &Sparse) -> Option<Factor> {
+    let (cp, ri, v) = (k.symbolic().col_ptr(), k.symbolic().row_idx(), k.val());
+    let mut cols: Vec<Vec<(usize, fx128)>> = vec![Vec::new(); k.ncols()];
+    let mut row = 0;
+    for j in 0..k.ncols() {
+        for p in cp[j]..cp[j + 1] {
+            let i = ri[p];
+            if i < j {
+                if v[p] > 0.0 {
+                    return None;
+                }
+                if v[p] < 0.0 {
+                    let r = fx128::from(-v[p]).sqrt();
+                    cols[i].push((row, r));
+                    cols[j].push((row, -r));
+                    row += 1;
+                }
+            }
+        }
+    }
+    // each column's rows are in increasing order by construction
+    Some(Factor::from_dd(&Dd { nrows: row, cols }))
+}
+
+/// `F` with `FᵀF = Q` for the energy [`super::polyharmonic`] assembles from the same arguments,
+/// the rows of every term stacked, entries in double-double. `k_factor` is a first-order
+/// factor, `k_factorᵀ k_factor = K` (one row per edge from [`edge_factor`], or per triangle
+/// gradient component on meshes).
+///
+/// Per order, with `S` dropping sharp vertices and `F₁′` the factor of `K′` (the rows of
+/// `k_factor` that touch no sharp vertex):
+/// `F₁ = k_factor`, `F₂ = S M^{-½} K`, `F₃ = F₁′ S M⁻¹ K`, `F₄ = M^{-½} K′ S M⁻¹ K`,
+/// each term scaled by `√(weight · scale)`.
+///
+/// `None` when a term needs `F₁′` but `k_factor`'s rows are not single edges (a mesh whose
+/// cotangent weights are not all ≥ 0, with sharp vertices and an order ≥ 3): `K′` removes
+/// edges, which a triangle's gradient cannot.
+pub fn polyharmonic_factor(k: &Sparse, k_factor: &Factor, m: &[f64], energy: &Energy, scale: &[f64]) -> Option<Factor> {
+    assert_eq!(scale.len(), energy.terms.len());
+    let n = k.nrows();
+    let k = &without_zeros(k);
+    let mut sharp = vec![false; n];
+    for &v in &energy.sharp {
+        sharp[v] = true;
+    }
+    let zero = fx128::from(0.0);
+    let minv: Vec<fx128> = m.iter().map(|&x| fx128::from(1.0) / fx128::from(x)).collect();
+    let root_minv: Vec<fx128> = minv.iter().map(|x| x.sqrt()).collect();
+    let d: Vec<fx128> = (0..n).map(|i| if sharp[i] { zero } else { minv[i] }).collect();
+    let root_d: Vec<fx128> = (0..n).map(|i| if sharp[i] { zero } else { root_minv[i] }).collect();
+    let kd = Dd::of(k);
+    let f1 = factor_dd(k_factor);
+    let edge_rows = f1.row_supports().iter().all(|r| r.len() <= 2);
+    let cut_factor = || -> Option<Dd> {
+        if energy.sharp.is_empty() {
+            return Some(factor_dd(k_factor));
+        }
+        if !edge_rows {
+            return None;
+        }
+        let keep: Vec<bool> = f1.row_supports().iter().map(|r| r.iter().all(|&v| !sharp[v])).collect();
+        Some(f1.select_rows(&keep))
+    };
+    let mut rows: Vec<Vec<(usize, fx128)>> = vec![Vec::new(); n];
+    let mut base = 0;
+    for (&(order, w), &s) in energy.terms.iter().zip(scale) {
+        let c = w * s;
+        if c == 0.0 {
+            continue;
+        }
+        let g = || kd.scale_rows(&d); // S M⁻¹ K
+        let f = match order {
+            1 => factor_dd(k_factor),
+            2 => kd.scale_rows(&root_d),
+            3 => cut_factor()?.mul(&g()),
+            _ => {
+                let k_cut =
+                    if energy.sharp.is_empty() { kd.mul(&g()) } else { Dd::of(&cut_edges(k, &sharp)).mul(&g()) };
+                k_cut.scale_rows(&root_minv)
+            }
+        }
+        .without_empty_rows();
+        let root = (fx128::from(w) * fx128::from(s)).sqrt();
+        for (j, col) in f.cols.iter().enumerate() {
+            rows[j].extend(col.iter().map(|&(i, v)| (base + i, root * v)));
+        }
+        base += f.nrows;
+    }
+    Some(Factor::from_dd(&Dd { nrows: base, cols: rows }))
+}
+
+fn factor_dd(f: &Factor) -> Dd {
+    let (cp, ri) = (f.matrix.symbolic().col_ptr(), f.matrix.symbolic().row_idx());
+    Dd {
+        nrows: f.matrix.nrows(),
+        cols: (0..f.matrix.ncols()).map(|j| (cp[j]..cp[j + 1]).map(|p| (ri[p], f.entry(p))).collect()).collect(),
+    }
+}

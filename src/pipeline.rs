@@ -479,6 +479,9 @@ pub struct FitReport {
     pub gap: Option<f64>,
     /// Ĝ ÷ the data term of f.
     pub gap_over_data: Option<f64>,
+    /// Ĝ ÷ the smoothness energy of f (with `--data-weight 0` the only measure: Ĝ then needs
+    /// one solve with the energy's matrix).
+    pub gap_over_energy: Option<f64>,
     /// ‖f − f*‖_M ≤ √(Ĝ / γD) (mass-weighted; `null` when the output is not feasible for the
     /// QP as written, see `why_no_bound`).
     pub distance_bound: Option<f64>,
@@ -519,6 +522,12 @@ impl FitReport {
             (None, Some(g)) => format!(
                 "gap bound {:.2e} = {g:.1e} × the data term, no distance claimed: {}{cond}{form}",
                 self.gap.unwrap_or(0.0),
+                self.why_no_bound.as_deref().unwrap_or("")
+            ),
+            (None, None) if self.gap_over_energy.is_some() => format!(
+                "gap {:.2e} = {:.1e} × the energy (no data term; {}){cond}{form}",
+                self.gap.unwrap_or(0.0),
+                self.gap_over_energy.unwrap_or(0.0),
                 self.why_no_bound.as_deref().unwrap_or("")
             ),
             _ => format!("no optimality bound: {}{cond}{form}", self.why_no_bound.as_deref().unwrap_or("")),
@@ -570,9 +579,11 @@ fn fit_report(
     let bounded = o.gap.is_finite();
     let mass: f64 = (0..n).filter(|&i| !qp.fixed[i]).map(|i| m[i]).sum();
     // J = 2φ + const, so Ĝ_J = 2 Ĝ_φ; ‖f − f*‖_M = ‖f − f*‖_D / √γD ≤ √(2 Ĝ_φ / γD)
-    let distance = o.distance.filter(|_| gd > 0.0).map(|d| d / gd.sqrt());
+    let distance = o.distance.filter(|_| gd > 0.0 && !o.by_solve).map(|d| d / gd.sqrt());
     let why_no_bound = if !bounded {
-        Some("a free vertex has no data weight (P ⪰ γD·M does not bound the gap)".to_string())
+        Some("the energy's matrix could not be solved with (no data term)".to_string())
+    } else if o.by_solve {
+        Some("without a data term the distance is bounded in the energy's norm only".to_string())
     } else if o.min_slack < 0.0 {
         Some(format!(
             "the output violates a constraint row by {:.1e} (rounding at the margin), so it is not feasible for the QP as written",
@@ -584,6 +595,7 @@ fn fit_report(
     FitReport {
         gap: bounded.then_some(2.0 * o.gap),
         gap_over_data: (bounded && o.data > 0.0).then(|| o.gap / o.data),
+        gap_over_energy: (bounded && o.energy > 0.0).then(|| o.gap / o.energy),
         distance_bound: distance,
         relative_distance_bound: distance.map(|d| d / mass.max(f64::MIN_POSITIVE).sqrt() / range),
         min_slack: o.min_slack,

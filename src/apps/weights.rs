@@ -110,6 +110,9 @@ pub struct WeightFunction {
     pub solver_iterations: u32,
     /// Vertices the rounding repair changed.
     pub repaired: usize,
+    /// Gap `sᵀz + ½ ρᵀP⁻¹ρ` of the monotone QP at the certified function, ÷ its energy
+    /// (SPEC.md: without a data term, by one solve with the energy's matrix).
+    pub gap_over_energy: Option<f64>,
     /// Seconds for this function (its representative, constraints, solve, repair, certificate).
     pub seconds: f64,
 }
@@ -138,6 +141,7 @@ impl WeightFunction {
             solver_status: None,
             solver_iterations: 0,
             repaired: 0,
+            gap_over_energy: None,
             seconds: 0.0,
         })
     }
@@ -276,6 +280,8 @@ fn one_function<D: Smoothable>(
             out.solver_status = Some(sol.status);
             out.solver_iterations = sol.iterations;
             out.repaired = r.changed_vertices;
+            let o = crate::solve::optimality(&qp, &f, &sol.z, None);
+            out.gap_over_energy = (o.gap.is_finite() && o.energy > 0.0).then(|| o.gap / o.energy);
             f
         }
         WeightMethod::Unconstrained => dirichlet_solve(&ops.energy, fixed)

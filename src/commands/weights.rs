@@ -369,7 +369,7 @@ fn finish(
     );
     for (h, f) in w.functions.iter().enumerate() {
         text += &format!(
-            "  {:<14} {:>5} handle vertices, {:>5} filled: {}; {} spurious (exact), {} (1e-9); {} iterations, {} s\n",
+            "  {:<14} {:>5} handle vertices, {:>5} filled: {}; {} spurious (exact), {} (1e-9); {} iterations{}, {} s\n",
             names[h],
             sets[h].len(),
             f.filled,
@@ -381,6 +381,7 @@ fn finish(
             f.spurious.exact,
             f.spurious.tolerance_1e9,
             f.solver_iterations,
+            f.gap_over_energy.map(|g| format!(" (gap {g:.1e} × the energy)")).unwrap_or_default(),
             sig6(f.seconds)
         );
     }

@@ -246,14 +246,22 @@ pub(super) trait Objective<T: Real> {
     fn solve_in_place(&mut self, rhs: &mut [T]);
     /// The auxiliary variables `t = F x + g` (factored form), rounded.
     fn auxiliary(&self, x: &[T]) -> Option<Vec<f64>>;
+    /// `½ rᵀ P⁻¹ r`, for the gap of a QP without a data term (no `P ⪰ diag(d)` to bound it
+    /// by): `None` where the objective cannot solve with `P` alone.
+    fn energy_dual(&mut self, _r: &[T]) -> Option<f64> {
+        None
+    }
 }
 
 /// `P` assembled; normal equations in double precision.
 struct Assembled<'r> {
     r: &'r ReducedQp,
     normal: Normal,
+    analysis: std::rc::Rc<ordering::Analysis>,
     spd: ordering::SpdFactor,
     vals: Vec<f64>,
+    /// `P` alone factorised (on the normal matrix's pattern), for [`Objective::energy_dual`].
+    energy: Option<ordering::SpdFactor>,
 }
 
 impl Objective<f64> for Assembled<'_> {
@@ -306,6 +314,21 @@ impl Objective<f64> for Assembled<'_> {
     fn auxiliary(&self, _: &[f64]) -> Option<Vec<f64>> {
         None
     }
+
+    fn energy_dual(&mut self, r: &[f64]) -> Option<f64> {
+        if self.energy.is_none() {
+            let mut vals = vec![0.0; self.vals.len()];
+            for (k, &(_, _, v)) in self.r.p.iter().enumerate() {
+                vals[self.normal.pos_p[k]] += v;
+            }
+            let mut f = ordering::SpdFactor::new(self.analysis.clone()).ok()?;
+            f.factor(SparseColMatRef::new(self.normal.symbolic.as_ref(), &vals)).ok()?;
+            self.energy = Some(f);
+        }
+        let mut y = r.to_vec();
+        self.energy.as_mut()?.solve_in_place(&mut y);
+        Some(0.5 * r.iter().zip(&y).map(|(a, b)| a * b).sum::<f64>())
+    }
 }
 
 /// The largest relative change of the iterate in one step at which the solver may stop (the
@@ -340,11 +363,11 @@ pub(super) fn solve(r: &ReducedQp, hint: Option<&[f64]>, settings: &QpSettings) 
             })?;
             let spare = spare.filter(|(a, _)| std::rc::Rc::ptr_eq(a, &analysis));
             let spd = match spare {
-                Some((_, workspace)) => ordering::SpdFactor::with_workspace(analysis, workspace),
-                None => ordering::SpdFactor::new(analysis)?,
+                Some((_, workspace)) => ordering::SpdFactor::with_workspace(analysis.clone(), workspace),
+                None => ordering::SpdFactor::new(analysis.clone())?,
             };
             let vals = vec![0.0f64; normal.symbolic.row_idx().len()];
-            let mut objective = Assembled { r, normal, spd, vals };
+            let mut objective = Assembled { r, normal, analysis, spd, vals, energy: None };
             run::<f64, _>(r, &rows, &mut objective, hint, settings)
         }
     }
@@ -437,6 +460,12 @@ fn run<T: Real, O: Objective<T>>(
     for it in 0..settings.max_iter {
         // residuals
         objective.gradient(&x, &mut rd);
+        // φ(x) = ½ xᵀ(∇φ + q), the objective (up to the fixed part's constant)
+        let phi = if has_data {
+            0.0
+        } else {
+            0.5 * x.iter().zip(rd.iter().zip(&r.q)).map(|(x, (g, q))| (*x * (*g + of(*q))).to_f64()).sum::<f64>()
+        };
         rows.atz(&z, &mut tmp_n);
         for i in 0..n {
             rd[i] += tmp_n[i];
@@ -483,9 +512,20 @@ fn run<T: Real, O: Objective<T>>(
                 // the bound has reached its rounding floor, within 100× the target
                 return Ok(finish(&x, &z, SolveStatus::AlmostSolved, it, objective));
             }
-        } else if pres <= tol && dres <= tol && mu <= tol_mu {
-            return Ok(finish(&x, &z, SolveStatus::Solved, it, objective));
         } else {
+            // without a data term: the gap sᵀz + ½ ρᵀP⁻¹ρ against the energy ½ fᵀQf (P
+            // factorised once), or, where P cannot be solved alone, the mean complementarity
+            let energy = phi + r.constant;
+            let gap = objective
+                .energy_dual(&rd)
+                .map(|dual| slack.iter().zip(&z).map(|(s, z)| (max(*s, zero) * *z).to_f64()).sum::<f64>() + dual);
+            let converged = match gap {
+                Some(gap) => pres <= tol && small_step && gap <= settings.gap_tolerance * energy.abs().max(1e-300),
+                None => pres <= tol && dres <= tol && mu <= tol_mu,
+            };
+            if converged {
+                return Ok(finish(&x, &z, SolveStatus::Solved, it, objective));
+            }
             fallback_status = None;
         }
         for k in 0..m {

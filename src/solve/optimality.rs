@@ -17,8 +17,14 @@ use faer::fx128;
 /// The gap bound of a point and what it is made of, in the units of the QP as given.
 #[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
 pub struct Optimality {
-    /// Ĝ ≥ φ(f) − φ* (infinite without a data term on every free entry).
+    /// Ĝ ≥ φ(f) − φ*. Without a data term on every free entry, `sᵀz + ½ ρᵀP⁻¹ρ` by one solve
+    /// with `P` (infinite if that fails).
     pub gap: f64,
+    /// Whether `gap` needed that solve (no data term): `distance` is then in the norm of `P`.
+    pub by_solve: bool,
+    /// `φ(f) − qᵀf` restricted to the quadratic part, `½ fᵀPf`: what the gap is measured
+    /// against without a data term.
+    pub energy: f64,
     /// The data term `½ Σ d_i (f_i − c_i)²` (with `q = −d∘c`).
     pub data: f64,
     /// The smallest slack `b − A f` (≥ 0 when f is feasible).
@@ -29,7 +35,8 @@ pub struct Optimality {
     pub dual_residual: f64,
     /// `‖F f − y‖` (factored form; 0 otherwise).
     pub auxiliary_residual: f64,
-    /// `‖f − f*‖_D ≤ √(2 Ĝ)`, when f is feasible (`None` when some slack is negative).
+    /// `‖f − f*‖_D ≤ √(2 Ĝ)` (`‖f − f*‖_P` when `by_solve`), when f is feasible (`None` when
+    /// some slack is negative).
     pub distance: Option<f64>,
 }
 
@@ -139,20 +146,62 @@ pub fn optimality(qp: &MonotoneQp<'_>, f: &[f64], z: &[f64], y: Option<&[f64]>) 
         }
     }
     let complementarity = round(complementarity);
-    let stationarity = round(stationarity);
-    let gap = if bounded {
-        complementarity + 0.5 * stationarity + 0.5 * auxiliary_residual * auxiliary_residual
-    } else {
-        f64::INFINITY
+    let mut stationarity = round(stationarity);
+    let by_solve = !bounded;
+    if by_solve {
+        // no data term: ½ ρᵀP⁻¹ρ by one solve with P on the free entries
+        stationarity = solve_with_p(qp, &free, &rho).unwrap_or(f64::INFINITY);
+    }
+    let gap = complementarity + 0.5 * stationarity + 0.5 * auxiliary_residual * auxiliary_residual;
+    let energy = {
+        let (cp, ri, v) = (qp.p.symbolic().col_ptr(), qp.p.symbolic().row_idx(), qp.p.val());
+        let mut e = dd(0.0);
+        for j in 0..n {
+            for p in cp[j]..cp[j + 1] {
+                e += product(v[p], f[ri[p]]) * dd(f[j]);
+            }
+        }
+        0.5 * round(e)
     };
     let min_slack = if rows.is_empty() { 0.0 } else { min_slack };
     Optimality {
         gap,
+        by_solve,
+        energy,
         data: 0.5 * round(data),
         min_slack,
         complementarity,
         dual_residual: stationarity.sqrt(),
         auxiliary_residual,
-        distance: (bounded && min_slack >= 0.0).then(|| (2.0 * gap.max(0.0)).sqrt()),
+        distance: (gap.is_finite() && min_slack >= 0.0).then(|| (2.0 * gap.max(0.0)).sqrt()),
     }
+}
+
+/// `ρ_Fᵀ P_FF⁻¹ ρ_F` for the free entries (`None` if `P_FF` is not numerically positive
+/// definite).
+fn solve_with_p(qp: &MonotoneQp<'_>, free: &[bool], rho: &[fx128]) -> Option<f64> {
+    let n = free.len();
+    let mut slot = vec![usize::MAX; n];
+    let mut nf = 0;
+    for (i, &is_free) in free.iter().enumerate() {
+        if is_free {
+            slot[i] = nf;
+            nf += 1;
+        }
+    }
+    let (cp, ri, v) = (qp.p.symbolic().col_ptr(), qp.p.symbolic().row_idx(), qp.p.val());
+    let mut t = Vec::new();
+    for j in 0..n {
+        for p in cp[j]..cp[j + 1] {
+            let (si, sj) = (slot[ri[p]], slot[j]);
+            if si != usize::MAX && sj != usize::MAX && si <= sj {
+                t.push(faer::sparse::Triplet::new(si, sj, v[p]));
+            }
+        }
+    }
+    let upper = crate::operators::Sparse::try_new_from_triplets(nf, nf, &t).ok()?;
+    let r: Vec<f64> = (0..n).filter(|&i| free[i]).map(|i| round(rho[i])).collect();
+    let mut y = r.clone();
+    crate::linalg::solve_spd_once(upper.as_ref(), &mut y).ok()?;
+    Some(r.iter().zip(&y).map(|(a, b)| a * b).sum())
 }

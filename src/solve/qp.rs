@@ -229,6 +229,9 @@ pub struct ReducedQp {
     pub factor: Option<ReducedFactor>,
     /// The factor the objective was divided by.
     pub scale: f64,
+    /// `½ x_Xᵀ P_XX x_X` (scaled): the objective of the fixed part, so that `φ(x) + constant`
+    /// is `½ fᵀPf + qᵀf` of the whole vector (less the fixed part's linear term).
+    pub constant: f64,
 }
 
 impl ReducedQp {
@@ -361,10 +364,12 @@ fn reduce(qp: &MonotoneQp<'_>, free: &[usize]) -> ReducedQp {
     let mut q: Vec<f64> = free.iter().map(|&i| qp.q[i]).collect();
     let (cp, ri, val) = (qp.p.symbolic().col_ptr(), qp.p.symbolic().row_idx(), qp.p.val());
     let mut p = Vec::new();
+    let mut constant = 0.0;
     for j in 0..n {
         for k in cp[j]..cp[j + 1] {
             let i = ri[k];
             match (slot[i], slot[j]) {
+                (usize::MAX, usize::MAX) => constant += 0.5 * xfix(i) * val[k] * xfix(j),
                 (usize::MAX, _) => {}
                 (si, usize::MAX) => q[si] += val[k] * xfix(j),
                 (si, sj) if si <= sj => p.push((si, sj, val[k])),
@@ -393,6 +398,7 @@ fn reduce(qp: &MonotoneQp<'_>, free: &[usize]) -> ReducedQp {
         gap_bound,
         factor: None,
         scale,
+        constant: constant / scale,
     };
     for row in constraint_rows(qp) {
         let at = r.b.len();
@@ -434,6 +440,7 @@ fn reduce(qp: &MonotoneQp<'_>, free: &[usize]) -> ReducedQp {
 /// Divides the objective of `r` by a further `by` (its `scale` becomes `scale · by`).
 fn rescale(r: &mut ReducedQp, by: f64) {
     r.p.iter_mut().for_each(|t| t.2 /= by);
+    r.constant /= by;
     for v in r.q.iter_mut().chain(r.d.iter_mut()).chain(r.q_free.iter_mut()) {
         *v /= by;
     }

@@ -387,3 +387,85 @@ fn outputs_never_overwrite_inputs_or_half_write() {
     let o = toposmooth(&["verify", &vti, "--input", &piv, "--fill-missing"]);
     assert_eq!(o.status.code(), Some(0), "{}", text(&o));
 }
+
+/// Item 5 of issue 15: a representative given with `--representative` is built or refused,
+/// never replaced. A plateau at 8 with a dip to 5 beside a plain at 2 with a bump to 4: the
+/// harmonic representative (0 at every kept minimum, 1 at every kept maximum) runs up from the
+/// dip (a kept minimum at 5) to the bump (a kept maximum at 4), which no strict function with
+/// those values can follow: exit 3 naming both. On few-valued random grids an explicit
+/// separatrix representative certifies as itself or exits 1 naming the vertices, and the
+/// automatic choice names every fallback in the summary and the report.
+#[test]
+fn an_explicit_representative_is_built_or_refused() {
+    let dir = scratch("explicit-representative");
+    let (nx, ny) = (20, 10);
+    let mut rows = vec![vec![0.0f64; nx]; ny];
+    for (r, row) in rows.iter_mut().enumerate() {
+        for (c, v) in row.iter_mut().enumerate() {
+            let g = |cx: f64, cy: f64| (-((c as f64 - cx).powi(2) + (r as f64 - cy).powi(2)) / 2.0).exp();
+            *v = if c < 10 { 8.0 - 3.0 * g(7.0, 5.0) } else { 2.0 + 2.0 * g(12.0, 5.0) };
+        }
+    }
+    rows[9][0] = 10.0;
+    rows[0][19] = 0.0;
+    let csv = path(&dir, "plateau.csv");
+    let body: Vec<String> =
+        rows.iter().map(|r| r.iter().map(|v| format!("{v:?}")).collect::<Vec<_>>().join(",")).collect();
+    std::fs::write(&csv, body.join("\n") + "\n").unwrap();
+    let out = path(&dir, "out.npz");
+    let o = toposmooth(&["smooth", &csv, "-o", &out, "--persistence", "15%", "--representative", "harmonic"]);
+    assert_eq!(o.status.code(), Some(3), "{}", text(&o));
+    let msg = text(&o);
+    let (dip, bump) = (5 * nx + 7, 5 * nx + 12);
+    assert!(
+        msg.contains(&format!("kept minimum {dip} (value 5)"))
+            && msg.contains(&format!("kept maximum {bump} (value 4)")),
+        "{msg}"
+    );
+    assert!(!Path::new(&out).exists(), "no output written");
+    // few-valued grids
+    let (mut explicit_ok, mut explicit_refused, mut fallbacks) = (0, 0, 0);
+    for seed in 0..40u64 {
+        let r = common::uniform(seed + 1000, 80);
+        let (gx, gy) = (5 + (seed % 6) as usize, 4 + (seed % 5) as usize);
+        let body: Vec<String> = (0..gy)
+            .map(|y| (0..gx).map(|x| format!("{}", (r[(y * gx + x) % 80] * 4.0).floor())).collect::<Vec<_>>().join(","))
+            .collect();
+        let g = path(&dir, &format!("g{seed}.csv"));
+        std::fs::write(&g, body.join("\n") + "\n").unwrap();
+        let json = path(&dir, &format!("g{seed}.json"));
+        let o = toposmooth(&["smooth", &g, "-o", &out, "--representative", "separatrix", "--report", &json]);
+        match o.status.code() {
+            Some(0) => {
+                let rep: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+                assert!(
+                    rep["representative"].as_str().unwrap().starts_with("separatrix"),
+                    "seed {seed}: {}",
+                    rep["representative"]
+                );
+                assert_eq!(rep["representative_fallbacks"].as_array().unwrap().len(), 0, "seed {seed}");
+                explicit_ok += 1;
+            }
+            Some(1) => {
+                let m = text(&o);
+                assert!(m.contains("separatrix representative") && m.contains("vertex"), "seed {seed}: {m}");
+                assert!(m.contains("requested explicitly"), "seed {seed}: {m}");
+                explicit_refused += 1;
+            }
+            c => panic!("seed {seed}: exit {c:?}: {}", text(&o)),
+        }
+        let o = toposmooth(&["smooth", &g, "-o", &out, "--report", &json]);
+        assert!(o.status.success(), "seed {seed}: {}", text(&o));
+        let rep: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+        let used = rep["representative"].as_str().unwrap();
+        let named = rep["representative_fallbacks"].as_array().unwrap();
+        if !used.starts_with("separatrix") {
+            fallbacks += 1;
+            assert!(!named.is_empty(), "seed {seed}: {used} without a named fallback");
+            assert!(text(&o).contains("representative fallback"), "seed {seed}: {}", text(&o));
+        }
+        check_output(&out);
+    }
+    assert_eq!(explicit_ok + explicit_refused, 40);
+    eprintln!("explicit separatrix: {explicit_ok} built, {explicit_refused} refused; automatic fallbacks {fallbacks}");
+}

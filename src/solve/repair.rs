@@ -22,7 +22,6 @@ pub struct RepairSummary {
 /// never change, so kept values stay bit for bit; the passes repeat (at most 4 sweeps) until
 /// no edge is violated. Whether that succeeded is for the certificate to decide.
 pub fn repair(f: &mut [f64], fixed: &[bool], edges: &[(usize, usize)], order: &[usize], delta: f64) -> RepairSummary {
-    let n = f.len();
     // `strictly_below(a, b)` is false for NaN too, so NaN counts as a violation
     let strictly_below = |a: f64, b: f64| a.partial_cmp(&b) == Some(std::cmp::Ordering::Less);
     let violated = |f: &[f64]| edges.iter().filter(|&&(i, j)| !strictly_below(f[i], f[j])).count();
@@ -31,46 +30,16 @@ pub fn repair(f: &mut [f64], fixed: &[bool], edges: &[(usize, usize)], order: &[
         return summary;
     }
     let original = f.to_vec();
-    let mut preds: Vec<Vec<usize>> = vec![Vec::new(); n];
-    let mut succs: Vec<Vec<usize>> = vec![Vec::new(); n];
-    for &(i, j) in edges {
-        preds[j].push(i);
-        succs[i].push(j);
-    }
-    let above = |v: f64| (v + delta).max(v.next_up());
-    let below = |v: f64| (v - delta).min(v.next_down());
-    for _ in 0..4 {
-        summary.sweeps += 1;
-        for &v in order {
-            if fixed[v] {
-                continue;
-            }
-            if let Some(lo) = preds[v].iter().map(|&p| f[p]).reduce(f64::max) {
-                if !strictly_below(lo, f[v]) {
-                    f[v] = above(lo);
-                }
-            }
-        }
-        for &v in order.iter().rev() {
-            if fixed[v] {
-                continue;
-            }
-            if let Some(hi) = succs[v].iter().map(|&s| f[s]).reduce(f64::min) {
-                if !strictly_below(f[v], hi) {
-                    f[v] = below(hi);
-                }
-            }
-        }
-        if violated(f) == 0 {
-            break;
-        }
-    }
-    for (a, b) in original.iter().zip(f.iter()) {
-        if a != b {
-            summary.changed_vertices += 1;
-            summary.max_change = summary.max_change.max((a - b).abs());
-        }
-    }
+    let passes = Passes::new(f.len(), fixed, edges, order);
+    summary.sweeps = passes.run(
+        f,
+        strictly_below,
+        |v| (v + delta).max(v.next_up()),
+        |v| (v - delta).min(v.next_down()),
+        |_, v| v,
+        |f| violated(f) == 0,
+    );
+    (summary.changed_vertices, summary.max_change) = changes(&original, f);
     summary
 }
 
@@ -96,9 +65,9 @@ fn meets(a: f64, b: f64, m: f64) -> bool {
 /// Moves free vertices so that the returned point is feasible for the QP as written: `f_j −
 /// f_i ≥ margin` on every edge `(i, j)` and every bound, exactly (the interior-point solution
 /// meets its rows only to its tolerance, so active rows come back a rounding short). Passes in
-/// `order` (a topological order of the edges) lift each free `f_j` to its in-edges plus the
-/// margin, passes in reverse lower it below its out-edges; fixed values never change. At most
-/// 4 sweeps.
+/// `order` (a topological order of the edges) lift each free `f_j` to the smallest double a
+/// margin above its in-edges, passes in reverse lower it below its out-edges, each held inside
+/// its bounds; fixed values never change. At most 4 sweeps.
 pub fn meet_margin(
     f: &mut [f64],
     fixed: &[bool],
@@ -126,61 +95,95 @@ pub fn meet_margin(
         return summary;
     }
     let original = f.to_vec();
-    let mut preds: Vec<Vec<usize>> = vec![Vec::new(); n];
-    let mut succs: Vec<Vec<usize>> = vec![Vec::new(); n];
-    for &(i, j) in edges {
-        preds[j].push(i);
-        succs[i].push(j);
-    }
-    let above = |a: f64| {
-        let mut t = a + margin;
-        while !meets(a, t, margin) {
-            t = t.next_up();
-        }
-        t
-    };
-    let below = |b: f64| {
-        let mut t = b - margin;
-        while !meets(t, b, margin) {
-            t = t.next_down();
-        }
-        t
-    };
-    for _ in 0..4 {
-        for &v in order {
-            if fixed[v] {
-                continue;
+    let passes = Passes::new(n, fixed, edges, order);
+    passes.run(
+        f,
+        |a, b| meets(a, b, margin),
+        |a| {
+            let mut t = a + margin;
+            while !meets(a, t, margin) {
+                t = t.next_up();
             }
-            for &p in &preds[v] {
-                if !meets(f[p], f[v], margin) {
-                    f[v] = above(f[p]);
-                }
+            t
+        },
+        |b| {
+            let mut t = b - margin;
+            while !meets(t, b, margin) {
+                t = t.next_down();
             }
-            f[v] = f[v].max(lower[v]).min(upper[v]);
-        }
-        for &v in order.iter().rev() {
-            if fixed[v] {
-                continue;
-            }
-            for &s in &succs[v] {
-                if !meets(f[v], f[s], margin) {
-                    f[v] = below(f[s]);
-                }
-            }
-            f[v] = f[v].min(upper[v]).max(lower[v]);
-        }
-        if feasible(f) {
-            summary.met = true;
-            break;
-        }
-    }
-    for (a, b) in original.iter().zip(f.iter()) {
-        if a != b {
-            summary.changed_vertices += 1;
-            summary.max_change = summary.max_change.max((a - b).abs());
-        }
-    }
+            t
+        },
+        |v, x| x.max(lower[v]).min(upper[v]),
+        |f| feasible(f),
+    );
+    summary.met = feasible(f);
+    (summary.changed_vertices, summary.max_change) = changes(&original, f);
     summary
+}
+
+/// The in- and out-edges of every vertex, for passes in a topological order.
+struct Passes<'a> {
+    preds: Vec<Vec<usize>>,
+    succs: Vec<Vec<usize>>,
+    fixed: &'a [bool],
+    order: &'a [usize],
+}
+
+impl<'a> Passes<'a> {
+    fn new(n: usize, fixed: &'a [bool], edges: &[(usize, usize)], order: &'a [usize]) -> Self {
+        let mut preds: Vec<Vec<usize>> = vec![Vec::new(); n];
+        let mut succs: Vec<Vec<usize>> = vec![Vec::new(); n];
+        for &(i, j) in edges {
+            preds[j].push(i);
+            succs[i].push(j);
+        }
+        Passes { preds, succs, fixed, order }
+    }
+
+    /// Up to 4 sweeps: forward, each free `f_v` not `ok` above its highest in-edge is set to
+    /// `above(it)`; backward, one not `ok` below its lowest out-edge to `below(it)`; every free
+    /// value through `clamp` after its turn; stops when `done`. Returns the sweeps run.
+    fn run(
+        &self,
+        f: &mut [f64],
+        ok: impl Fn(f64, f64) -> bool,
+        above: impl Fn(f64) -> f64,
+        below: impl Fn(f64) -> f64,
+        clamp: impl Fn(usize, f64) -> f64,
+        done: impl Fn(&[f64]) -> bool,
+    ) -> usize {
+        for sweep in 1..=4 {
+            for &v in self.order.iter().filter(|&&v| !self.fixed[v]) {
+                if let Some(lo) = self.preds[v].iter().map(|&p| f[p]).reduce(f64::max) {
+                    if !ok(lo, f[v]) {
+                        f[v] = above(lo);
+                    }
+                }
+                f[v] = clamp(v, f[v]);
+            }
+            for &v in self.order.iter().rev().filter(|&&v| !self.fixed[v]) {
+                if let Some(hi) = self.succs[v].iter().map(|&s| f[s]).reduce(f64::min) {
+                    if !ok(f[v], hi) {
+                        f[v] = below(hi);
+                    }
+                }
+                f[v] = clamp(v, f[v]);
+            }
+            if done(f) {
+                return sweep;
+            }
+        }
+        4
+    }
+}
+
+/// How many entries changed, and the largest change.
+fn changes(original: &[f64], f: &[f64]) -> (usize, f64) {
+    original
+        .iter()
+        .zip(f)
+        .filter(|(a, b)| a != b)
+        .fold((0, 0.0), |(c, m), (a, b)| (c + 1, f64::max(m, (a - b).abs())))
 }
 
 #[cfg(test)]

@@ -6,9 +6,12 @@
 //! known before the first iteration. faer's sparse Cholesky analyses that pattern once
 //! (ordering — nested dissection or AMD, whichever needs fewer flops, see `crate::linalg` —
 //! elimination tree, supernodes) and only refactors the values at each iteration:
-//! one factorisation and two solves per iteration, instead of an LDLᵀ of the full
+//! one factorisation and two to four solves per iteration, instead of an LDLᵀ of the full
 //! `(n + m) × (n + m)` KKT system. Starting from the representative u (feasible for every
-//! row) the iteration count stays low. Whatever it returns, the certificate decides.
+//! row) the iteration count stays low. It stops on the gap bound of [`super::optimality`]
+//! against the data term; the factored form (ill-conditioned P) runs the same iteration in
+//! double-double ([`super::factored`]). Whatever it returns, the certificate decides the
+//! topology and the gap bound of the output as written decides the fit.
 
 use super::qp::{Outcome, QpSettings, ReducedQp, SolveStatus};
 use crate::linalg as ordering;

@@ -78,8 +78,9 @@ pub enum Formulation {
 }
 
 /// Condition estimate of `diag(d)^{-½} P diag(d)^{-½}` above which [`Formulation::Auto`]
-/// chooses the factored form: the assembled normal equations lose about
-/// `log10(κ) − 16 + 8` of the 8 digits the gap needs beyond the data term's.
+/// chooses the factored form. An assembled P carries rounding errors of about `10⁻¹⁶ κ`
+/// relative to its smallest eigenvalues, and the gap bound squares the gradient's: at κ = 10⁹
+/// that is `10⁻¹⁴` of the data term, ample; at 10¹¹ it reaches the bound's target (10⁻⁷ of it).
 pub const FACTORED_ABOVE: f64 = 1e9;
 
 /// Solver settings.

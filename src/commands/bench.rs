@@ -205,6 +205,8 @@ fn run_single(case: BenchCase, args: &BenchArgs) -> Result<String> {
         "representative": rep.representative,
         "status": format!("{:?}", rep.solver_status),
         "certified": rep.certificate.passed,
+        "gap_over_data": rep.fit.gap_over_data,
+        "formulation": rep.fit.formulation,
         "seconds": rep.seconds,
         "total": total,
         "peak_rss_mib": peak_rss_mib(),
@@ -221,7 +223,7 @@ pub fn bench(args: &BenchArgs) -> Result<String> {
     let exe = std::env::current_exe().map_err(|source| Error::Io { path: "current executable".into(), source })?;
     let order = args.energy.terms.iter().map(|(k, w)| format!("{k}:{w}")).collect::<Vec<_>>().join(",");
     let mut out = String::from(
-        "| size | input extrema | kept | constraints | iterations | read s | geodesic s | persistence s | complex s | simplify s | representative s | operators s | constraints s | solve s | repair s | verify s | total s | peak MiB |\n|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n",
+        "| size | input extrema | kept | constraints | iterations | Ĝ ÷ data | read s | geodesic s | persistence s | complex s | simplify s | representative s | operators s | constraints s | solve s | repair s | verify s | total s | peak MiB |\n|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n",
     );
     for case in &args.cases {
         let child = std::process::Command::new(&exe)
@@ -260,12 +262,13 @@ pub fn bench(args: &BenchArgs) -> Result<String> {
         let s = &v["seconds"];
         let f = |x: &serde_json::Value| x.as_f64().unwrap_or(f64::NAN);
         out += &format!(
-            "| {} | {} | {} | {} | {} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} | {:.0} |\n",
+            "| {} | {} | {} | {} | {} | {:.1e} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} | {:.0} |\n",
             case.label(),
             v["input_extrema"],
             v["kept"],
             v["constraints"],
             v["iterations"],
+            f(&v["gap_over_data"]),
             v["extra"]["read"].as_f64().unwrap_or(0.0),
             v["extra"]["geodesic"].as_f64().unwrap_or(0.0),
             f(&s["persistence"]),

@@ -179,11 +179,7 @@ impl<'a> Passes<'a> {
 
 /// How many entries changed, and the largest change.
 fn changes(original: &[f64], f: &[f64]) -> (usize, f64) {
-    original
-        .iter()
-        .zip(f)
-        .filter(|(a, b)| a != b)
-        .fold((0, 0.0), |(c, m), (a, b)| (c + 1, f64::max(m, (a - b).abs())))
+    original.iter().zip(f).filter(|(a, b)| a != b).fold((0, 0.0), |(c, m), (a, b)| (c + 1, f64::max(m, (a - b).abs())))
 }
 
 #[cfg(test)]

@@ -90,3 +90,29 @@ fn power(d: &[f64], apply: impl Fn(&[f64], &mut [f64])) -> f64 {
     }
     lambda.max(1.0)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::domain::Series;
+    use crate::operators::{plus_diagonal, polyharmonic, series_mass, series_stiffness, Energy};
+
+    #[test]
+    fn the_estimate_follows_four_to_the_k_times_the_length_ratio() {
+        // uniform unit spacing: λ_max(M⁻¹K) → 4, so λ_max(D^{-½}PD^{-½}) → 1 + γ 4^k
+        let s = Series::uniform(400);
+        let (k, m) = (series_stiffness(&s), series_mass(&s));
+        let fixed = vec![None; 400];
+        for order in 1..=3u8 {
+            let gamma = 10f64.powi(2 * order as i32); // ℓ = 10 samples
+            let p = plus_diagonal(polyharmonic(&k, &m, &Energy::order(order), &[gamma]), &m);
+            let est = condition_estimate(&p, &m, &fixed).unwrap();
+            let expected = 1.0 + gamma * 4f64.powi(order as i32);
+            assert!(est <= expected * 1.05 && est >= expected * 0.7, "order {order}: {est:e} against {expected:e}");
+        }
+        // no data weight at a free vertex: no estimate
+        let mut d = m.clone();
+        d[3] = 0.0;
+        assert!(condition_estimate(&series_stiffness(&s), &d, &fixed).is_none());
+    }
+}

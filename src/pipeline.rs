@@ -479,8 +479,8 @@ pub struct FitReport {
     pub gap: Option<f64>,
     /// Ĝ ÷ the data term of f.
     pub gap_over_data: Option<f64>,
-    /// Ĝ ÷ the smoothness energy of f (with `--data-weight 0` the only measure: Ĝ then needs
-    /// one solve with the energy's matrix).
+    /// Without a data term (`--data-weight 0`): the gap `sᵀz + ½ρᵀP⁻¹ρ` (one solve with the
+    /// energy's matrix) ÷ the energy of f.
     pub gap_over_energy: Option<f64>,
     /// ‖f − f*‖_M ≤ √(Ĝ / γD) (mass-weighted; `null` when the output is not feasible for the
     /// QP as written, see `why_no_bound`).
@@ -595,7 +595,7 @@ fn fit_report(
     FitReport {
         gap: bounded.then_some(2.0 * o.gap),
         gap_over_data: (bounded && o.data > 0.0).then(|| o.gap / o.data),
-        gap_over_energy: (bounded && o.energy > 0.0).then(|| o.gap / o.energy),
+        gap_over_energy: (bounded && o.by_solve && o.energy > 0.0).then(|| o.gap / o.energy),
         distance_bound: distance,
         relative_distance_bound: distance.map(|d| d / mass.max(f64::MIN_POSITIVE).sqrt() / range),
         min_slack: o.min_slack,

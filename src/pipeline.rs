@@ -153,12 +153,15 @@ fn surface_representative<D: Domain>(
     // the matched saddles first; if u fails its check, once more with the one-sided saddles
     // (a kept boundary extremum's partner is often one: without its separatrices the cells
     // beside it reach along the boundary to values beyond it)
+    // (u is built from the values with their ties broken as the complex broke them, SoS: a
+    // saddle and an extremum of equal input value no longer give a flat separatrix)
     let separatrix = |why: &mut Vec<String>| -> Option<Vec<f64>> {
         let matched = complex.as_ref()?;
         let merged = matched.with_one_sided();
+        let untied = crate::domain::sos_untied(h);
         let mut first_failure = None;
         for (attempt, ms) in std::iter::once(matched).chain(merged.as_ref()).enumerate() {
-            match separatrix_representative(domain, h, kept, ms, k) {
+            match separatrix_representative(domain, &untied, kept, ms, k) {
                 Ok((u, r)) => {
                     let c = certify(domain, &u, &kept.roles, None);
                     if c.passed {

@@ -21,7 +21,7 @@ use crate::operators::{
     plus_diagonal, polyharmonic, polyharmonic_factor, positive_cotan_stiffness, quadratic_form_without_diagonal,
     series_mass, series_stiffness, Energy, Factor, Sparse,
 };
-use crate::representative::{flooded_representative, separatrix_representative, series_representative};
+use crate::representative::{flooded_representative, separatrix_representative, series_representative, Repairs};
 use crate::solve::{
     condition_estimate, meet_margin, optimality, repair, solve_monotone_qp, Bound, Formulation, MarginSummary, Method,
     MonotoneQp, QpSettings, RepairSummary, SolveStatus, FACTORED_ABOVE,
@@ -147,37 +147,43 @@ fn surface_representative<D: Domain>(
             None
         }
     };
-    let released = std::cell::Cell::new(0);
+    let repairs = std::cell::Cell::new(Repairs::default());
     let one_sided_saddles = std::cell::Cell::new(0);
     let merged_used: std::cell::RefCell<Option<MorseSmale>> = std::cell::RefCell::new(None);
     // the matched saddles first; if u fails its check, once more with the one-sided saddles
     // (a kept boundary extremum's partner is often one: without its separatrices the cells
-    // beside it reach along the boundary to values beyond it)
+    // beside it reach along the boundary to values beyond it); then both again with failing
+    // kept extrema moved outward instead of released around (few-valued data: a kept minimum
+    // beside free vertices the fill holds below it). u is built from the values with their
+    // ties broken as the complex broke them (SoS): a saddle and an extremum of equal input
+    // value no longer give a flat separatrix.
     let separatrix = |why: &mut Vec<String>| -> Option<Vec<f64>> {
         let matched = complex.as_ref()?;
         let merged = matched.with_one_sided();
-        let mut first_failure = None;
-        for (attempt, ms) in std::iter::once(matched).chain(merged.as_ref()).enumerate() {
-            match separatrix_representative(domain, h, kept, ms, k) {
+        let untied = crate::domain::sos_untied(h);
+        let complexes: Vec<&MorseSmale> = std::iter::once(matched).chain(merged.as_ref()).collect();
+        let attempts = [false, true].into_iter().flat_map(|moving| complexes.iter().map(move |&ms| (ms, moving)));
+        // the failure of the last attempt (the most mended one) is the one reported
+        let mut last_failure = None;
+        for (ms, move_kept) in attempts {
+            match separatrix_representative(domain, &untied, kept, ms, k, move_kept) {
                 Ok((u, r)) => {
                     let c = certify(domain, &u, &kept.roles, None);
                     if c.passed {
-                        released.set(r);
-                        if attempt > 0 {
+                        repairs.set(r);
+                        if !std::ptr::eq(ms, matched) {
                             // the one-sided saddles are never matched ones
                             one_sided_saddles.set(ms.saddles.len() - matched.saddles.len());
                             *merged_used.borrow_mut() = Some(ms.clone());
                         }
                         return Some(u);
                     }
-                    first_failure.get_or_insert(format!("separatrix representative: {}", c.summary()));
+                    last_failure = Some(format!("separatrix representative: {}", c.summary()));
                 }
-                Err(e) => {
-                    first_failure.get_or_insert(format!("separatrix representative: {e}"));
-                }
+                Err(e) => last_failure = Some(format!("separatrix representative: {e}")),
             }
         }
-        why.extend(first_failure);
+        why.extend(last_failure);
         None
     };
     let harmonic = |why: &mut Vec<String>| -> Option<Vec<f64>> {
@@ -220,9 +226,23 @@ fn surface_representative<D: Domain>(
         if name == "separatrix" && one_sided_saddles.get() > 0 {
             name = format!("separatrix with {} one-sided saddles", one_sided_saddles.get());
         }
-        if name.starts_with("separatrix") && released.get() > 0 {
-            name =
-                format!("{name} ({} contradicting separatrix vertices released to the harmonic fill)", released.get());
+        if !name.starts_with("separatrix") {
+            return name;
+        }
+        let r = repairs.get();
+        let mut changes = Vec::new();
+        if r.released > 0 {
+            changes.push(format!("{} contradicting separatrix vertices released to the harmonic fill", r.released));
+        }
+        let plural = |n: usize, one: &str, many: &str| format!("{n} {}", if n == 1 { one } else { many });
+        if r.moved > 0 {
+            changes.push(format!("{} moved outward", plural(r.moved, "kept value", "kept values")));
+        }
+        if r.pinned > 0 {
+            changes.push(format!("{} pinned beside them", plural(r.pinned, "free vertex", "free vertices")));
+        }
+        if !changes.is_empty() {
+            name = format!("{name} ({})", changes.join(", "));
         }
         name
     };

@@ -174,7 +174,10 @@ fn strictify(u: &mut [f64], anchors: &[(usize, Role)]) {
 ///
 /// Where separatrix values contradict each other (a prescribed vertex becomes a spurious
 /// extremum or a free one flat), those vertices and their prescribed neighbours are released
-/// to the harmonic fill and the solve repeated; returns u and how many vertices were released.
+/// to the harmonic fill and the solve repeated. Around a kept extremum that is not strict the
+/// release widens ring by ring; with `move_kept` the extremum's value is moved outward instead
+/// ([`outward_moves`]; u's values at kept extrema may be rescaled, SPEC). Returns u and what
+/// was changed.
 ///
 /// # Errors
 /// A message when the harmonic solve fails; the caller checks the result with the
@@ -185,7 +188,8 @@ pub fn separatrix_representative<D: crate::domain::Domain>(
     kept: &KeptSet,
     ms: &crate::topology::morse_smale::MorseSmale,
     k: &crate::operators::Sparse,
-) -> std::result::Result<(Vec<f64>, usize), String> {
+    move_kept: bool,
+) -> std::result::Result<(Vec<f64>, Repairs), String> {
     let n = h.len();
     let mut down = vec![f64::INFINITY; n];
     let mut up = vec![f64::NEG_INFINITY; n];
@@ -242,6 +246,12 @@ pub fn separatrix_representative<D: crate::domain::Domain>(
     let mut reach: std::collections::HashMap<usize, usize> = std::collections::HashMap::new();
     let mut gone = vec![false; separatrices.len()];
     let mut count = 0;
+    let (mut moved, mut pinned) = (std::collections::BTreeSet::new(), std::collections::BTreeSet::new());
+    let unit = {
+        let (lo, hi) = crate::domain::value_range(h);
+        hi - lo
+    };
+    let mut prescribed = prescribed;
     for _ in 0..MAX_RELEASE_ROUNDS {
         let fixed: Vec<Option<f64>> = (0..n).map(|v| if released[v] { None } else { prescribed[v] }).collect();
         let u = dirichlet.solve(&fixed)?;
@@ -253,7 +263,24 @@ pub fn separatrix_representative<D: crate::domain::Domain>(
                 _ => false,
             })
             .collect();
+        let repairs = Repairs { released: count, moved: moved.len(), pinned: pinned.len() };
+        if bad.is_empty() {
+            return Ok((u, repairs));
+        }
         let mut progress = false;
+        if move_kept {
+            // failing kept extrema move outward instead of releasing the rings around them
+            for (v, value) in outward_moves(domain, kept, &fixed, &u, &mut dirichlet, k, unit)? {
+                if kept.roles[v].is_fixed() {
+                    moved.insert(v);
+                } else {
+                    pinned.insert(v);
+                }
+                prescribed[v] = Some(value);
+                released[v] = false;
+                progress = true;
+            }
+        }
         let release = |w: usize, released: &mut Vec<bool>, count: &mut usize| {
             if fixed[w].is_some() && !kept.roles[w].is_fixed() && !released[w] {
                 released[w] = true;
@@ -269,6 +296,9 @@ pub fn separatrix_representative<D: crate::domain::Domain>(
             // farther out hold them up; doubling the radius instead made the retina image
             // release too much and fall back to the harmonic representative)
             let around: Vec<usize> = if kept.roles[v].is_fixed() {
+                if move_kept {
+                    continue;
+                }
                 // widen until the rings hold a vertex still prescribed (at most 64 rings)
                 let r = reach.entry(v).or_insert(0);
                 loop {
@@ -301,12 +331,93 @@ pub fn separatrix_representative<D: crate::domain::Domain>(
                 }
             }
         }
-        if bad.is_empty() || !progress {
-            return Ok((u, count));
+        if !progress {
+            return Ok((u, repairs));
         }
     }
     Err(format!("separatrix vertices still contradict each other after {MAX_RELEASE_ROUNDS} rounds of releasing them"))
 }
+
+/// What [`separatrix_representative`] changed in the paper's construction.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Repairs {
+    /// Prescribed vertices released to the harmonic fill (counted each time).
+    pub released: usize,
+    /// Kept extrema whose value was moved outward.
+    pub moved: usize,
+    /// Free vertices prescribed between a kept extremum and its other neighbours.
+    pub pinned: usize,
+}
+
+/// New values for the kept extrema that are not strict in the fill `u` of `fixed`, each
+/// moved outward (a maximum up, a minimum down) far enough to clear its neighbours. This
+/// mends what releasing cannot: the fill holding a kept extremum's free neighbours beyond it
+/// from prescribed values farther out (a kept minimum beside lower harmonic values). The fill
+/// is linear in the fixed values: a second solve with each failing value moved by `unit`
+/// gives the fraction of the move each neighbour follows, and the move clears the farthest
+/// neighbour with a quarter to spare. A free neighbour that follows (almost) fully is given a
+/// value (pinned) instead, halfway to its farthest other neighbour.
+fn outward_moves<D: crate::domain::Domain>(
+    domain: &D,
+    kept: &KeptSet,
+    fixed: &[Option<f64>],
+    u: &[f64],
+    dirichlet: &mut crate::operators::Dirichlet,
+    k: &crate::operators::Sparse,
+    unit: f64,
+) -> std::result::Result<Vec<(usize, f64)>, String> {
+    // +1 for a maximum (moves up), −1 for a minimum
+    let outward = |v: usize| if kept.roles[v] == Role::Max { 1.0 } else { -1.0 };
+    let failing: Vec<usize> = (0..u.len())
+        .filter(|&v| {
+            matches!(kept.roles[v], Role::Min | Role::Max)
+                && domain.neighbors(v).any(|w| outward(v) * (u[w] - u[v]) >= 0.0)
+        })
+        .collect();
+    if failing.is_empty() {
+        return Ok(Vec::new());
+    }
+    let mut moved = fixed.to_vec();
+    for &v in &failing {
+        moved[v] = Some(u[v] + outward(v) * unit);
+    }
+    let u1 = dirichlet.solve(&moved)?;
+    let mut out = Vec::new();
+    for &v in &failing {
+        let s = outward(v);
+        let mut step: f64 = 0.0;
+        for w in domain.neighbors(v) {
+            let behind = s * (u[w] - u[v]);
+            if behind < 0.0 {
+                continue;
+            }
+            // w follows the move by this fraction (a prescribed neighbour does not follow)
+            let follow = (s * (u1[w] - u[w]) / unit).max(0.0);
+            // the fill makes w an average of kept extrema of v's type alone (a grid's corner
+            // between two kept maxima, with the 5-point stencil): no move clears it
+            let held = fixed[w].is_none() && {
+                let (cp, ri, val) = (k.symbolic().col_ptr(), k.symbolic().row_idx(), k.val());
+                (cp[w]..cp[w + 1]).all(|p| ri[p] == w || val[p] == 0.0 || kept.roles[ri[p]] == kept.roles[v])
+            };
+            if follow < MAX_FOLLOW && !held {
+                step = step.max(behind / (1.0 - follow));
+                continue;
+            }
+            // held (almost) only by moved extrema, w cannot be cleared: it is prescribed
+            // halfway between v and its farthest other neighbour on the inner side, if any
+            let inner = domain.neighbors(w).filter(|&x| x != v).map(|x| s * u[x]).fold(f64::INFINITY, f64::min);
+            if inner < s * u[v] && fixed[w].is_none() && kept.roles[w] == Role::Other {
+                out.push((w, 0.5 * (u[v] + s * inner)));
+            }
+        }
+        out.push((v, u[v] + s * (1.25 * step + 1e-9 * unit)));
+    }
+    Ok(out)
+}
+
+/// A free neighbour that follows a kept extremum's outward move by this fraction or more is
+/// prescribed instead of being outrun ([`outward_moves`]).
+const MAX_FOLLOW: f64 = 0.9;
 
 /// Vertices within `radius` rings of `v` (itself included).
 fn rings<D: crate::domain::Domain>(domain: &D, v: usize, radius: usize) -> Vec<usize> {

@@ -18,7 +18,7 @@ pub mod vec3;
 
 pub use grid::{Grid2d, MAX_SPACING, MIN_SPACING};
 pub use mesh::{shapes, triangle_area, TriMesh};
-pub use order::{sos_greater, sos_less, sos_sort, value_range};
+pub use order::{sos_greater, sos_less, sos_sort, sos_untied, value_range};
 pub use series::Series;
 
 /// How persistence pairs are formed on a domain (SPEC.md, "Persistence").

@@ -779,7 +779,9 @@ pub fn smooth<D: Smoothable + Sync>(domain: &D, h: &[f64], settings: &SmoothSett
             (_, Formulation::Assembled) => false,
             (_, Formulation::Auto) => condition.is_some_and(|c| c > FACTORED_ABOVE),
         };
-        let factor = if factored {
+        // without a data term there is no estimate: the factor is made for a retry should the
+        // assembled normal matrix lose its definiteness
+        let factor = if factored || condition.is_none() {
             domain.stiffness_factor(&k).and_then(|k1| polyharmonic_factor(&k, &k1, &m, &settings.energy, &weights))
         } else {
             None

@@ -340,6 +340,9 @@ const STEP_TOLERANCE: f64 = 1e-5;
 /// Iterations without a halving of the best gap bound after which the solver stops with
 /// what it has (the bound has reached its rounding floor).
 const STALL_ITERATIONS: u32 = 8;
+/// Coordinate-descent sweeps over the multipliers per iteration (20 and 100 gave the same
+/// bound as 5 on the 300² benchmark grid, each about 5 × below the solver's own).
+const POLISH_SWEEPS: usize = 5;
 
 /// Solves the reduced QP; `Err(reason)` when it cannot (the caller falls back to Clarabel).
 ///
@@ -497,8 +500,18 @@ fn run<T: Real, O: Objective<T>>(
                 a + e * e / d[i]
             });
             let data = (0.5 * data.to_f64()).max(1e-20 * d_sum);
+            // the multipliers polished for this point (coordinate descent on the bound): the
+            // interior z of rows far from active still carries complementarity the point no
+            // longer needs; about one iteration less on the benchmark grids
+            let mut polished = z.clone();
+            let gap = if pres <= tol {
+                let mut rho = rd.clone();
+                gap.min(polish_multipliers(rows, &slack, &d, &mut rho, &mut polished, POLISH_SWEEPS).to_f64())
+            } else {
+                gap
+            };
             if pres <= tol && small_step && gap <= settings.gap_tolerance * data {
-                return Ok(finish(&x, &z, SolveStatus::Solved, it, objective));
+                return Ok(finish(&x, &polished, SolveStatus::Solved, it, objective));
             }
             fallback_status = if pres > tol {
                 None
@@ -513,7 +526,7 @@ fn run<T: Real, O: Objective<T>>(
                 (best_gap, best_at) = (gap, it);
             } else if pres <= tol && it >= best_at + STALL_ITERATIONS && gap <= 1e2 * settings.gap_tolerance * data {
                 // the bound has reached its rounding floor, within 100× the target
-                return Ok(finish(&x, &z, SolveStatus::AlmostSolved, it, objective));
+                return Ok(finish(&x, &polished, SolveStatus::AlmostSolved, it, objective));
             }
         } else {
             // without a data term: the gap sᵀz + ½ ρᵀP⁻¹ρ against the energy ½ fᵀQf (P
@@ -642,4 +655,34 @@ pub(crate) fn normal_pattern(r: &ReducedQp) -> SymbolicSparseColMat<usize> {
         row_len[row] += 1;
     }
     Normal::new(r, &row_cols, &row_len).symbolic
+}
+
+/// Coordinate descent on the gap bound `Σ max(s, 0) z + ½ Σ ρ²/d` over the multipliers
+/// `z ≥ 0` for a fixed point (ρ = ∇φ + Aᵀz updated in place): returns the bound reached.
+fn polish_multipliers<T: Real>(rows: &Rows, slack: &[T], d: &[T], rho: &mut [T], z: &mut [T], sweeps: usize) -> T {
+    let zero = T::of(0.0);
+    for _ in 0..sweeps {
+        for k in 0..z.len() {
+            let s = max(slack[k], zero);
+            let [c0, c1] = rows.cols[k];
+            let [v0, v1] = rows.vals[k];
+            let (mut grad, mut curv) = (s + T::of(v0) * rho[c0] / d[c0], T::of(v0 * v0) / d[c0]);
+            if rows.len[k] == 2 {
+                grad += T::of(v1) * rho[c1] / d[c1];
+                curv += T::of(v1 * v1) / d[c1];
+            }
+            let new = max(z[k] - grad / curv, zero);
+            let delta = new - z[k];
+            if delta != zero {
+                z[k] = new;
+                rho[c0] += T::of(v0) * delta;
+                if rows.len[k] == 2 {
+                    rho[c1] += T::of(v1) * delta;
+                }
+            }
+        }
+    }
+    let comp = slack.iter().zip(z.iter()).fold(zero, |a, (&s, &z)| a + max(s, zero) * z);
+    let stat = rho.iter().zip(d).fold(zero, |a, (&g, &d)| a + g * g / d);
+    comp + T::of(0.5) * stat
 }

@@ -276,15 +276,18 @@ pub fn solve_monotone_qp(qp: &MonotoneQp<'_>, settings: &QpSettings) -> Result<Q
         (_, Formulation::Auto) => condition.is_some_and(|c| c > FACTORED_ABOVE),
     };
     let forced = settings.method == Method::ClarabelAuxiliary || settings.formulation == Formulation::Factored;
-    let formulation = match (wants_factored, qp.factor) {
+    let to_factored = |reduced: &mut ReducedQp, f: &Factor| {
+        // scaled by the data term rather than by P's diagonal: the variables' own block
+        // (d) then has unit size beside Clarabel's static regularisation, F carries √κ
+        let d_mean = reduced.d.iter().sum::<f64>() / reduced.n as f64;
+        if d_mean > 0.0 {
+            rescale(reduced, d_mean);
+        }
+        reduced.factor = Some(reduce_factor(qp, f, &free, reduced.scale));
+    };
+    let mut formulation = match (wants_factored, qp.factor) {
         (true, Some(f)) => {
-            // scaled by the data term rather than by P's diagonal: the variables' own block
-            // (d) then has unit size beside Clarabel's static regularisation, F carries √κ
-            let d_mean = reduced.d.iter().sum::<f64>() / reduced.n as f64;
-            if d_mean > 0.0 {
-                rescale(&mut reduced, d_mean);
-            }
-            reduced.factor = Some(reduce_factor(qp, f, &free, reduced.scale));
+            to_factored(&mut reduced, f);
             Formulation::Factored
         }
         (true, None) if forced => {
@@ -303,6 +306,23 @@ pub fn solve_monotone_qp(qp: &MonotoneQp<'_>, settings: &QpSettings) -> Result<Q
     let (out, method) = match settings.method {
         Method::Structured => match super::ipm::solve(&reduced, hint.as_deref(), settings) {
             Ok(out) => (out, Method::Structured),
+            // the assembled normal matrix lost its definiteness (an energy without a data
+            // term, ill-conditioned on its own): the factored form in double-double next
+            Err(_)
+                if formulation == Formulation::Assembled
+                    && settings.formulation == Formulation::Auto
+                    && qp.factor.is_some() =>
+            {
+                to_factored(&mut reduced, qp.factor.expect("checked"));
+                formulation = Formulation::Factored;
+                match super::ipm::solve(&reduced, hint.as_deref(), settings) {
+                    Ok(out) => (out, Method::Structured),
+                    Err(why) => {
+                        fallback = Some(why);
+                        (clarabel(&reduced)?, Method::Clarabel)
+                    }
+                }
+            }
             Err(why) => {
                 fallback = Some(why);
                 (clarabel(&reduced)?, Method::Clarabel)

@@ -349,9 +349,10 @@ const POLISH_SWEEPS: usize = 5;
 /// Stops when the rows are met to `settings.tolerance`, the last step moved no value by more
 /// than [`STEP_TOLERANCE`], and — with a data term — the gap bound
 /// `Ĝ = Σ max(s, 0) z + ½ Σ ρ²/d` (s = b − Ax, ρ = ∇φ + Aᵀz, d the data diagonal: P ⪰
-/// diag(d)) is below `settings.gap_tolerance` × the data term; without one, when the mean
-/// complementarity is 10× below the feasibility tolerance. The factored form runs in
-/// double-double throughout.
+/// diag(d)), with the multipliers polished for the point, is below `settings.gap_tolerance` ×
+/// the data term; without one, when `sᵀz + ½ρᵀP⁻¹ρ` (P factorised alone) is below it × the
+/// energy, or — where P alone cannot be factorised — when the mean complementarity is 10×
+/// below the feasibility tolerance. The factored form runs in double-double throughout.
 pub(super) fn solve(r: &ReducedQp, hint: Option<&[f64]>, settings: &QpSettings) -> Result<Outcome, String> {
     // the storage made in advance is this solve's or nobody's: not kept past an early return
     let spare = SPARE.with(|c| c.borrow_mut().take());

@@ -92,7 +92,7 @@ pub struct QpSettings {
     pub tolerance: f64,
     /// The structured solver stops when the gap bound is below this fraction of the data
     /// term (without a data term: of the objective's range, by the mean complementarity).
-    /// {1e-7}
+    /// {3e-7: a third of the target, 10⁻⁶, for what the output's rounding and the repair add}
     pub gap_tolerance: f64,
     /// Solver. {structured}
     pub method: Method,
@@ -105,7 +105,7 @@ impl Default for QpSettings {
         QpSettings {
             max_iter: 200,
             tolerance: 1e-9,
-            gap_tolerance: 1e-7,
+            gap_tolerance: 3e-7,
             method: Method::Structured,
             formulation: Formulation::Auto,
         }

@@ -533,17 +533,32 @@ fn run<T: Real, O: Objective<T>>(
             // without a data term: the gap sᵀz + ½ ρᵀP⁻¹ρ against the energy ½ fᵀQf (P
             // factorised once), or, where P cannot be solved alone, the mean complementarity
             let energy = phi + r.constant;
-            let gap = objective
-                .energy_dual(&rd)
+            // (one solve with P: only once the rows are met, where it can decide)
+            let gap = (pres <= tol)
+                .then(|| objective.energy_dual(&rd))
+                .flatten()
                 .map(|dual| slack.iter().zip(&z).map(|(s, z)| (max(*s, zero) * *z).to_f64()).sum::<f64>() + dual);
+            let target = settings.gap_tolerance * energy.abs().max(1e-300);
             let converged = match gap {
-                Some(gap) => pres <= tol && small_step && gap <= settings.gap_tolerance * energy.abs().max(1e-300),
+                Some(gap) => pres <= tol && small_step && gap <= target,
                 None => pres <= tol && dres <= tol && mu <= tol_mu,
             };
             if converged {
                 return Ok(finish(&x, &z, SolveStatus::Solved, it, objective));
             }
-            fallback_status = None;
+            // the rows met and the complementarity gone: the dual part ½ρᵀP⁻¹ρ of the bound
+            // can sit on the rounding floor of ρ amplified by P⁻¹ (k = 4: Ĝ ÷ energy ≈ 10⁻⁴
+            // with μ ≈ 10⁻²⁵), and the next factorisation can fail there; the point is kept
+            // rather than handed to another solver
+            let settled = pres <= tol && mu <= tol_mu;
+            fallback_status = settled.then_some(SolveStatus::AlmostSolved);
+            if let Some(gap) = gap {
+                if gap < 0.5 * best_gap {
+                    (best_gap, best_at) = (gap, it);
+                } else if settled && it >= best_at + STALL_ITERATIONS {
+                    return Ok(finish(&x, &z, SolveStatus::AlmostSolved, it, objective));
+                }
+            }
         }
         for k in 0..m {
             w[k] = z[k] / s[k];

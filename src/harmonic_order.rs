@@ -99,9 +99,14 @@ fn irregular<D: Domain>(domain: &D, phi: &[Vec<f64>], fixed: &[Option<f64>]) -> 
 /// # Errors
 /// The Dirichlet solve fails, or a region stays irregular after [`MAX_LEVELS`] refinements or
 /// is exactly flat (its boundary values all equal).
-pub fn ordered_harmonic<D: Domain>(domain: &D, k: &Sparse, fixed: &[Option<f64>]) -> Result<(Vec<f64>, usize), String> {
+pub fn ordered_harmonic<D: Domain>(
+    domain: &D,
+    k: &Sparse,
+    fixed: &[Option<f64>],
+    analyses: Option<&mut crate::linalg::Analyses>,
+) -> Result<(Vec<f64>, usize), String> {
     let n = domain.n_vertices();
-    let u = dirichlet_solve(k, fixed)?;
+    let u = crate::operators::dirichlet_solve_with(k, fixed, analyses)?;
     let mut phi: Vec<Vec<f64>> = u.iter().map(|&x| vec![x]).collect();
     let spread = {
         let vals: Vec<f64> = fixed.iter().flatten().copied().collect();
@@ -281,7 +286,7 @@ mod tests {
         let plain = dirichlet_solve(&k, &fixed).unwrap();
         let plain_phi: Vec<Vec<f64>> = plain.iter().map(|&x| vec![x]).collect();
         assert!(!irregular(mesh, &plain_phi, &fixed).is_empty(), "the plain harmonic function should lose its order");
-        let (u, levels) = ordered_harmonic(mesh, &k, &fixed).unwrap();
+        let (u, levels) = ordered_harmonic(mesh, &k, &fixed, None).unwrap();
         assert!(levels >= 2, "{levels}");
         let c = certify_no_data(mesh, &u, &fixed, |v| if v == 1.0 { RegionKind::Max } else { RegionKind::Min });
         assert!(c.passed, "{}", c.summary());
@@ -289,7 +294,7 @@ mod tests {
         let mut short = vec![None; mesh.n_vertices()];
         short[pm.vertex_of_pixel[2 * w + 2].unwrap()] = Some(0.0);
         short[pm.vertex_of_pixel[10 * w + 170].unwrap()] = Some(1.0);
-        let (u, levels) = ordered_harmonic(mesh, &k, &short).unwrap();
+        let (u, levels) = ordered_harmonic(mesh, &k, &short, None).unwrap();
         assert_eq!(levels, 0);
         assert_eq!(u, dirichlet_solve(&k, &short).unwrap());
     }

@@ -16,6 +16,7 @@ use crate::constraints::{
 };
 use crate::domain::{sos_sort, Domain, Grid2d, Series, TriMesh};
 use crate::error::{Error, Result};
+use crate::linalg::Analyses;
 use crate::operators::{
     cotan_stiffness, dirichlet_solve, edge_factor, gradient_factor, grid_mass, grid_stiffness, lumped_mass,
     plus_diagonal, polyharmonic, polyharmonic_factor, positive_cotan_stiffness, quadratic_form_without_diagonal,
@@ -23,8 +24,8 @@ use crate::operators::{
 };
 use crate::representative::{flooded_representative, separatrix_representative, series_representative, Repairs};
 use crate::solve::{
-    condition_estimate, meet_margin, optimality, repair, solve_monotone_qp, Bound, Formulation, MarginSummary, Method,
-    MonotoneQp, QpSettings, RepairSummary, SolveStatus, FACTORED_ABOVE,
+    condition_estimate, meet_margin, optimality, repair, solve_monotone_qp_with, Bound, Formulation, MarginSummary,
+    Method, MonotoneQp, QpSettings, RepairSummary, SolveStatus, FACTORED_ABOVE,
 };
 use crate::topology::morse_smale::MorseSmale;
 use crate::topology::{count_sos_extrema, select, KeptExtremum, KeptSet, Role, Selection};
@@ -86,6 +87,7 @@ pub trait Smoothable: Domain {
         choice: Option<RepresentativeChoice>,
         k: &Sparse,
         excluded: &[(&'static str, String)],
+        analyses: &mut Analyses,
     ) -> Result<Representative>;
 }
 
@@ -103,6 +105,7 @@ impl Smoothable for Series {
         _: Option<RepresentativeChoice>,
         _: &Sparse,
         _: &[(&'static str, String)],
+        _: &mut Analyses,
     ) -> Result<Representative> {
         let u = series_representative(self, h, kept)?;
         Ok(Representative { u, kind: "linear", name: "linear".into(), fallbacks: Vec::new(), complex: None })
@@ -137,7 +140,9 @@ fn surface_representative<D: Domain>(
     choice: Option<RepresentativeChoice>,
     k: &Sparse,
     excluded: &[(&'static str, String)],
+    analyses: &mut Analyses,
 ) -> Result<Representative> {
+    let analyses = std::cell::RefCell::new(analyses);
     let mut why: Vec<String> = excluded.iter().map(|(kind, e)| format!("{kind} representative: {e}")).collect();
     let skip = |kind: &str| excluded.iter().any(|(x, _)| *x == kind);
     let complex = match MorseSmale::new(domain, h, kept) {
@@ -166,7 +171,7 @@ fn surface_representative<D: Domain>(
         // the failure of the last attempt (the most mended one) is the one reported
         let mut last_failure = None;
         for (ms, move_kept) in attempts {
-            match separatrix_representative(domain, &untied, kept, ms, k, move_kept) {
+            match separatrix_representative(domain, &untied, kept, ms, k, move_kept, &mut analyses.borrow_mut()) {
                 Ok((u, r)) => {
                     let c = certify(domain, &u, &kept.roles, None);
                     if c.passed {
@@ -288,8 +293,9 @@ impl Smoothable for TriMesh {
         choice: Option<RepresentativeChoice>,
         _k: &Sparse,
         excluded: &[(&'static str, String)],
+        analyses: &mut Analyses,
     ) -> Result<Representative> {
-        surface_representative(self, h, kept, choice, &self.fill_stiffness(), excluded)
+        surface_representative(self, h, kept, choice, &self.fill_stiffness(), excluded, analyses)
     }
 }
 
@@ -307,8 +313,9 @@ impl Smoothable for Grid2d {
         choice: Option<RepresentativeChoice>,
         k: &Sparse,
         excluded: &[(&'static str, String)],
+        analyses: &mut Analyses,
     ) -> Result<Representative> {
-        surface_representative(self, h, kept, choice, k, excluded)
+        surface_representative(self, h, kept, choice, k, excluded, analyses)
     }
 }
 
@@ -661,6 +668,22 @@ struct Operators {
 /// that fails its check (1), no solver point (4), an output that fails the certificate even
 /// after repair (1).
 pub fn smooth<D: Smoothable + Sync>(domain: &D, h: &[f64], settings: &SmoothSettings) -> Result<Smoothed> {
+    smooth_with(domain, h, settings, &mut Analyses::default())
+}
+
+/// [`smooth`] with the factorisations' analyses taken from and kept in `analyses`: the harmonic
+/// fills' Laplacian (made, for instance, by the geodesic distance the field came from), and
+/// the solver's normal matrix, kept for the next field with the same fixed set. The fills'
+/// analysis is dropped before the solve (a million-vertex Laplacian's is hundreds of MiB).
+///
+/// # Errors
+/// As [`smooth`].
+pub fn smooth_with<D: Smoothable + Sync>(
+    domain: &D,
+    h: &[f64],
+    settings: &SmoothSettings,
+    analyses: &mut Analyses,
+) -> Result<Smoothed> {
     settings.validate()?;
     let n = domain.n_vertices();
     if h.len() != n {
@@ -695,7 +718,7 @@ pub fn smooth<D: Smoothable + Sync>(domain: &D, h: &[f64], settings: &SmoothSett
         let mut excluded: Vec<(&'static str, String)> = Vec::new();
         loop {
             let t = Instant::now();
-            let rep = domain.representative(h, &kept, settings.representative, &k, &excluded)?;
+            let rep = domain.representative(h, &kept, settings.representative, &k, &excluded, analyses)?;
             if let Some(ms) = &rep.complex {
                 seconds.complex = ms.seconds[0];
                 seconds.simplify = ms.seconds[1];
@@ -818,10 +841,7 @@ pub fn smooth<D: Smoothable + Sync>(domain: &D, h: &[f64], settings: &SmoothSett
     let gd = settings.data_weight;
     // the fills' Laplacian analysis is not needed again: free it before the solver runs (the
     // solver's factor storage was made beside the representative: 1000² peak 2.93 → 3.06 GiB)
-    crate::linalg::forget_solver_analysis();
-    if let Some(prepared) = prepared {
-        prepared.install();
-    }
+    analyses.clear();
 
     let t = Instant::now();
     let hint: Vec<f64> = u.iter().map(|v| (v - lo) / range).collect();
@@ -839,7 +859,7 @@ pub fn smooth<D: Smoothable + Sync>(domain: &D, h: &[f64], settings: &SmoothSett
         factor: factor.as_ref(),
         condition,
     };
-    let sol = solve_monotone_qp(&qp, &settings.qp)?;
+    let sol = solve_monotone_qp_with(&qp, &settings.qp, analyses, prepared)?;
     seconds.solve = t.elapsed().as_secs_f64();
 
     let t = Instant::now();

@@ -189,6 +189,7 @@ pub fn separatrix_representative<D: crate::domain::Domain>(
     ms: &crate::topology::morse_smale::MorseSmale,
     k: &crate::operators::Sparse,
     move_kept: bool,
+    analyses: &mut crate::linalg::Analyses,
 ) -> std::result::Result<(Vec<f64>, Repairs), String> {
     let n = h.len();
     let mut down = vec![f64::INFINITY; n];
@@ -241,7 +242,7 @@ pub fn separatrix_representative<D: crate::domain::Domain>(
             through[v].push(i);
         }
     }
-    let mut dirichlet = crate::operators::Dirichlet::new(k)?;
+    let mut dirichlet = crate::operators::Dirichlet::new(k, analyses)?;
     let mut released = vec![false; n];
     let mut reach: std::collections::HashMap<usize, usize> = std::collections::HashMap::new();
     let mut gone = vec![false; separatrices.len()];

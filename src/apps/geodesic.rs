@@ -70,6 +70,19 @@ fn upper(
 /// A message for no source, a source out of range, or a factorisation failure (a component
 /// with no source gets no finite distance: refused).
 pub fn heat_geodesic(mesh: &TriMesh, sources: &[usize]) -> Result<(Vec<f64>, GeodesicSeconds), String> {
+    heat_geodesic_with(mesh, sources, &mut crate::linalg::Analyses::default())
+}
+
+/// [`heat_geodesic`] with the Laplacian's analysis taken from and kept in `analyses` (the
+/// smoothing of the distance that follows reuses it for its harmonic fills).
+///
+/// # Errors
+/// As [`heat_geodesic`].
+pub fn heat_geodesic_with(
+    mesh: &TriMesh,
+    sources: &[usize],
+    analyses: &mut crate::linalg::Analyses,
+) -> Result<(Vec<f64>, GeodesicSeconds), String> {
     let t0 = std::time::Instant::now();
     let mut seconds = GeodesicSeconds::default();
     let p = mesh.positions();
@@ -105,7 +118,7 @@ pub fn heat_geodesic(mesh: &TriMesh, sources: &[usize]) -> Result<(Vec<f64>, Geo
     let time = h * h;
     let none = vec![false; n];
     let (pattern, heat_values) = upper(&k, time, &m, &none);
-    let mut solver = SpdSolver::new(pattern.as_ref())?;
+    let mut solver = SpdSolver::new(pattern.as_ref(), analyses)?;
     seconds.setup = t0.elapsed().as_secs_f64();
     let factor_failed = |e: String| {
         let (worst, angle) = mesh.smallest_angle();

@@ -19,9 +19,10 @@ use crate::constraints::{choose_margin, constraint_edges, margin_cap, max_margin
 use crate::domain::sos_sort;
 use crate::error::{Error, Result};
 use crate::harmonic_order::ordered_harmonic;
+use crate::linalg::Analyses;
 use crate::operators::{dirichlet_solve, polyharmonic, Energy, Sparse};
 use crate::pipeline::Smoothable;
-use crate::solve::{repair, solve_bounded_partition, solve_monotone_qp, MonotoneQp, QpSettings, SolveStatus};
+use crate::solve::{repair, solve_bounded_partition, solve_monotone_qp_with, MonotoneQp, QpSettings, SolveStatus};
 use crate::verify::{certify_no_data, spurious_components, Certificate, RegionKind};
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::Instant;
@@ -122,12 +123,17 @@ pub struct WeightFunction {
 impl WeightFunction {
     /// A function not computed yet: the given fixed values completed by the fill rule, and
     /// its representative (harmonic with the non-negative-weight Laplacian `fill`).
-    fn prepare<D: Smoothable>(domain: &D, given: &[Option<f64>], handle: usize, fill: &Sparse) -> Result<Self> {
+    fn prepare<D: Smoothable>(
+        domain: &D,
+        given: &[Option<f64>],
+        handle: usize,
+        fill: &Sparse,
+        analyses: Option<&mut Analyses>,
+    ) -> Result<Self> {
         let mut prescribed = given.to_vec();
         let filled = fill_rule(domain, &mut prescribed);
-        let (u, refinements) = ordered_harmonic(domain, fill, &prescribed).map_err(|e| Error::Representative {
-            path: None,
-            message: format!("handle {handle}: harmonic representative: {e}"),
+        let (u, refinements) = ordered_harmonic(domain, fill, &prescribed, analyses).map_err(|e| {
+            Error::Representative { path: None, message: format!("handle {handle}: harmonic representative: {e}") }
         })?;
         Ok(WeightFunction {
             handle,
@@ -251,9 +257,10 @@ fn one_function<D: Smoothable>(
     which: usize,
     ops: &Operators,
     settings: &WeightSettings,
+    analyses: &mut Analyses,
 ) -> Result<WeightFunction> {
     let t = Instant::now();
-    let mut out = WeightFunction::prepare(domain, prescribed, which, &ops.fill)?;
+    let mut out = WeightFunction::prepare(domain, prescribed, which, &ops.fill, Some(&mut *analyses))?;
     let fixed = &out.prescribed;
     out.raw = match settings.method {
         WeightMethod::Monotone => {
@@ -274,7 +281,7 @@ fn one_function<D: Smoothable>(
                 factor: None,
                 condition: None,
             };
-            let sol = solve_monotone_qp(&qp, &settings.qp)?;
+            let sol = solve_monotone_qp_with(&qp, &settings.qp, analyses, None)?;
             let mut f = sol.x;
             let is_fixed: Vec<bool> = fixed.iter().map(|x| x.is_some()).collect();
             let r = repair(&mut f, &is_fixed, &edges, &sos_sort(&out.u), 0.25 * eps);
@@ -284,7 +291,7 @@ fn one_function<D: Smoothable>(
             out.solver_iterations = sol.iterations;
             out.solver_fallback = sol.fallback.clone();
             out.repaired = r.changed_vertices;
-            let o = crate::solve::optimality(&qp, &f, &sol.z, None);
+            let o = crate::solve::optimality_with(&qp, &f, &sol.z, None, Some(analyses));
             out.gap_over_energy = (o.gap.is_finite() && o.energy > 0.0).then(|| o.gap / o.energy);
             f
         }
@@ -374,15 +381,16 @@ pub fn weights_prescribed<D: Smoothable + Sync>(
             let workers: Vec<_> = (0..threads)
                 .map(|_| {
                     s.spawn(|| {
-                        // one function per core already: no nested two-thread factorisations
-                        crate::linalg::allow_split_on_this_thread(threads == 1);
+                        // one function per core already: no nested two-thread factorisations;
+                        // the normal matrix's analysis is shared by this thread's functions
+                        let mut analyses = Analyses::new(threads == 1);
                         let mut mine = Vec::new();
                         loop {
                             let h = next.fetch_add(1, Ordering::Relaxed);
                             if h >= count {
                                 break;
                             }
-                            mine.push((h, one_function(domain, &prescribed[h], h, &ops, settings)));
+                            mine.push((h, one_function(domain, &prescribed[h], h, &ops, settings, &mut analyses)));
                         }
                         mine
                     })
@@ -439,7 +447,7 @@ fn bounded<D: Smoothable>(
     let t = Instant::now();
     let mut functions = Vec::with_capacity(given.len());
     for (which, g) in given.iter().enumerate() {
-        functions.push(WeightFunction::prepare(domain, g, which, &ops.fill)?);
+        functions.push(WeightFunction::prepare(domain, g, which, &ops.fill, None)?);
     }
     let fixed: Vec<Vec<Option<f64>>> = functions.iter().map(|f| f.prescribed.clone()).collect();
     let (w, status, it) = solve_bounded_partition(&ops.energy, &fixed, &settings.qp)?;

@@ -2,6 +2,7 @@
 //! `main.rs` only parses arguments into these option structs and maps errors to exit codes.
 
 mod bench;
+mod critical_output;
 mod deform;
 mod diffuse;
 mod extrema;
@@ -9,6 +10,7 @@ mod geodesic;
 pub mod input;
 mod mesh_outline;
 mod smooth;
+mod smooth_args;
 mod smooth_grid;
 mod smooth_mesh;
 mod verify;
@@ -20,7 +22,8 @@ pub use diffuse::{diffuse, DiffuseArgs};
 pub use extrema::{extrema, ExtremaArgs};
 pub use geodesic::{geodesic, GeodesicArgs};
 pub use mesh_outline::{mesh_outline, MeshOutlineArgs};
-pub use smooth::{smooth, SmoothArgs};
+pub use smooth::smooth;
+pub use smooth_args::SmoothArgs;
 pub use verify::{verify, VerifyArgs};
 pub use weights::{weights, WeightsArgs};
 

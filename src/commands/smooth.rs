@@ -1,43 +1,17 @@
 //! `toposmooth smooth`: the whole pipeline on a file, with output, plot and report.
 
-use super::input::{read_field, DomainKind, FieldInput, GridOptions};
+use super::input::{read_field, FieldInput};
+use super::smooth_args::{fit_and_solver_lines, SmoothArgs};
 use super::{check_distinct, check_png_name, sig6, stage_plot, x_axis};
 use crate::domain::Series;
 use crate::error::{Error, Result};
-use crate::io::series_csv::{stage_series_output, SeriesCsv, SeriesCsvOptions, SeriesOutput};
+use crate::io::series_csv::{stage_series_output, SeriesCsv, SeriesOutput};
 use crate::io::stage_json;
-use crate::pipeline::{smooth as run_pipeline, Report, SmoothSettings};
+use crate::pipeline::{smooth as run_pipeline, Report};
 use crate::plot::{plot_series, Marker};
 use crate::topology::Role;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
-
-/// Options of `smooth`.
-#[derive(Clone, Debug)]
-pub struct SmoothArgs {
-    /// Input file (none when a grid comes from `--u`/`--v`).
-    pub input: Option<PathBuf>,
-    /// Series or grid.
-    pub kind: DomainKind,
-    /// Column choice (series).
-    pub csv: SeriesCsvOptions,
-    /// Array, spacing, derivation and NaN policy (grids).
-    pub grid: GridOptions,
-    /// Kept critical points and separatrices as VTK PolyData (grids).
-    pub complex: Option<PathBuf>,
-    /// Isolines in the grid plot.
-    pub isolines: usize,
-    /// Camera of the mesh plot.
-    pub view: crate::plot::MeshView,
-    /// Output CSV.
-    pub output: PathBuf,
-    /// Pipeline settings.
-    pub settings: SmoothSettings,
-    /// Figure.
-    pub plot: Option<PathBuf>,
-    /// JSON report.
-    pub report: Option<PathBuf>,
-}
 
 #[derive(serde::Serialize)]
 struct RunReport<'a> {
@@ -202,24 +176,4 @@ fn smooth_series(args: &SmoothArgs, input: &Path, data: SeriesCsv, start: Instan
     }
     text.push('\n');
     Ok(text)
-}
-
-/// The certificate, deviation and solver lines of `smooth`'s summary (series and grids).
-pub(super) fn fit_and_solver_lines(r: &Report) -> String {
-    format!(
-        "{}; RMS deviation {}, max deviation {}\n{}\nsolver {:?} {:?} in {} iterations{}, {} constraints, margin {:.3e}; margin met exactly by moving {} vertices (at most {:.1e}); strictness repair changed {} vertices\n",
-        r.certificate.summary(),
-        sig6(r.rms_deviation),
-        sig6(r.max_deviation),
-        r.fit.summary(),
-        r.solver,
-        r.solver_status,
-        r.solver_iterations,
-        r.solver_fallback.as_ref().map(|w| format!(" (structured solver gave up: {w})")).unwrap_or_default(),
-        r.constraints,
-        r.settings.margin[0],
-        r.margin_repair.changed_vertices,
-        r.margin_repair.max_change,
-        r.repair.changed_vertices
-    )
 }

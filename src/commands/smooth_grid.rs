@@ -1,18 +1,18 @@
 //! `toposmooth smooth` on a grid: run the pipeline, write .vti / .npz / .npy / CSV, the
 //! complex as .vtp, the heat-map figure and the report.
 
+use super::critical_output::{complex_polydata, kept_markers, role_codes};
 use super::input::GridInput;
-use super::smooth::SmoothArgs;
+use super::smooth_args::{fit_and_solver_lines, surface_seconds_line, SmoothArgs};
 use super::{sig6, stage_plot};
 use crate::domain::Grid2d;
 use crate::error::Result;
 use crate::io::grid::stage_grid_csv;
 use crate::io::npz::{stage_npy, stage_npz};
-use crate::io::vtk::{stage_vti, stage_vtp, PolyData};
+use crate::io::vtk::{stage_vti, stage_vtp};
 use crate::io::{stage_json, Staged};
 use crate::pipeline::{smooth as run_pipeline, Report, Smoothed};
-use crate::plot::{plot_grid_fields, GridMarker, GridPanel, GridPlotOptions};
-use crate::topology::morse_smale::MorseSmale;
+use crate::plot::{plot_grid_fields, GridPanel, GridPlotOptions};
 use crate::topology::Role;
 use std::path::Path;
 use std::time::Instant;
@@ -36,82 +36,12 @@ struct GridRunReport<'a> {
     report: &'a Report,
 }
 
-/// The kept extrema of a surface result as plot markers.
-pub fn kept_markers(roles: &[Role]) -> Vec<GridMarker> {
-    roles
-        .iter()
-        .enumerate()
-        .filter_map(|(i, r)| match r {
-            Role::Min => Some(GridMarker { index: i, is_max: false }),
-            Role::Max => Some(GridMarker { index: i, is_max: true }),
-            _ => None,
-        })
-        .collect()
-}
-
-/// The `seconds:` line of a surface run.
-pub fn surface_seconds_line(read: f64, s: &crate::pipeline::StageSeconds, write: f64, total: f64) -> String {
-    format!(
-        "seconds: read {:.3}, persistence {:.3}, complex {:.3}, simplify {:.3}, representative {:.3}, operators {:.3}, constraints {:.3}, solve {:.3}, repair {:.3}, verify {:.3}, write {:.3}, total {:.3}\n",
-        read, s.persistence, s.complex, s.simplify, s.representative, s.operators, s.constraints, s.solve, s.repair, s.verify, write, total
-    )
-}
-
-/// Role codes as Float64 (SPEC.md: −1 kept min, +1 kept max, 2 fixed, 3 end, 0 other).
-pub fn role_codes(roles: &[Role]) -> Vec<f64> {
-    roles.iter().map(|r| f64::from(r.code())).collect()
-}
-
 /// Physical position of a vertex: origin + (c·dx, r·dy) with the signed spacing, as VTK
 /// places ImageData points.
 fn physical(grid: &Grid2d, v: usize) -> [f64; 3] {
     let (r, c) = grid.row_col(v);
     let ([dx, dy], [ox, oy]) = (grid.spacing(), grid.origin());
     [ox + c as f64 * dx, oy + r as f64 * dy, 0.0]
-}
-
-/// The kept extrema, surviving saddles and separatrices as PolyData: vertex cells first
-/// (cell array `type`: −1 minimum, +1 maximum, 0 saddle), then one polyline per separatrix
-/// (`type` −1 descending to a minimum, +1 ascending to a maximum).
-/// `place` gives each vertex's position.
-pub fn complex_polydata(place: &dyn Fn(usize) -> [f64; 3], h: &[f64], roles: &[Role], ms: &MorseSmale) -> PolyData {
-    let mut slot = std::collections::HashMap::new();
-    let mut points = Vec::new();
-    let mut values = Vec::new();
-    let mut id = |v: usize, points: &mut Vec<[f64; 3]>, values: &mut Vec<f64>| -> usize {
-        *slot.entry(v).or_insert_with(|| {
-            points.push(place(v));
-            values.push(h[v]);
-            points.len() - 1
-        })
-    };
-    let mut verts = Vec::new();
-    let mut types = Vec::new();
-    for (v, r) in roles.iter().enumerate() {
-        if matches!(r, Role::Min | Role::Max) {
-            verts.push(id(v, &mut points, &mut values));
-            types.push(f64::from(r.code()));
-        }
-    }
-    for &s in &ms.saddles {
-        verts.push(id(s, &mut points, &mut values));
-        types.push(0.0);
-    }
-    let mut lines = Vec::new();
-    for (list, t) in [(&ms.descending, -1.0), (&ms.ascending, 1.0)] {
-        for sep in list {
-            lines.push(sep.path.iter().map(|&v| id(v, &mut points, &mut values)).collect::<Vec<usize>>());
-            types.push(t);
-        }
-    }
-    PolyData {
-        points,
-        verts,
-        lines,
-        point_arrays: vec![("input".into(), values)],
-        cell_arrays: vec![("type".into(), types)],
-        ..Default::default()
-    }
 }
 
 fn stage_output(path: &Path, grid: &Grid2d, data: &GridInput, result: &Smoothed) -> Result<Staged> {
@@ -216,7 +146,7 @@ pub fn smooth_grid(args: &SmoothArgs, data: GridInput, start: Instant) -> Result
         r.settings.threshold.map(|t| format!(" (persistence ≥ {})", sig6(t))).unwrap_or_default(),
         r.representative
     );
-    text += &super::smooth::fit_and_solver_lines(r);
+    text += &fit_and_solver_lines(r);
     text += &surface_seconds_line(read_seconds, s, write_seconds, start.elapsed().as_secs_f64());
     let mut wrote = vec![args.output.display().to_string()];
     for p in [&args.complex, &args.plot, &args.report].into_iter().flatten() {

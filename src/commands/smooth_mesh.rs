@@ -1,10 +1,10 @@
 //! `toposmooth smooth` on a triangle mesh: run the pipeline, write .vtu / .vtp / .ply, the
 //! complex as .vtp, and the report.
 
+use super::critical_output::{complex_polydata, kept_markers, role_codes};
 use super::input::MeshInput;
 use super::sig6;
-use super::smooth::SmoothArgs;
-use super::smooth_grid::{complex_polydata, kept_markers, role_codes, surface_seconds_line};
+use super::smooth_args::{fit_and_solver_lines, surface_seconds_line, SmoothArgs};
 use crate::domain::{Domain, TriMesh};
 use crate::error::{Error, Result};
 use crate::io::mesh::stage_ply;
@@ -175,7 +175,7 @@ pub fn smooth_mesh(args: &SmoothArgs, data: MeshInput, start: Instant) -> Result
         r.settings.threshold.map(|t| format!(" (persistence ≥ {})", sig6(t))).unwrap_or_default(),
         r.representative
     );
-    text += &super::smooth::fit_and_solver_lines(r);
+    text += &fit_and_solver_lines(r);
     text += &surface_seconds_line(read_seconds, s, write_seconds, start.elapsed().as_secs_f64());
     let mut wrote = vec![args.output.display().to_string()];
     if args.plot.is_some() && hidden > 0 {

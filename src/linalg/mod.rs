@@ -486,10 +486,8 @@ pub fn parallelism_for(s: &SymbolicCholesky<usize>) -> Par {
 /// ordering costs more than it saves. `Err` if `A` is not numerically positive definite.
 pub fn solve_spd_once(a: SparseColMatRef<'_, usize, f64>, b: &mut [f64]) -> Result<(), String> {
     let n = a.ncols();
-    let s = cached_symbolic(&LAST_AMD, a.symbolic(), || {
-        factorize_symbolic_cholesky(a.symbolic(), Side::Upper, SymmetricOrdering::Amd, Default::default())
-            .map_err(|e| format!("symbolic Cholesky: {e:?}"))
-    })?;
+    let s = factorize_symbolic_cholesky(a.symbolic(), Side::Upper, SymmetricOrdering::Amd, Default::default())
+        .map_err(|e| format!("symbolic Cholesky: {e:?}"))?;
     let s: &SymbolicCholesky<usize> = &s;
     let par = parallelism_for(s);
     let mut l = vec![0.0f64; s.len_val()];
@@ -503,37 +501,6 @@ pub fn solve_spd_once(a: SparseColMatRef<'_, usize, f64>, b: &mut [f64]) -> Resu
     let rhs = faer::MatMut::from_column_major_slice_mut(b, n, 1);
     LltRef::new(s, &l).solve_in_place_with_conj(Conj::No, rhs, par, MemStack::new(&mut mem));
     Ok(())
-}
-
-/// A per-thread slot holding the last pattern analysed and its analysis.
-pub type SymbolicSlot<T> = std::cell::RefCell<Option<(SymbolicSparseColMat<usize>, std::rc::Rc<T>)>>;
-
-/// The analysis of `pattern`: the one in `slot` when the slot holds the same pattern, else
-/// `build()`, which is then stored. Repeated problems on one pattern (the weight functions of
-/// a run, each thread taking several) order it once per thread.
-///
-/// # Errors
-/// What `build` returns, or a failure to copy the pattern.
-pub fn cached_symbolic<T>(
-    slot: &'static std::thread::LocalKey<SymbolicSlot<T>>,
-    pattern: SymbolicSparseColMatRef<'_, usize>,
-    build: impl FnOnce() -> Result<T, String>,
-) -> Result<std::rc::Rc<T>, String> {
-    let same = |a: &SymbolicSparseColMat<usize>| {
-        a.nrows() == pattern.nrows() && a.col_ptr() == pattern.col_ptr() && a.row_idx() == pattern.row_idx()
-    };
-    if let Some(s) = slot.with(|c| c.borrow().as_ref().filter(|(q, _)| same(q)).map(|(_, s)| s.clone())) {
-        return Ok(s);
-    }
-    let s = std::rc::Rc::new(build()?);
-    let owned = pattern.to_owned().map_err(|e| format!("{e:?}"))?;
-    slot.with(|c| *c.borrow_mut() = Some((owned, s.clone())));
-    Ok(s)
-}
-
-thread_local! {
-    /// The last pattern [`solve_spd_once`] analysed on this thread.
-    static LAST_AMD: SymbolicSlot<SymbolicCholesky<usize>> = const { std::cell::RefCell::new(None) };
 }
 
 /// The pattern (upper triangle with diagonal) of a matrix given by triplets; for tests and
@@ -553,17 +520,6 @@ pub fn upper_pattern(n: usize, edges: &[(usize, usize)]) -> SymbolicSparseColMat
         cp.push(ri.len());
     }
     SymbolicSparseColMat::new_checked(n, n, cp, None, ri)
-}
-
-thread_local! {
-    /// Whether [`analyse`] may split a factorisation over two threads on this thread.
-    static SPLIT_ALLOWED: std::cell::Cell<bool> = const { std::cell::Cell::new(true) };
-}
-
-/// Forbids (or allows again) two-thread factorisations analysed on the calling thread: for
-/// callers that already run one problem per core (the weight functions).
-pub fn allow_split_on_this_thread(allowed: bool) {
-    SPLIT_ALLOWED.with(|c| c.set(allowed));
 }
 
 /// How a fixed pattern is factorised: one faer factorisation (AMD or nested dissection,
@@ -589,11 +545,12 @@ const PARALLEL_MIN_FLOPS: f64 = 2e10;
 /// Analyses the upper-triangular pattern `a` of a symmetric positive definite matrix: nested
 /// dissection and AMD side by side, then the cheapest of AMD, nested dissection on one
 /// factorisation, and nested dissection's two halves on two threads (estimated time: flops on
-/// the critical path). From [`ND_ONLY_N`] unknowns on, nested dissection alone.
+/// the critical path). From [`ND_ONLY_N`] unknowns on, nested dissection alone. Without
+/// `split_allowed` (callers that already run one problem per core) no two-thread plan.
 ///
 /// # Errors
 /// A message if faer's analysis fails.
-pub fn analyse(a: SymbolicSparseColMatRef<'_, usize>) -> Result<Analysis, String> {
+pub fn analyse(a: SymbolicSparseColMatRef<'_, usize>, split_allowed: bool) -> Result<Analysis, String> {
     let n = a.ncols();
     let single = |symbolic: SymbolicCholesky<usize>| {
         let par = parallelism_for(&symbolic);
@@ -606,7 +563,6 @@ pub fn analyse(a: SymbolicSparseColMatRef<'_, usize>) -> Result<Analysis, String
     if n < ND_MIN_N {
         return Ok(single(amd()?));
     }
-    let split_allowed = SPLIT_ALLOWED.with(|c| c.get());
     let nd = || -> Result<Result<two_way::Symbolic, SymbolicCholesky<usize>>, String> {
         // the dissection's own second thread only where the factorisation may use one
         let g = Graph::from_pattern(a);
@@ -787,16 +743,83 @@ impl SpdFactor {
     }
 }
 
-thread_local! {
-    /// The last pattern analysed for an [`SpdSolver`] on this thread (a run's geodesic and
-    /// harmonic fills share the Laplacian's).
-    static SOLVER_LAST: SymbolicSlot<Analysis> = const { std::cell::RefCell::new(None) };
+/// [`solve_spd_once`], or with the analysis taken from and kept in `analyses` when given (a
+/// pattern solved again and again: the weight functions' fills and gaps).
+///
+/// # Errors
+/// As [`solve_spd_once`].
+pub fn solve_spd(
+    a: SparseColMatRef<'_, usize, f64>,
+    b: &mut [f64],
+    analyses: Option<&mut Analyses>,
+) -> Result<(), String> {
+    match analyses {
+        None => solve_spd_once(a, b),
+        Some(analyses) => SpdSolver::new(a.symbolic(), analyses)?.solve(a, b),
+    }
 }
 
-/// Drops the analysis [`SpdSolver::new`] keeps for reuse on this thread (a million-vertex
-/// Laplacian's is hundreds of MiB): for callers done with that pattern.
-pub fn forget_solver_analysis() {
-    SOLVER_LAST.with(|c| *c.borrow_mut() = None);
+/// The analyses a sequence of factorisations reuses, held by the caller: the last patterns
+/// analysed with their analyses (a run's geodesic distance and harmonic fills share the
+/// Laplacian's, the weight functions of a thread their normal matrix's), and whether an
+/// analysis may plan a factorisation over two threads. Nothing is kept anywhere else.
+pub struct Analyses {
+    split_allowed: bool,
+    /// Most recent last; at most [`Analyses::KEPT`].
+    kept: Vec<(SymbolicSparseColMat<usize>, std::rc::Rc<Analysis>)>,
+}
+
+impl Default for Analyses {
+    fn default() -> Self {
+        Analyses::new(true)
+    }
+}
+
+impl Analyses {
+    /// Patterns kept at once (a Laplacian, the energy and a normal matrix).
+    const KEPT: usize = 3;
+
+    /// An empty store; `split_allowed`: see [`analyse`].
+    pub fn new(split_allowed: bool) -> Self {
+        Analyses { split_allowed, kept: Vec::new() }
+    }
+
+    /// The analysis of `pattern`: a kept one for the same pattern, else a new one, then kept.
+    ///
+    /// # Errors
+    /// A message if the analysis fails or the pattern cannot be copied.
+    pub fn of(&mut self, pattern: SymbolicSparseColMatRef<'_, usize>) -> Result<std::rc::Rc<Analysis>, String> {
+        let same = |a: &SymbolicSparseColMat<usize>| {
+            a.nrows() == pattern.nrows() && a.col_ptr() == pattern.col_ptr() && a.row_idx() == pattern.row_idx()
+        };
+        if let Some(at) = self.kept.iter().position(|(q, _)| same(q)) {
+            let entry = self.kept.remove(at);
+            let analysis = entry.1.clone();
+            self.kept.push(entry);
+            return Ok(analysis);
+        }
+        let analysis = std::rc::Rc::new(analyse(pattern, self.split_allowed)?);
+        self.keep(pattern.to_owned().map_err(|e| format!("{e:?}"))?, analysis.clone());
+        Ok(analysis)
+    }
+
+    /// Keeps `analysis` (made elsewhere, e.g. on another thread) as the one of `pattern`.
+    pub fn keep(&mut self, pattern: SymbolicSparseColMat<usize>, analysis: std::rc::Rc<Analysis>) {
+        if self.kept.len() == Self::KEPT {
+            self.kept.remove(0);
+        }
+        self.kept.push((pattern, analysis));
+    }
+
+    /// Drops every kept analysis (a million-vertex Laplacian's is hundreds of MiB).
+    pub fn clear(&mut self) {
+        self.kept.clear();
+    }
+
+    /// Whether analyses made here may plan two-thread factorisations.
+    pub fn split_allowed(&self) -> bool {
+        self.split_allowed
+    }
 }
 
 /// A sparse SPD solver for a fixed pattern: the analysis ([`analyse`]) is done once, each
@@ -807,12 +830,12 @@ pub struct SpdSolver {
 }
 
 impl SpdSolver {
-    /// Analyses the upper-triangular pattern.
+    /// Analyses the upper-triangular pattern, or takes its analysis from `analyses`.
     ///
     /// # Errors
     /// A message if the analysis or the workspace allocation fails.
-    pub fn new(pattern: SymbolicSparseColMatRef<'_, usize>) -> Result<Self, String> {
-        let analysis = cached_symbolic(&SOLVER_LAST, pattern, || analyse(pattern))?;
+    pub fn new(pattern: SymbolicSparseColMatRef<'_, usize>, analyses: &mut Analyses) -> Result<Self, String> {
+        let analysis = analyses.of(pattern)?;
         Ok(SpdSolver { f: SpdFactor::new(analysis)? })
     }
 
@@ -852,10 +875,7 @@ mod tests {
 
     /// [`analyse`] restricted to one factorisation (AMD or nested dissection).
     fn single_analysis(a: SymbolicSparseColMatRef<'_, usize>) -> SymbolicCholesky<usize> {
-        allow_split_on_this_thread(false);
-        let analysis = analyse(a);
-        allow_split_on_this_thread(true);
-        match analysis.unwrap() {
+        match analyse(a, false).unwrap() {
             Analysis::Single { symbolic, .. } => *symbolic,
             Analysis::TwoWay(_) => panic!("split forbidden"),
         }
@@ -956,7 +976,7 @@ mod tests {
             let n = nx * ny;
             let a = upper_pattern(n, &grid_edges(nx, ny, ring2));
             let vals = spd_values(a.as_ref());
-            let analysis = analyse(a.as_ref()).unwrap();
+            let analysis = analyse(a.as_ref(), true).unwrap();
             let Analysis::TwoWay(t) = &analysis else { panic!("{nx}x{ny}: a grid is split in two") };
             // the separator is a thin cut: one or two grid lines across
             assert!(t.separator_len() <= 3 * nx.max(ny), "separator {}", t.separator_len());
@@ -984,7 +1004,7 @@ mod tests {
         e.extend(grid_edges(30, 30, false).into_iter().map(|(i, j)| (i + 2000, j + 2000)));
         let n = 2000 + 900;
         let a = upper_pattern(n, &e);
-        let analysis = analyse(a.as_ref()).unwrap();
+        let analysis = analyse(a.as_ref(), true).unwrap();
         assert!(matches!(analysis, Analysis::Single { .. }));
         let vals = spd_values(a.as_ref());
         let mut f = SpdFactor::new(std::rc::Rc::new(analysis)).unwrap();
@@ -1003,10 +1023,7 @@ mod tests {
         // parts = first and second half of the rows, "separator" = the last row: they touch
         let perm: Vec<usize> = (0..n).collect();
         assert!(two_way::Symbolic::new(a.as_ref(), &perm, [n / 2, n / 2 - nx]).is_none());
-        allow_split_on_this_thread(false);
-        let analysis = analyse(a.as_ref());
-        allow_split_on_this_thread(true);
-        assert!(matches!(analysis.unwrap(), Analysis::Single { .. }));
+        assert!(matches!(analyse(a.as_ref(), false).unwrap(), Analysis::Single { .. }));
     }
 
     #[test]

@@ -1,7 +1,7 @@
 //! Harmonic interpolation: `K u = 0` at free vertices, given values at fixed ones.
 
 use super::sparse::Sparse;
-use crate::linalg::solve_spd_once;
+use crate::linalg::{solve_spd, Analyses};
 use faer::sparse::Triplet;
 
 /// Solves `(K u)_i = 0` for every free vertex `i` with `u_j = fixed_j` where given (Dirichlet
@@ -12,6 +12,19 @@ use faer::sparse::Triplet;
 /// # Errors
 /// A message if `K_FF` is not positive definite (a free part with no fixed vertex).
 pub fn dirichlet_solve(k: &Sparse, fixed: &[Option<f64>]) -> Result<Vec<f64>, String> {
+    dirichlet_solve_with(k, fixed, None)
+}
+
+/// [`dirichlet_solve`] with the analysis of `K_FF` taken from and kept in `analyses` when
+/// given (the same fixed set solved again).
+///
+/// # Errors
+/// As [`dirichlet_solve`].
+pub fn dirichlet_solve_with(
+    k: &Sparse,
+    fixed: &[Option<f64>],
+    analyses: Option<&mut Analyses>,
+) -> Result<Vec<f64>, String> {
     let n = k.nrows();
     assert_eq!(fixed.len(), n);
     let mut slot = vec![usize::MAX; n];
@@ -42,7 +55,7 @@ pub fn dirichlet_solve(k: &Sparse, fixed: &[Option<f64>]) -> Result<Vec<f64>, St
         }
     }
     let a = Sparse::try_new_from_triplets(nf, nf, &t).map_err(|e| format!("{e:?}"))?;
-    solve_spd_once(a.as_ref(), &mut rhs)
+    solve_spd(a.as_ref(), &mut rhs, analyses)
         .map_err(|_| "a free part of the domain touches no fixed vertex".to_string())?;
     for (k, &i) in free.iter().enumerate() {
         u[i] = rhs[k];
@@ -62,13 +75,14 @@ pub struct Dirichlet<'a> {
 }
 
 impl<'a> Dirichlet<'a> {
-    /// Analyses `k`'s pattern (square, symmetric, with every diagonal entry present).
+    /// Analyses `k`'s pattern (square, symmetric, with every diagonal entry present), or
+    /// takes its analysis from `analyses`.
     ///
     /// # Errors
     /// A message if the analysis fails.
-    pub fn new(k: &'a Sparse) -> Result<Self, String> {
+    pub fn new(k: &'a Sparse, analyses: &mut crate::linalg::Analyses) -> Result<Self, String> {
         let (upper, pattern) = Self::pattern(k);
-        let solver = crate::linalg::SpdSolver::new(pattern.as_ref())?;
+        let solver = crate::linalg::SpdSolver::new(pattern.as_ref(), analyses)?;
         Ok(Dirichlet { k, upper, pattern, solver })
     }
 
@@ -156,7 +170,7 @@ mod tests {
         }
         assert!(dirichlet_solve(&k, &vec![None; 20]).is_err());
         // the reusable solver gives the same answers for changing fixed sets
-        let mut d = Dirichlet::new(&k).unwrap();
+        let mut d = Dirichlet::new(&k, &mut Analyses::default()).unwrap();
         let u2 = d.solve(&fixed).unwrap();
         assert!(u.iter().zip(&u2).all(|(a, b)| (a - b).abs() < 1e-12));
         let mut fewer = fixed.clone();

@@ -3,7 +3,8 @@
 //! vertex, by Clarabel. The comparison method of the no-data mode: no monotonicity.
 
 use super::clarabel::run;
-use super::qp::{QpSettings, SolveStatus};
+use super::settings::QpSettings;
+use super::status::SolveStatus;
 use crate::error::{Error, Result};
 use crate::operators::Sparse;
 use clarabel::algebra::CscMatrix;

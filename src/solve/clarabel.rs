@@ -1,6 +1,8 @@
 //! Clarabel (faer's sparse LDLᵀ inside) on the reduced QP.
 
-use super::qp::{Outcome, QpSettings, ReducedFactor, ReducedQp, SolveStatus};
+use super::problem::{ReducedFactor, ReducedQp};
+use super::settings::QpSettings;
+use super::status::{Outcome, SolveStatus};
 use crate::error::{Error, Result};
 use clarabel::algebra::CscMatrix;
 use clarabel::solver::{

@@ -5,7 +5,7 @@
 //! function is nearly free of energy, so the largest eigenvalue is the estimate: for an energy
 //! of order k with smoothing length ℓ on spacings h it is about `1 + 4^k (ℓ/h)^{2k}`.
 
-use super::qp::ReducedQp;
+use super::problem::ReducedQp;
 
 /// Power iterations: the Rayleigh quotient of the largest eigenvalue, from a start with random
 /// signs (the top eigenvector oscillates at the grid scale), settles within a few per cent.

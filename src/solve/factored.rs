@@ -16,8 +16,8 @@
 //! eigenvalues: κ beyond about 10¹⁴), the normal matrix is factorised in double-double itself
 //! (simplicial: faer's dense kernels are for native floats only), from then on.
 
-use super::ipm::{Normal as Pattern, Objective, Rows};
-use super::qp::{ReducedFactor, ReducedQp};
+use super::newton::{Normal as Pattern, Objective, Rows};
+use super::problem::{ReducedFactor, ReducedQp};
 use crate::linalg;
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::fx128;
@@ -58,7 +58,8 @@ pub(super) struct Normal<'r> {
 
 impl<'r> Normal<'r> {
     /// The pattern of `P + AᵀWA` (P's on the free variables and the constrained pairs), `F`'s
-    /// Gram matrix on it in double-double, and its symbolic factorisation.
+    /// Gram matrix on it in double-double, and its symbolic factorisation (`split_allowed`:
+    /// see [`linalg::analyse`]).
     ///
     /// # Errors
     /// A message if `FᵀF` has an entry outside `P`'s pattern or the analysis fails.
@@ -67,6 +68,7 @@ impl<'r> Normal<'r> {
         f: &'r ReducedFactor,
         row_cols: &[[usize; 2]],
         row_len: &[u8],
+        split: bool,
     ) -> Result<Normal<'r>, String> {
         let pattern = Pattern::new(r, row_cols, row_len);
         let (cp, ri) = (pattern.symbolic.col_ptr(), pattern.symbolic.row_idx());
@@ -97,7 +99,7 @@ impl<'r> Normal<'r> {
         for (j, &d) in r.d.iter().enumerate() {
             base[pattern.pos_diag[j]] += fx128::from(d);
         }
-        let analysis = std::rc::Rc::new(linalg::analyse(pattern.symbolic.as_ref())?);
+        let analysis = std::rc::Rc::new(linalg::analyse(pattern.symbolic.as_ref(), split)?);
         let spd = linalg::SpdFactor::new(analysis)?;
         Ok(Normal {
             f,

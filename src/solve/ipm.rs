@@ -13,124 +13,12 @@
 //! double-double ([`super::factored`]). Whatever it returns, the certificate decides the
 //! topology and the gap bound of the output as written decides the fit.
 
-use super::qp::{Outcome, QpSettings, ReducedQp, SolveStatus};
+use super::newton::{max, Normal, Objective, Prepared, Real, Rows};
+use super::problem::ReducedQp;
+use super::settings::QpSettings;
+use super::status::{Outcome, SolveStatus};
 use crate::linalg as ordering;
-use faer::sparse::{SparseColMatRef, SymbolicSparseColMat, SymbolicSparseColMatRef};
-
-/// Upper-triangular pattern of `N` and where each contribution lands in its value array.
-pub(super) struct Normal {
-    pub(super) symbolic: SymbolicSparseColMat<usize>,
-    /// Position of each P triplet.
-    pub(super) pos_p: Vec<usize>,
-    /// Per row: positions of (c1,c1), (c2,c2), (c1,c2) (the last two unused for one-entry rows).
-    pub(super) pos_row: Vec<[usize; 3]>,
-    /// Position of each diagonal entry.
-    pub(super) pos_diag: Vec<usize>,
-}
-
-/// Upper-triangular pattern, every diagonal entry included, of the pairs `(i, j)` with
-/// `i ≤ j` (duplicates merged): column pointers and sorted row indices.
-fn upper_pattern(n: usize, pairs: impl Iterator<Item = (usize, usize)> + Clone) -> (Vec<usize>, Vec<usize>) {
-    let mut count = vec![0usize; n + 1];
-    for (_, j) in pairs.clone() {
-        count[j + 1] += 1;
-    }
-    for j in 0..n {
-        count[j + 1] += count[j] + 1;
-    }
-    let mut fill = count.clone();
-    let mut rows = vec![0usize; count[n]];
-    for j in 0..n {
-        rows[fill[j]] = j;
-        fill[j] += 1;
-    }
-    for (i, j) in pairs {
-        rows[fill[j]] = i;
-        fill[j] += 1;
-    }
-    ordering::compress_columns(&count, &mut rows)
-}
-
-impl Normal {
-    pub(super) fn new(r: &ReducedQp, row_cols: &[[usize; 2]], row_len: &[u8]) -> Normal {
-        let n = r.n;
-        let rows = row_cols.iter().zip(row_len).filter(|(_, &l)| l == 2).map(|(c, _)| (c[0].min(c[1]), c[0].max(c[1])));
-        let (col_ptr, row_idx) = upper_pattern(n, r.p.iter().map(|&(i, j, _)| (i, j)).chain(rows));
-        let find = |i: usize, j: usize| {
-            col_ptr[j] + row_idx[col_ptr[j]..col_ptr[j + 1]].binary_search(&i).expect("in pattern")
-        };
-        let pos_p = r.p.iter().map(|&(i, j, _)| find(i, j)).collect();
-        let pos_row = row_cols
-            .iter()
-            .zip(row_len)
-            .map(|(c, &len)| {
-                if len == 2 {
-                    [find(c[0], c[0]), find(c[1], c[1]), find(c[0].min(c[1]), c[0].max(c[1]))]
-                } else {
-                    let d = find(c[0], c[0]);
-                    [d, d, d]
-                }
-            })
-            .collect();
-        let pos_diag = (0..n).map(|j| find(j, j)).collect();
-        let symbolic = SymbolicSparseColMat::new_checked(n, n, col_ptr, None, row_idx);
-        Normal { symbolic, pos_p, pos_row, pos_diag }
-    }
-}
-
-/// The analysis of a normal matrix made before its constraints are known: from the pattern of
-/// `P` on the free variables alone. The constrained pairs of a monotone QP are edges of the
-/// domain, inside the pattern of any energy built on its Laplacian, so the normal matrix's
-/// pattern is that one and [`solve`] finds this analysis ready ([`Prepared::install`]).
-pub struct Prepared {
-    pattern: SymbolicSparseColMat<usize>,
-    analysis: ordering::Analysis,
-    /// The factor's storage, its pages mapped in advance.
-    workspace: Option<ordering::Workspace>,
-}
-
-impl Prepared {
-    /// Analyses the pattern of the upper triangle of `P` on the free variables (`slot[i]`:
-    /// index of variable `i` among the free ones, `usize::MAX` if fixed; `n` free ones).
-    ///
-    /// # Errors
-    /// A message if the analysis fails.
-    pub fn new(p: SymbolicSparseColMatRef<'_, usize>, slot: &[usize], n: usize) -> Result<Prepared, String> {
-        let (cp, ri) = (p.col_ptr(), p.row_idx());
-        let pairs = (0..p.ncols()).flat_map(|j| {
-            ri[cp[j]..p.col_range(j).end].iter().filter_map(move |&i| {
-                let (si, sj) = (slot[i], slot[j]);
-                (si != usize::MAX && sj != usize::MAX && si <= sj).then_some((si, sj))
-            })
-        });
-        let (col_ptr, row_idx) = upper_pattern(n, pairs);
-        let pattern = SymbolicSparseColMat::new_checked(n, n, col_ptr, None, row_idx);
-        let analysis = ordering::analyse(pattern.as_ref())?;
-        // without it (faer's scratch could not be allocated) the solver makes the storage
-        let workspace = ordering::Workspace::new(&analysis).ok();
-        Ok(Prepared { pattern, analysis, workspace })
-    }
-
-    /// The analysed pattern.
-    #[cfg(test)]
-    pub(crate) fn pattern(&self) -> SymbolicSparseColMatRef<'_, usize> {
-        self.pattern.as_ref()
-    }
-
-    /// Makes the analysis the one [`solve`] on this thread uses for a normal matrix of this
-    /// pattern.
-    pub fn install(self) {
-        let analysis = std::rc::Rc::new(self.analysis);
-        SPARE.with(|c| *c.borrow_mut() = self.workspace.map(|w| (analysis.clone(), w)));
-        LAST.with(|c| *c.borrow_mut() = Some((self.pattern, analysis)));
-    }
-}
-
-/// Drops the factor storage [`Prepared::install`] made ready on this thread, for a QP that
-/// needs no solve.
-pub(super) fn forget_prepared_storage() {
-    SPARE.with(|c| *c.borrow_mut() = None);
-}
+use faer::sparse::SparseColMatRef;
 
 /// Centrality correctors per iteration at most. Iterations without / with 2 at the same
 /// stopping rule (μ ≤ tol): 150 × 100 grid 10 / 7, 300² 11 / 8, mountain distance 7 / 6,
@@ -139,122 +27,6 @@ pub(super) fn forget_prepared_storage() {
 const CORRECTORS: usize = 2;
 /// How much longer than the corrected predictor's step a corrector aims.
 const CORRECTOR_STEP: f64 = 0.3;
-
-thread_local! {
-    /// The last normal-equation pattern analysed on this thread (nested dissection and AMD).
-    static LAST: ordering::SymbolicSlot<ordering::Analysis> = const { std::cell::RefCell::new(None) };
-    /// Storage made in advance for the factorisations of one analysis in `LAST`.
-    static SPARE: std::cell::RefCell<Option<(std::rc::Rc<ordering::Analysis>, ordering::Workspace)>> =
-        const { std::cell::RefCell::new(None) };
-}
-
-/// The arithmetic of an interior-point run: `f64`, or double-double (`fx128`) for the factored
-/// form of an ill-conditioned QP, where every residual and right-hand side must keep the digits
-/// that `P`'s condition number takes from the solve.
-pub(super) trait Real:
-    Copy
-    + PartialOrd
-    + std::ops::Add<Output = Self>
-    + std::ops::Sub<Output = Self>
-    + std::ops::Mul<Output = Self>
-    + std::ops::Div<Output = Self>
-    + std::ops::Neg<Output = Self>
-    + std::ops::AddAssign
-{
-    fn of(x: f64) -> Self;
-    fn to_f64(self) -> f64;
-}
-
-impl Real for f64 {
-    fn of(x: f64) -> Self {
-        x
-    }
-    fn to_f64(self) -> f64 {
-        self
-    }
-}
-
-impl Real for faer::fx128 {
-    fn of(x: f64) -> Self {
-        faer::fx128::from(x)
-    }
-    fn to_f64(self) -> f64 {
-        self.0 + self.1
-    }
-}
-
-fn max<T: Real>(a: T, b: T) -> T {
-    if b > a {
-        b
-    } else {
-        a
-    }
-}
-
-/// The constraint rows of a reduced QP: one or two entries each.
-pub(super) struct Rows {
-    pub(super) cols: Vec<[usize; 2]>,
-    pub(super) vals: Vec<[f64; 2]>,
-    pub(super) len: Vec<u8>,
-}
-
-impl Rows {
-    fn new(r: &ReducedQp) -> Result<Rows, String> {
-        let m = r.m();
-        let mut rows = Rows { cols: vec![[0; 2]; m], vals: vec![[0.0; 2]; m], len: vec![0; m] };
-        for k in 0..r.a_row.len() {
-            let row = r.a_row[k];
-            let l = rows.len[row] as usize;
-            if l >= 2 {
-                return Err(format!("row {row} has more than two entries"));
-            }
-            rows.cols[row][l] = r.a_col[k];
-            rows.vals[row][l] = r.a_val[k];
-            rows.len[row] += 1;
-        }
-        Ok(rows)
-    }
-
-    /// `out = A x`.
-    fn ax<T: Real>(&self, x: &[T], out: &mut [T]) {
-        for (k, o) in out.iter_mut().enumerate() {
-            let [c0, c1] = self.cols[k];
-            let [v0, v1] = self.vals[k];
-            *o = if self.len[k] == 2 { T::of(v0) * x[c0] + T::of(v1) * x[c1] } else { T::of(v0) * x[c0] };
-        }
-    }
-
-    /// `out = Aᵀ z`.
-    fn atz<T: Real>(&self, z: &[T], out: &mut [T]) {
-        out.iter_mut().for_each(|v| *v = T::of(0.0));
-        for (k, &zk) in z.iter().enumerate() {
-            let [c0, c1] = self.cols[k];
-            let [v0, v1] = self.vals[k];
-            out[c0] += T::of(v0) * zk;
-            if self.len[k] == 2 {
-                out[c1] += T::of(v1) * zk;
-            }
-        }
-    }
-}
-
-/// The objective's part of the Newton system: its gradient at the iterate and the
-/// factorisation of `P + AᵀWA`.
-pub(super) trait Objective<T: Real> {
-    /// `out = ∇φ(x)`.
-    fn gradient(&mut self, x: &[T], out: &mut [T]);
-    /// Factorises `P + Aᵀ diag(w) A`.
-    fn factor(&mut self, rows: &Rows, w: &[T]) -> Result<(), String>;
-    /// Overwrites `rhs` with the last factorised matrix's inverse times it.
-    fn solve_in_place(&mut self, rhs: &mut [T]);
-    /// The auxiliary variables `t = F x + g` (factored form), rounded.
-    fn auxiliary(&self, x: &[T]) -> Option<Vec<f64>>;
-    /// `½ rᵀ P⁻¹ r`, for the gap of a QP without a data term (no `P ⪰ diag(d)` to bound it
-    /// by): `None` where the objective cannot solve with `P` alone.
-    fn energy_dual(&mut self, _r: &[T]) -> Option<f64> {
-        None
-    }
-}
 
 /// `P` assembled; normal equations in double precision.
 struct Assembled<'r> {
@@ -353,21 +125,28 @@ const POLISH_SWEEPS: usize = 5;
 /// the data term; without one, when `sᵀz + ½ρᵀP⁻¹ρ` (P factorised alone) is below it × the
 /// energy, or — where P alone cannot be factorised — when the mean complementarity is 10×
 /// below the feasibility tolerance. The factored form runs in double-double throughout.
-pub(super) fn solve(r: &ReducedQp, hint: Option<&[f64]>, settings: &QpSettings) -> Result<Outcome, String> {
-    // the storage made in advance is this solve's or nobody's: not kept past an early return
-    let spare = SPARE.with(|c| c.borrow_mut().take());
+///
+/// The normal matrix's analysis comes from `analyses` (and is kept there for the next solve
+/// on the same pattern); `prepared`, made in advance, is kept there first.
+pub(super) fn solve(
+    r: &ReducedQp,
+    hint: Option<&[f64]>,
+    settings: &QpSettings,
+    analyses: &mut ordering::Analyses,
+    prepared: Option<Prepared>,
+) -> Result<Outcome, String> {
+    let spare = prepared.and_then(|p| p.keep_in(analyses));
     let rows = Rows::new(r)?;
     match &r.factor {
         Some(factor) => {
             drop(spare);
-            let mut objective = super::factored::Normal::new(r, factor, &rows.cols, &rows.len)?;
+            let split = analyses.split_allowed();
+            let mut objective = super::factored::Normal::new(r, factor, &rows.cols, &rows.len, split)?;
             run::<faer::fx128, _>(r, &rows, &mut objective, hint, settings)
         }
         None => {
             let normal = Normal::new(r, &rows.cols, &rows.len);
-            let analysis = ordering::cached_symbolic(&LAST, normal.symbolic.as_ref(), || {
-                ordering::analyse(normal.symbolic.as_ref())
-            })?;
+            let analysis = analyses.of(normal.symbolic.as_ref())?;
             let spare = spare.filter(|(a, _)| std::rc::Rc::ptr_eq(a, &analysis));
             let spd = match spare {
                 Some((_, workspace)) => ordering::SpdFactor::with_workspace(analysis.clone(), workspace),
@@ -662,7 +441,7 @@ fn run<T: Real, O: Objective<T>>(
 
 /// The normal matrix's pattern [`solve`] analyses for `r`.
 #[cfg(test)]
-pub(crate) fn normal_pattern(r: &ReducedQp) -> SymbolicSparseColMat<usize> {
+pub(crate) fn normal_pattern(r: &ReducedQp) -> faer::sparse::SymbolicSparseColMat<usize> {
     let mut row_cols = vec![[0usize; 2]; r.m()];
     let mut row_len = vec![0u8; r.m()];
     for k in 0..r.a_row.len() {

@@ -9,16 +9,20 @@ mod clarabel;
 mod condition;
 mod factored;
 mod ipm;
+mod newton;
 mod optimality;
+mod problem;
 mod qp;
 mod repair;
+mod settings;
+mod status;
 
 pub use bounded::solve_bounded_partition;
 pub use condition::condition_estimate;
-pub use ipm::Prepared;
-pub use optimality::{optimality, Optimality};
-pub use qp::{
-    constraint_rows, prepare, solve_monotone_qp, Bound, Formulation, Method, MonotoneQp, QpSettings, QpSolution,
-    ReducedQp, Row, SolveStatus, FACTORED_ABOVE,
-};
+pub use newton::Prepared;
+pub use optimality::{optimality, optimality_with, Optimality};
+pub use problem::{constraint_rows, Bound, MonotoneQp, ReducedQp, Row};
+pub use qp::{prepare, solve_monotone_qp, solve_monotone_qp_with};
 pub use repair::{meet_margin, repair, MarginSummary, RepairSummary};
+pub use settings::{Formulation, Method, QpSettings, FACTORED_ABOVE};
+pub use status::{QpSolution, SolveStatus};

@@ -11,7 +11,7 @@
 //!
 //! Everything is summed in double-double, so the bound measures the point, not the arithmetic.
 
-use super::qp::{constraint_rows, MonotoneQp, Row};
+use super::problem::{constraint_rows, MonotoneQp, Row};
 use faer::fx128;
 
 /// The gap bound of a point and what it is made of, in the units of the QP as given.
@@ -60,6 +60,21 @@ fn round(x: fx128) -> f64 {
 /// # Panics
 /// If the lengths disagree with the problem.
 pub fn optimality(qp: &MonotoneQp<'_>, f: &[f64], z: &[f64], y: Option<&[f64]>) -> Optimality {
+    optimality_with(qp, f, z, y, None)
+}
+
+/// [`optimality`]; without a data term the solve with `P` takes its analysis from and keeps
+/// it in `analyses` when given.
+///
+/// # Panics
+/// As [`optimality`].
+pub fn optimality_with(
+    qp: &MonotoneQp<'_>,
+    f: &[f64],
+    z: &[f64],
+    y: Option<&[f64]>,
+    analyses: Option<&mut crate::linalg::Analyses>,
+) -> Optimality {
     let n = qp.q.len();
     assert_eq!(f.len(), n);
     let rows = constraint_rows(qp);
@@ -150,7 +165,7 @@ pub fn optimality(qp: &MonotoneQp<'_>, f: &[f64], z: &[f64], y: Option<&[f64]>) 
     let by_solve = !bounded;
     if by_solve {
         // no data term: ½ ρᵀP⁻¹ρ by one solve with P on the free entries
-        stationarity = solve_with_p(qp, &free, &rho).unwrap_or(f64::INFINITY);
+        stationarity = solve_with_p(qp, &free, &rho, analyses).unwrap_or(f64::INFINITY);
     }
     let gap = complementarity + 0.5 * stationarity + 0.5 * auxiliary_residual * auxiliary_residual;
     let energy = {
@@ -179,7 +194,12 @@ pub fn optimality(qp: &MonotoneQp<'_>, f: &[f64], z: &[f64], y: Option<&[f64]>) 
 
 /// `ρ_Fᵀ P_FF⁻¹ ρ_F` for the free entries (`None` if `P_FF` is not numerically positive
 /// definite).
-fn solve_with_p(qp: &MonotoneQp<'_>, free: &[bool], rho: &[fx128]) -> Option<f64> {
+fn solve_with_p(
+    qp: &MonotoneQp<'_>,
+    free: &[bool],
+    rho: &[fx128],
+    analyses: Option<&mut crate::linalg::Analyses>,
+) -> Option<f64> {
     let n = free.len();
     let mut slot = vec![usize::MAX; n];
     let mut nf = 0;
@@ -202,6 +222,6 @@ fn solve_with_p(qp: &MonotoneQp<'_>, free: &[bool], rho: &[fx128]) -> Option<f64
     let upper = crate::operators::Sparse::try_new_from_triplets(nf, nf, &t).ok()?;
     let r: Vec<f64> = (0..n).filter(|&i| free[i]).map(|i| round(rho[i])).collect();
     let mut y = r.clone();
-    crate::linalg::solve_spd_once(upper.as_ref(), &mut y).ok()?;
+    crate::linalg::solve_spd(upper.as_ref(), &mut y, analyses).ok()?;
     Some(r.iter().zip(&y).map(|(a, b)| a * b).sum())
 }

@@ -1,0 +1,63 @@
+//! What the three `smooth` paths (series, grids, meshes) share: the command's options and the
+//! lines of its summary.
+
+use super::input::{DomainKind, GridOptions};
+use super::sig6;
+use crate::io::series_csv::SeriesCsvOptions;
+use crate::pipeline::{Report, SmoothSettings, StageSeconds};
+use std::path::PathBuf;
+
+/// Options of `smooth`.
+#[derive(Clone, Debug)]
+pub struct SmoothArgs {
+    /// Input file (none when a grid comes from `--u`/`--v`).
+    pub input: Option<PathBuf>,
+    /// Series or grid.
+    pub kind: DomainKind,
+    /// Column choice (series).
+    pub csv: SeriesCsvOptions,
+    /// Array, spacing, derivation and NaN policy (grids).
+    pub grid: GridOptions,
+    /// Kept critical points and separatrices as VTK PolyData (grids).
+    pub complex: Option<PathBuf>,
+    /// Isolines in the grid plot.
+    pub isolines: usize,
+    /// Camera of the mesh plot.
+    pub view: crate::plot::MeshView,
+    /// Output CSV.
+    pub output: PathBuf,
+    /// Pipeline settings.
+    pub settings: SmoothSettings,
+    /// Figure.
+    pub plot: Option<PathBuf>,
+    /// JSON report.
+    pub report: Option<PathBuf>,
+}
+
+/// The certificate, deviation and solver lines of `smooth`'s summary (series and grids).
+pub fn fit_and_solver_lines(r: &Report) -> String {
+    format!(
+        "{}; RMS deviation {}, max deviation {}\n{}\nsolver {:?} {:?} in {} iterations{}, {} constraints, margin {:.3e}; margin met exactly by moving {} vertices (at most {:.1e}); strictness repair changed {} vertices\n",
+        r.certificate.summary(),
+        sig6(r.rms_deviation),
+        sig6(r.max_deviation),
+        r.fit.summary(),
+        r.solver,
+        r.solver_status,
+        r.solver_iterations,
+        r.solver_fallback.as_ref().map(|w| format!(" (structured solver gave up: {w})")).unwrap_or_default(),
+        r.constraints,
+        r.settings.margin[0],
+        r.margin_repair.changed_vertices,
+        r.margin_repair.max_change,
+        r.repair.changed_vertices
+    )
+}
+
+/// The `seconds:` line of a surface run.
+pub fn surface_seconds_line(read: f64, s: &StageSeconds, write: f64, total: f64) -> String {
+    format!(
+        "seconds: read {:.3}, persistence {:.3}, complex {:.3}, simplify {:.3}, representative {:.3}, operators {:.3}, constraints {:.3}, solve {:.3}, repair {:.3}, verify {:.3}, write {:.3}, total {:.3}\n",
+        read, s.persistence, s.complex, s.simplify, s.representative, s.operators, s.constraints, s.solve, s.repair, s.verify, write, total
+    )
+}

@@ -1,0 +1,227 @@
+//! The pieces of the interior-point method's Newton system that both arithmetics share: the
+//! constraint rows, the normal matrix's pattern (and its analysis made in advance), the
+//! objective's interface and the arithmetic itself (`f64` or double-double).
+
+use super::problem::ReducedQp;
+use crate::linalg as ordering;
+use faer::sparse::{SymbolicSparseColMat, SymbolicSparseColMatRef};
+
+/// Upper-triangular pattern of `N` and where each contribution lands in its value array.
+pub(super) struct Normal {
+    pub(super) symbolic: SymbolicSparseColMat<usize>,
+    /// Position of each P triplet.
+    pub(super) pos_p: Vec<usize>,
+    /// Per row: positions of (c1,c1), (c2,c2), (c1,c2) (the last two unused for one-entry rows).
+    pub(super) pos_row: Vec<[usize; 3]>,
+    /// Position of each diagonal entry.
+    pub(super) pos_diag: Vec<usize>,
+}
+
+/// Upper-triangular pattern, every diagonal entry included, of the pairs `(i, j)` with
+/// `i ≤ j` (duplicates merged): column pointers and sorted row indices.
+fn upper_pattern(n: usize, pairs: impl Iterator<Item = (usize, usize)> + Clone) -> (Vec<usize>, Vec<usize>) {
+    let mut count = vec![0usize; n + 1];
+    for (_, j) in pairs.clone() {
+        count[j + 1] += 1;
+    }
+    for j in 0..n {
+        count[j + 1] += count[j] + 1;
+    }
+    let mut fill = count.clone();
+    let mut rows = vec![0usize; count[n]];
+    for j in 0..n {
+        rows[fill[j]] = j;
+        fill[j] += 1;
+    }
+    for (i, j) in pairs {
+        rows[fill[j]] = i;
+        fill[j] += 1;
+    }
+    ordering::compress_columns(&count, &mut rows)
+}
+
+impl Normal {
+    pub(super) fn new(r: &ReducedQp, row_cols: &[[usize; 2]], row_len: &[u8]) -> Normal {
+        let n = r.n;
+        let rows = row_cols.iter().zip(row_len).filter(|(_, &l)| l == 2).map(|(c, _)| (c[0].min(c[1]), c[0].max(c[1])));
+        let (col_ptr, row_idx) = upper_pattern(n, r.p.iter().map(|&(i, j, _)| (i, j)).chain(rows));
+        let find = |i: usize, j: usize| {
+            col_ptr[j] + row_idx[col_ptr[j]..col_ptr[j + 1]].binary_search(&i).expect("in pattern")
+        };
+        let pos_p = r.p.iter().map(|&(i, j, _)| find(i, j)).collect();
+        let pos_row = row_cols
+            .iter()
+            .zip(row_len)
+            .map(|(c, &len)| {
+                if len == 2 {
+                    [find(c[0], c[0]), find(c[1], c[1]), find(c[0].min(c[1]), c[0].max(c[1]))]
+                } else {
+                    let d = find(c[0], c[0]);
+                    [d, d, d]
+                }
+            })
+            .collect();
+        let pos_diag = (0..n).map(|j| find(j, j)).collect();
+        let symbolic = SymbolicSparseColMat::new_checked(n, n, col_ptr, None, row_idx);
+        Normal { symbolic, pos_p, pos_row, pos_diag }
+    }
+}
+
+/// The analysis of a normal matrix made before its constraints are known: from the pattern of
+/// `P` on the free variables alone. The constrained pairs of a monotone QP are edges of the
+/// domain, inside the pattern of any energy built on its Laplacian, so the normal matrix's
+/// pattern is that one and [`super::ipm::solve`], given it, finds this analysis ready.
+pub struct Prepared {
+    pattern: SymbolicSparseColMat<usize>,
+    analysis: ordering::Analysis,
+    /// The factor's storage, its pages mapped in advance.
+    workspace: Option<ordering::Workspace>,
+}
+
+impl Prepared {
+    /// Analyses the pattern of the upper triangle of `P` on the free variables (`slot[i]`:
+    /// index of variable `i` among the free ones, `usize::MAX` if fixed; `n` free ones).
+    ///
+    /// # Errors
+    /// A message if the analysis fails.
+    pub fn new(p: SymbolicSparseColMatRef<'_, usize>, slot: &[usize], n: usize) -> Result<Prepared, String> {
+        let (cp, ri) = (p.col_ptr(), p.row_idx());
+        let pairs = (0..p.ncols()).flat_map(|j| {
+            ri[cp[j]..p.col_range(j).end].iter().filter_map(move |&i| {
+                let (si, sj) = (slot[i], slot[j]);
+                (si != usize::MAX && sj != usize::MAX && si <= sj).then_some((si, sj))
+            })
+        });
+        let (col_ptr, row_idx) = upper_pattern(n, pairs);
+        let pattern = SymbolicSparseColMat::new_checked(n, n, col_ptr, None, row_idx);
+        let analysis = ordering::analyse(pattern.as_ref(), true)?;
+        // without it (faer's scratch could not be allocated) the solver makes the storage
+        let workspace = ordering::Workspace::new(&analysis).ok();
+        Ok(Prepared { pattern, analysis, workspace })
+    }
+
+    /// The analysed pattern.
+    #[cfg(test)]
+    pub(crate) fn pattern(&self) -> SymbolicSparseColMatRef<'_, usize> {
+        self.pattern.as_ref()
+    }
+
+    /// Keeps the analysis in `analyses` and returns the storage made for it.
+    pub(super) fn keep_in(
+        self,
+        analyses: &mut ordering::Analyses,
+    ) -> Option<(std::rc::Rc<ordering::Analysis>, ordering::Workspace)> {
+        let analysis = std::rc::Rc::new(self.analysis);
+        analyses.keep(self.pattern, analysis.clone());
+        self.workspace.map(|w| (analysis, w))
+    }
+}
+
+/// The arithmetic of an interior-point run: `f64`, or double-double (`fx128`) for the factored
+/// form of an ill-conditioned QP, where every residual and right-hand side must keep the digits
+/// that `P`'s condition number takes from the solve.
+pub(super) trait Real:
+    Copy
+    + PartialOrd
+    + std::ops::Add<Output = Self>
+    + std::ops::Sub<Output = Self>
+    + std::ops::Mul<Output = Self>
+    + std::ops::Div<Output = Self>
+    + std::ops::Neg<Output = Self>
+    + std::ops::AddAssign
+{
+    fn of(x: f64) -> Self;
+    fn to_f64(self) -> f64;
+}
+
+impl Real for f64 {
+    fn of(x: f64) -> Self {
+        x
+    }
+    fn to_f64(self) -> f64 {
+        self
+    }
+}
+
+impl Real for faer::fx128 {
+    fn of(x: f64) -> Self {
+        faer::fx128::from(x)
+    }
+    fn to_f64(self) -> f64 {
+        self.0 + self.1
+    }
+}
+
+pub(super) fn max<T: Real>(a: T, b: T) -> T {
+    if b > a {
+        b
+    } else {
+        a
+    }
+}
+
+/// The constraint rows of a reduced QP: one or two entries each.
+pub(super) struct Rows {
+    pub(super) cols: Vec<[usize; 2]>,
+    pub(super) vals: Vec<[f64; 2]>,
+    pub(super) len: Vec<u8>,
+}
+
+impl Rows {
+    /// The rows of `r`; `Err` if one has more than two entries.
+    pub(super) fn new(r: &ReducedQp) -> Result<Rows, String> {
+        let m = r.m();
+        let mut rows = Rows { cols: vec![[0; 2]; m], vals: vec![[0.0; 2]; m], len: vec![0; m] };
+        for k in 0..r.a_row.len() {
+            let row = r.a_row[k];
+            let l = rows.len[row] as usize;
+            if l >= 2 {
+                return Err(format!("row {row} has more than two entries"));
+            }
+            rows.cols[row][l] = r.a_col[k];
+            rows.vals[row][l] = r.a_val[k];
+            rows.len[row] += 1;
+        }
+        Ok(rows)
+    }
+
+    /// `out = A x`.
+    pub(super) fn ax<T: Real>(&self, x: &[T], out: &mut [T]) {
+        for (k, o) in out.iter_mut().enumerate() {
+            let [c0, c1] = self.cols[k];
+            let [v0, v1] = self.vals[k];
+            *o = if self.len[k] == 2 { T::of(v0) * x[c0] + T::of(v1) * x[c1] } else { T::of(v0) * x[c0] };
+        }
+    }
+
+    /// `out = Aᵀ z`.
+    pub(super) fn atz<T: Real>(&self, z: &[T], out: &mut [T]) {
+        out.iter_mut().for_each(|v| *v = T::of(0.0));
+        for (k, &zk) in z.iter().enumerate() {
+            let [c0, c1] = self.cols[k];
+            let [v0, v1] = self.vals[k];
+            out[c0] += T::of(v0) * zk;
+            if self.len[k] == 2 {
+                out[c1] += T::of(v1) * zk;
+            }
+        }
+    }
+}
+
+/// The objective's part of the Newton system: its gradient at the iterate and the
+/// factorisation of `P + AᵀWA`.
+pub(super) trait Objective<T: Real> {
+    /// `out = ∇φ(x)`.
+    fn gradient(&mut self, x: &[T], out: &mut [T]);
+    /// Factorises `P + Aᵀ diag(w) A`.
+    fn factor(&mut self, rows: &Rows, w: &[T]) -> Result<(), String>;
+    /// Overwrites `rhs` with the last factorised matrix's inverse times it.
+    fn solve_in_place(&mut self, rhs: &mut [T]);
+    /// The auxiliary variables `t = F x + g` (factored form), rounded.
+    fn auxiliary(&self, x: &[T]) -> Option<Vec<f64>>;
+    /// `½ rᵀ P⁻¹ r`, for the gap of a QP without a data term (no `P ⪰ diag(d)` to bound it
+    /// by): `None` where the objective cannot solve with `P` alone.
+    fn energy_dual(&mut self, _r: &[T]) -> Option<f64> {
+        None
+    }
+}

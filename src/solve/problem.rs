@@ -1,0 +1,267 @@
+//! The monotone QP as posed (`MonotoneQp`: energy, linear term, fixed entries, ordered pairs,
+//! bounds) and as the solvers see it (`ReducedQp`: the free variables only, one row per
+//! constraint).
+
+use crate::operators::{Factor, Sparse};
+
+/// A one-sided bound on one entry: `f_v ≤ value` (`upper`) or `f_v ≥ value`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Bound {
+    /// The entry.
+    pub vertex: usize,
+    /// The bound.
+    pub value: f64,
+    /// `f_v ≤ value` when true, `f_v ≥ value` when false.
+    pub upper: bool,
+}
+
+/// The problem: `min ½ fᵀ P f + qᵀ f` s.t. `f_i = fixed_i` where given,
+/// `f_j − f_i ≥ margin` for every `(i, j)` in `edges`, and the `bounds`.
+pub struct MonotoneQp<'a> {
+    /// `#V × #V` symmetric positive semi-definite (positive definite on the free block).
+    pub p: &'a Sparse,
+    /// Linear term, `#V`. With `data`, `q = −diag(data)·c` for the data's target `c`.
+    pub q: &'a [f64],
+    /// Fixed values, `#V` (`None` = free).
+    pub fixed: &'a [Option<f64>],
+    /// Ordered pairs `(i, j)`: `f_j − f_i ≥ margin`. Pairs of two fixed entries are ignored.
+    pub edges: &'a [(usize, usize)],
+    /// ε > 0.
+    pub margin: f64,
+    /// One-sided bounds on free entries (bounds on fixed entries are ignored).
+    pub bounds: &'a [Bound],
+    /// The data term's diagonal `d` (`#V`, ≥ 0): `P = Q + diag(d)` with `Q ⪰ 0`, so `P ⪰
+    /// diag(d)`. With `d > 0` at every free entry the optimality gap is bounded without a
+    /// solve ([`super::optimality`]) and the solver stops on it.
+    pub data: Option<&'a [f64]>,
+    /// A point that satisfies every constraint (the representative u), `#V`, if known: the
+    /// structured solver starts there.
+    pub hint: Option<&'a [f64]>,
+    /// `F` with `P = FᵀF + diag(data)` (`rows × #V`), for the factored formulation: the
+    /// paper's appendix, auxiliary variables `t = F f`, with the square root of `P`'s
+    /// condition number.
+    pub factor: Option<&'a Factor>,
+    /// [`super::condition_estimate`] of this problem if already known (else estimated here).
+    pub condition: Option<f64>,
+}
+
+/// One constraint row of a [`MonotoneQp`] (fixed values substituted when it is reduced).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Row {
+    /// `f_j − f_i ≥ margin`.
+    Pair(usize, usize),
+    /// `f_v ≥ value`.
+    Lower(usize, f64),
+    /// `f_v ≤ value`.
+    Upper(usize, f64),
+}
+
+/// The rows that constrain a free entry, in the order of the solver's multipliers: the
+/// edges with a free end, then the bounds of free entries.
+pub fn constraint_rows(qp: &MonotoneQp<'_>) -> Vec<Row> {
+    let free = |v: usize| qp.fixed[v].is_none();
+    qp.edges
+        .iter()
+        .filter(|&&(i, j)| free(i) || free(j))
+        .map(|&(i, j)| Row::Pair(i, j))
+        .chain(qp.bounds.iter().filter(|b| free(b.vertex)).map(|b| {
+            if b.upper {
+                Row::Upper(b.vertex, b.value)
+            } else {
+                Row::Lower(b.vertex, b.value)
+            }
+        }))
+        .collect()
+}
+
+/// The factored objective on the free variables: `½‖F x + g‖² + ½ xᵀ diag(d) x + q_dᵀ x`
+/// (`q_d` is [`ReducedQp::q_free`]), scaled like [`ReducedQp`].
+pub struct ReducedFactor {
+    /// `F` restricted to the free columns, rounded to double.
+    pub f: Sparse,
+    /// The remainder of each stored entry of `f` (double-double entries).
+    pub lo: Vec<f64>,
+    /// `F_X x_X`: the fixed columns' contribution.
+    pub g: Vec<f64>,
+}
+
+impl ReducedFactor {
+    /// Stored entry `p` of `f` in double-double.
+    pub fn entry(&self, p: usize) -> faer::fx128 {
+        faer::fx128::from(self.f.val()[p]) + faer::fx128::from(self.lo[p])
+    }
+}
+
+/// The QP on the free variables: `min ½ xᵀ P x + qᵀ x` s.t. `A x ≤ b`, objective scaled so
+/// that the mean diagonal of P is 1. Rows have one or two entries and are stored in order.
+pub struct ReducedQp {
+    /// Number of free variables.
+    pub n: usize,
+    /// Upper triangle of P as triplets (row ≤ col).
+    pub p: Vec<(usize, usize, f64)>,
+    /// Linear term.
+    pub q: Vec<f64>,
+    /// Row index of each entry of A (non-decreasing).
+    pub a_row: Vec<usize>,
+    /// Column of each entry of A.
+    pub a_col: Vec<usize>,
+    /// Value of each entry of A.
+    pub a_val: Vec<f64>,
+    /// Right-hand side, one per row.
+    pub b: Vec<f64>,
+    /// The data diagonal on the free variables (zeros without a data term).
+    pub d: Vec<f64>,
+    /// `q` on the free variables without the fixed ones' coupling `P_FX x_X`: the data term's
+    /// linear part `−d ∘ c`, so that the data term is `½ Σ (d x + q_free)² / d` up to a
+    /// constant.
+    pub q_free: Vec<f64>,
+    /// Whether `d > 0` at every free variable: `P ⪰ diag(d)` then bounds the gap without a
+    /// solve.
+    pub gap_bound: bool,
+    /// The factored form, when the formulation is factored.
+    pub factor: Option<ReducedFactor>,
+    /// The factor the objective was divided by.
+    pub scale: f64,
+    /// `½ x_Xᵀ P_XX x_X` (scaled): the objective of the fixed part, so that `φ(x) + constant`
+    /// is `½ fᵀPf + qᵀf` of the whole vector (less the fixed part's linear term).
+    pub constant: f64,
+}
+
+impl ReducedQp {
+    /// Number of rows.
+    pub fn m(&self) -> usize {
+        self.b.len()
+    }
+}
+
+/// Eliminates the fixed variables: `P_FF`, `q_F + P_FX x_X`, one row per constraint row.
+pub(super) fn reduce(qp: &MonotoneQp<'_>, free: &[usize]) -> ReducedQp {
+    let n = qp.q.len();
+    let mut slot = vec![usize::MAX; n];
+    for (k, &i) in free.iter().enumerate() {
+        slot[i] = k;
+    }
+    let xfix = |i: usize| qp.fixed[i].unwrap_or(0.0);
+    let mut q: Vec<f64> = free.iter().map(|&i| qp.q[i]).collect();
+    let (cp, ri, val) = (qp.p.symbolic().col_ptr(), qp.p.symbolic().row_idx(), qp.p.val());
+    let mut p = Vec::new();
+    let mut constant = 0.0;
+    for j in 0..n {
+        for k in cp[j]..cp[j + 1] {
+            let i = ri[k];
+            match (slot[i], slot[j]) {
+                (usize::MAX, usize::MAX) => constant += 0.5 * xfix(i) * val[k] * xfix(j),
+                (usize::MAX, _) => {}
+                (si, usize::MAX) => q[si] += val[k] * xfix(j),
+                (si, sj) if si <= sj => p.push((si, sj, val[k])),
+                _ => {}
+            }
+        }
+    }
+    let nf = free.len();
+    let diag: f64 = p.iter().filter(|t| t.0 == t.1).map(|t| t.2).sum();
+    let scale = (diag / nf as f64).max(f64::MIN_POSITIVE);
+    p.iter_mut().for_each(|t| t.2 /= scale);
+    q.iter_mut().for_each(|v| *v /= scale);
+    let d: Vec<f64> = free.iter().map(|&i| qp.data.map_or(0.0, |d| d[i]) / scale).collect();
+    let q_free: Vec<f64> = free.iter().map(|&i| qp.q[i] / scale).collect();
+    let gap_bound = d.iter().all(|&v| v > 0.0);
+    let mut r = ReducedQp {
+        n: nf,
+        p,
+        q,
+        a_row: vec![],
+        a_col: vec![],
+        a_val: vec![],
+        b: vec![],
+        d,
+        q_free,
+        gap_bound,
+        factor: None,
+        scale,
+        constant: constant / scale,
+    };
+    for row in constraint_rows(qp) {
+        let at = r.b.len();
+        let mut push = |col: usize, v: f64| {
+            r.a_row.push(at);
+            r.a_col.push(col);
+            r.a_val.push(v);
+        };
+        // f_j − f_i ≥ ε  ⇔  f_i − f_j ≤ −ε
+        match row {
+            Row::Pair(i, j) => match (qp.fixed[i], qp.fixed[j]) {
+                (None, None) => {
+                    push(slot[i], 1.0);
+                    push(slot[j], -1.0);
+                    r.b.push(-qp.margin);
+                }
+                (Some(fi), _) => {
+                    push(slot[j], -1.0);
+                    r.b.push(-qp.margin - fi);
+                }
+                (None, Some(fj)) => {
+                    push(slot[i], 1.0);
+                    r.b.push(fj - qp.margin);
+                }
+            },
+            Row::Upper(v, c) => {
+                push(slot[v], 1.0);
+                r.b.push(c);
+            }
+            Row::Lower(v, c) => {
+                push(slot[v], -1.0);
+                r.b.push(-c);
+            }
+        }
+    }
+    r
+}
+
+/// Divides the objective of `r` by a further `by` (its `scale` becomes `scale · by`).
+pub(super) fn rescale(r: &mut ReducedQp, by: f64) {
+    r.p.iter_mut().for_each(|t| t.2 /= by);
+    r.constant /= by;
+    for v in r.q.iter_mut().chain(r.d.iter_mut()).chain(r.q_free.iter_mut()) {
+        *v /= by;
+    }
+    r.scale *= by;
+}
+
+/// The factored objective on the free variables, scaled like the reduced QP (`F / √scale`),
+/// in double-double.
+pub(super) fn reduce_factor(qp: &MonotoneQp<'_>, f: &Factor, free: &[usize], scale: f64) -> ReducedFactor {
+    use faer::fx128;
+    let n = qp.q.len();
+    let mut slot = vec![usize::MAX; n];
+    for (k, &i) in free.iter().enumerate() {
+        slot[i] = k;
+    }
+    let inv_root = fx128::from(1.0) / fx128::from(scale).sqrt();
+    let m = &f.matrix;
+    let mut g = vec![fx128::from(0.0); m.nrows()];
+    let (cp, ri) = (m.symbolic().col_ptr(), m.symbolic().row_idx());
+    let mut col_ptr = vec![0usize];
+    let (mut row_idx, mut val, mut lo) = (Vec::new(), Vec::new(), Vec::new());
+    for j in 0..n {
+        match qp.fixed[j] {
+            Some(v) => {
+                for p in cp[j]..cp[j + 1] {
+                    g[ri[p]] += f.entry(p) * fx128::from(v) * inv_root;
+                }
+            }
+            None => {
+                for (p, &i) in (cp[j]..cp[j + 1]).zip(&ri[cp[j]..cp[j + 1]]) {
+                    let e = f.entry(p) * inv_root;
+                    let hi = e.0 + e.1;
+                    row_idx.push(i);
+                    val.push(hi);
+                    lo.push((e - fx128::from(hi)).0);
+                }
+                col_ptr.push(row_idx.len());
+            }
+        }
+    }
+    let symbolic = faer::sparse::SymbolicSparseColMat::new_checked(m.nrows(), free.len(), col_ptr, None, row_idx);
+    ReducedFactor { f: Sparse::new(symbolic, val), lo, g: g.iter().map(|v| v.0 + v.1).collect() }
+}

@@ -1,0 +1,68 @@
+//! How the QP is solved: the solver, the formulation, the tolerances.
+
+/// Which interior-point solver runs.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Method {
+    /// The structured solver of [`super::ipm`] (normal equations, faer Cholesky with the
+    /// symbolic analysis done once); Clarabel takes over if it does not converge.
+    Structured,
+    /// Clarabel on the full KKT system, in the formulation the structured solver would use.
+    Clarabel,
+    /// Clarabel on the factored formulation whatever the conditioning (the paper's appendix:
+    /// variables `(f, t)` with `t = F f` as equality constraints; needs
+    /// [`super::MonotoneQp::factor`]).
+    #[serde(rename = "clarabel-auxiliary")]
+    ClarabelAuxiliary,
+}
+
+/// How the objective enters the solver.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Formulation {
+    /// Factored when `P`'s condition estimate exceeds [`FACTORED_ABOVE`] and a factor is
+    /// given, else assembled.
+    #[default]
+    Auto,
+    /// `P` as one matrix: normal equations in double precision.
+    Assembled,
+    /// `P = FᵀF + diag(d)`: the structured solver forms its normal matrix from `F` in
+    /// double-double arithmetic and keeps the iterate in it; Clarabel gets the auxiliary
+    /// variables `t = F f`.
+    Factored,
+}
+
+/// Condition estimate of `diag(d)^{-½} P diag(d)^{-½}` above which [`Formulation::Auto`]
+/// chooses the factored form. An assembled P carries rounding errors of about `10⁻¹⁶ κ`
+/// relative to its smallest eigenvalues, and the gap bound squares the gradient's: at κ = 10⁹
+/// that is `10⁻¹⁴` of the data term, ample; at 10¹¹ it reaches the bound's target (10⁻⁷ of it).
+pub const FACTORED_ABOVE: f64 = 1e9;
+
+/// Solver settings.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct QpSettings {
+    /// Largest number of interior-point iterations. {200}
+    pub max_iter: u32,
+    /// Feasibility tolerance on the scaled problem (values in [0, 1]). {1e-9}
+    pub tolerance: f64,
+    /// The structured solver stops when the gap bound is below this fraction of the data
+    /// term (without a data term: of the objective's range, by the mean complementarity).
+    /// {3e-7: a third of the target, 10⁻⁶, for what the output's rounding and the repair add}
+    pub gap_tolerance: f64,
+    /// Solver. {structured}
+    pub method: Method,
+    /// Formulation. {auto}
+    pub formulation: Formulation,
+}
+
+impl Default for QpSettings {
+    fn default() -> Self {
+        QpSettings {
+            max_iter: 200,
+            tolerance: 1e-9,
+            gap_tolerance: 3e-7,
+            method: Method::Structured,
+            formulation: Formulation::Auto,
+        }
+    }
+}

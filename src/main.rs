@@ -184,6 +184,10 @@ enum Command {
         /// Representative function on grids and meshes (default: automatic).
         #[arg(long, value_enum)]
         representative: Option<RepresentativeCli>,
+        /// Fields per case through one `Smoother` (the case's field, then the same with a smooth
+        /// wave of 1 % of its range added): one row each.
+        #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=1000))]
+        fields: u32,
         /// Run one size in this process and print one JSON line.
         #[arg(long, hide = true)]
         single: Option<String>,
@@ -641,7 +645,7 @@ fn run(cli: Cli) -> Result<String> {
         Command::Bench { weights, weight_orders, .. } if !weights.is_empty() => {
             commands::bench_weights(&weights, &weight_orders, 4)
         }
-        Command::Bench { sizes, order, persistence, edges, seed, single, solver, representative, .. } => {
+        Command::Bench { sizes, order, persistence, edges, seed, single, solver, representative, fields, .. } => {
             let persistence = match commands::parse_persistence(&persistence)? {
                 Selection::Relative(r) => r,
                 _ => return Err(Error::Usage("bench takes --persistence as a percentage".into())),
@@ -655,6 +659,7 @@ fn run(cli: Cli) -> Result<String> {
                 single,
                 method: method(solver),
                 representative: representative_choice(representative),
+                fields: fields as usize,
             })
         }
     }

@@ -70,7 +70,11 @@ pub trait Smoothable: Domain {
     /// The Laplacian of harmonic fills: non-negative weights on the domain's own edges, so
     /// that the maximum principle holds (the energy's stiffness where that already holds).
     fn fill_stiffness(&self) -> Sparse {
-        self.stiffness()
+        self.own_fill_stiffness().unwrap_or_else(|| self.stiffness())
+    }
+    /// The fills' Laplacian where it differs from [`Smoothable::stiffness`], else `None`.
+    fn own_fill_stiffness(&self) -> Option<Sparse> {
+        None
     }
     /// `F₁` with `F₁ᵀF₁ = k` (the stiffness): one row per edge of positive weight, or `None`
     /// when a weight is negative and the domain has no other square root.
@@ -79,13 +83,14 @@ pub trait Smoothable: Domain {
     }
     /// A function with exactly the kept extrema (checked by the pipeline), built by the
     /// first construction in the order `choice` prefers that is not `excluded` (kind and
-    /// why: the pipeline excludes one whose order makes the constraints infeasible).
+    /// why: the pipeline excludes one whose order makes the constraints infeasible); `fill`
+    /// is [`Smoothable::fill_stiffness`], the factorisations' analyses are in `analyses`.
     fn representative(
         &self,
         h: &[f64],
         kept: &KeptSet,
         choice: Option<RepresentativeChoice>,
-        k: &Sparse,
+        fill: &Sparse,
         excluded: &[(&'static str, String)],
         analyses: &mut Analyses,
     ) -> Result<Representative>;
@@ -275,27 +280,27 @@ impl Smoothable for TriMesh {
     fn mass(&self) -> Vec<f64> {
         lumped_mass(self.positions(), self.faces())
     }
-    fn fill_stiffness(&self) -> Sparse {
-        positive_cotan_stiffness(self.positions(), self.faces())
+    fn own_fill_stiffness(&self) -> Option<Sparse> {
+        Some(positive_cotan_stiffness(self.positions(), self.faces()))
     }
     /// One row per edge when every cotangent weight is ≥ 0, else the area-weighted triangle
     /// gradients (three rows per triangle).
     fn stiffness_factor(&self, k: &Sparse) -> Option<Factor> {
         edge_factor(k).or_else(|| Some(gradient_factor(self.positions(), self.faces())))
     }
-    /// As on grids, but the harmonic fills use [`positive_cotan_stiffness`]: cotangent
-    /// weights of obtuse triangles can be negative and break the maximum principle the
-    /// representative relies on (paper section 5); `k` (the energy's) is not used.
+    /// As on grids, but the harmonic fills use [`positive_cotan_stiffness`] (`fill`):
+    /// cotangent weights of obtuse triangles can be negative and break the maximum principle
+    /// the representative relies on (paper section 5).
     fn representative(
         &self,
         h: &[f64],
         kept: &KeptSet,
         choice: Option<RepresentativeChoice>,
-        _k: &Sparse,
+        fill: &Sparse,
         excluded: &[(&'static str, String)],
         analyses: &mut Analyses,
     ) -> Result<Representative> {
-        surface_representative(self, h, kept, choice, &self.fill_stiffness(), excluded, analyses)
+        surface_representative(self, h, kept, choice, fill, excluded, analyses)
     }
 }
 
@@ -311,11 +316,11 @@ impl Smoothable for Grid2d {
         h: &[f64],
         kept: &KeptSet,
         choice: Option<RepresentativeChoice>,
-        k: &Sparse,
+        fill: &Sparse,
         excluded: &[(&'static str, String)],
         analyses: &mut Analyses,
     ) -> Result<Representative> {
-        surface_representative(self, h, kept, choice, k, excluded, analyses)
+        surface_representative(self, h, kept, choice, fill, excluded, analyses)
     }
 }
 
@@ -661,6 +666,93 @@ struct Operators {
     condition: Option<f64>,
 }
 
+/// The operators of a domain that do not depend on the field: stiffness, lumped mass and the
+/// harmonic fills' Laplacian (stored only where it differs from the stiffness).
+pub struct DomainOperators {
+    /// `K = −L`.
+    pub stiffness: Sparse,
+    /// Lumped mass.
+    pub mass: Vec<f64>,
+    own_fill: Option<Sparse>,
+}
+
+impl DomainOperators {
+    /// Builds them for `domain`.
+    pub fn new<D: Smoothable>(domain: &D) -> Self {
+        DomainOperators { stiffness: domain.stiffness(), mass: domain.mass(), own_fill: domain.own_fill_stiffness() }
+    }
+
+    /// The harmonic fills' Laplacian ([`Smoothable::fill_stiffness`]).
+    pub fn fill(&self) -> &Sparse {
+        self.own_fill.as_ref().unwrap_or(&self.stiffness)
+    }
+}
+
+/// The library's entry point for many fields on one domain (time steps, ensemble members,
+/// colour channels): built once per domain and settings, it owns the domain's operators
+/// ([`DomainOperators`]) and the analyses of its factorisations ([`Analyses`]), and
+/// [`Smoother::smooth`] reuses them. What a second field skips: building the stiffness, the
+/// mass and the fills' Laplacian, and the symbolic analysis of the fills' Laplacian (the
+/// harmonic fills of the representative); the solver's normal matrix is analysed again unless
+/// the field keeps the same fixed vertices (its pattern is P's on the free vertices). The
+/// energy itself depends on the smoothing length, which on series follows the kept extrema,
+/// and is rebuilt. Memory for speed: the analyses stay between fields (the one-off [`smooth`]
+/// drops the fills' before the solve).
+///
+/// ```
+/// use toposmooth::domain::Grid2d;
+/// use toposmooth::pipeline::{SmoothSettings, Smoother};
+/// use toposmooth::topology::Selection;
+///
+/// let grid = Grid2d::new(24, 16).unwrap();
+/// // cancel the pairs below 20 % of the range
+/// let settings = SmoothSettings { selection: Selection::Relative(0.2), ..Default::default() };
+/// let mut smoother = Smoother::new(grid, settings).unwrap();
+/// for step in 0..2 {
+///     let h: Vec<f64> = (0..24 * 16)
+///         .map(|i| ((i % 24) as f64 * 0.4 + step as f64).sin() + ((i / 24) as f64 * 0.5).cos() + 0.05 * ((i * 7919) % 13) as f64)
+///         .collect();
+///     let out = smoother.smooth(&h).unwrap();
+///     assert!(out.report.certificate.passed);
+/// }
+/// ```
+pub struct Smoother<D: Smoothable + Sync> {
+    domain: D,
+    settings: SmoothSettings,
+    operators: DomainOperators,
+    analyses: Analyses,
+}
+
+impl<D: Smoothable + Sync> Smoother<D> {
+    /// Checks the settings and builds the domain's operators.
+    ///
+    /// # Errors
+    /// A usage error for contradictory settings.
+    pub fn new(domain: D, settings: SmoothSettings) -> Result<Self> {
+        settings.validate()?;
+        let operators = DomainOperators::new(&domain);
+        Ok(Smoother { domain, settings, operators, analyses: Analyses::default() })
+    }
+
+    /// Smooths one field (one value per vertex of the domain), as [`smooth`] does.
+    ///
+    /// # Errors
+    /// As [`smooth`].
+    pub fn smooth(&mut self, h: &[f64]) -> Result<Smoothed> {
+        smooth_on(&self.domain, &self.operators, h, &self.settings, &mut self.analyses, true)
+    }
+
+    /// The domain.
+    pub fn domain(&self) -> &D {
+        &self.domain
+    }
+
+    /// The settings.
+    pub fn settings(&self) -> &SmoothSettings {
+        &self.settings
+    }
+}
+
 /// Smooths `h` on `domain` keeping exactly the selected extrema; returns only certified output.
 ///
 /// # Errors
@@ -685,6 +777,19 @@ pub fn smooth_with<D: Smoothable + Sync>(
     analyses: &mut Analyses,
 ) -> Result<Smoothed> {
     settings.validate()?;
+    smooth_on(domain, &DomainOperators::new(domain), h, settings, analyses, false)
+}
+
+/// The pipeline on a domain whose operators are built; `keep_analyses`: the fills' analysis
+/// stays in `analyses` through the solve (else it is dropped first, for memory).
+fn smooth_on<D: Smoothable + Sync>(
+    domain: &D,
+    ops: &DomainOperators,
+    h: &[f64],
+    settings: &SmoothSettings,
+    analyses: &mut Analyses,
+    keep_analyses: bool,
+) -> Result<Smoothed> {
     let n = domain.n_vertices();
     if h.len() != n {
         return Err(Error::input(format!("the field has {} values, the domain {n} vertices", h.len())));
@@ -703,7 +808,7 @@ pub fn smooth_with<D: Smoothable + Sync>(
         Some(fraction) => (fraction * domain.diameter(), format!("--smooth-length {fraction} of the diameter")),
         None => default_smooth_length(domain, &kept),
     };
-    let k = domain.stiffness();
+    let k = &ops.stiffness;
     let (lo, hi) = crate::domain::value_range(h);
     let range = hi - lo;
     let z: Vec<f64> = h.iter().map(|v| (v - lo) / range).collect();
@@ -718,7 +823,7 @@ pub fn smooth_with<D: Smoothable + Sync>(
         let mut excluded: Vec<(&'static str, String)> = Vec::new();
         loop {
             let t = Instant::now();
-            let rep = domain.representative(h, &kept, settings.representative, &k, &excluded, analyses)?;
+            let rep = domain.representative(h, &kept, settings.representative, ops.fill(), &excluded, analyses)?;
             if let Some(ms) = &rep.complex {
                 seconds.complex = ms.seconds[0];
                 seconds.simplify = ms.seconds[1];
@@ -781,14 +886,14 @@ pub fn smooth_with<D: Smoothable + Sync>(
     // The energy and the solver's analysis of its normal matrix need only the kept set: they
     // are built on the other core while the complex and the representative are.
     let operators = || -> Result<Operators> {
-        let m = domain.mass();
+        let m = ops.mass.clone();
         let weights: Vec<f64> = settings
             .energy
             .terms
             .iter()
             .map(|&(order, _)| settings.smooth_weight.unwrap_or(ell.powi(2 * order as i32)))
             .collect();
-        let q_energy = polyharmonic(&k, &m, &settings.energy, &weights);
+        let q_energy = polyharmonic(k, &m, &settings.energy, &weights);
         let gd = settings.data_weight;
         let data_diag: Vec<f64> = m.iter().map(|mi| gd * mi).collect();
         // P = energy + data diagonal, in the energy's storage (one matrix of the size of a
@@ -805,7 +910,7 @@ pub fn smooth_with<D: Smoothable + Sync>(
         // without a data term there is no estimate: the factor is made for a retry should the
         // assembled normal matrix lose its definiteness
         let factor = if factored || condition.is_none() {
-            domain.stiffness_factor(&k).and_then(|k1| polyharmonic_factor(&k, &k1, &m, &settings.energy, &weights))
+            domain.stiffness_factor(k).and_then(|k1| polyharmonic_factor(k, &k1, &m, &settings.energy, &weights))
         } else {
             None
         };
@@ -841,7 +946,9 @@ pub fn smooth_with<D: Smoothable + Sync>(
     let gd = settings.data_weight;
     // the fills' Laplacian analysis is not needed again: free it before the solver runs (the
     // solver's factor storage was made beside the representative: 1000² peak 2.93 → 3.06 GiB)
-    analyses.clear();
+    if !keep_analyses {
+        analyses.clear();
+    }
 
     let t = Instant::now();
     let hint: Vec<f64> = u.iter().map(|v| (v - lo) / range).collect();

@@ -1,0 +1,58 @@
+//! The `Smoother`: many fields on one domain give exactly what one-off runs give, on a
+//! series, a grid and a mesh, with the domain's operators and analyses reused.
+
+mod common;
+
+use common::uniform;
+use toposmooth::domain::{shapes, Domain, Grid2d, Series};
+use toposmooth::pipeline::{smooth, SmoothSettings, Smoothable, Smoother};
+use toposmooth::topology::Selection;
+
+/// Fields `step = 0, 1, 2` of a moving pattern plus noise on `domain`.
+fn fields<D: Domain>(domain: &D, seed: u64) -> Vec<Vec<f64>> {
+    (0..3)
+        .map(|step| {
+            let r = uniform(seed + step, domain.n_vertices());
+            (0..domain.n_vertices())
+                .map(|v| {
+                    let [x, y, z] = domain.point(v);
+                    let t = step as f64 * 0.7;
+                    (1.3 * x + t).sin() * (0.9 * y - 0.5 * t).cos() + 0.3 * z + 0.2 * (r[v] - 0.5)
+                })
+                .collect()
+        })
+        .collect()
+}
+
+fn check<D: Smoothable + Sync + Clone>(name: &str, domain: D, settings: SmoothSettings, seed: u64) {
+    let fields = fields(&domain, seed);
+    let mut smoother = Smoother::new(domain.clone(), settings.clone()).unwrap();
+    for (step, h) in fields.iter().enumerate() {
+        let reused = smoother.smooth(h).unwrap();
+        let alone = smooth(&domain, h, &settings).unwrap();
+        assert!(reused.report.certificate.passed, "{name} step {step}");
+        assert_eq!(reused.report.solver_iterations, alone.report.solver_iterations, "{name} step {step}");
+        assert_eq!(reused.output, alone.output, "{name} step {step}: the outputs differ");
+        assert_eq!(reused.roles, alone.roles, "{name} step {step}");
+    }
+}
+
+#[test]
+fn many_fields_on_one_domain_give_the_one_off_results() {
+    let relative = |t: f64| SmoothSettings { selection: Selection::Relative(t), ..Default::default() };
+    let x: Vec<f64> = (0..400).map(|i| i as f64 * 0.05).collect();
+    check("series", Series::with_coordinates(x).unwrap(), relative(0.1), 1);
+    check("grid", Grid2d::new(40, 30).unwrap(), relative(0.15), 2);
+    check("sphere", shapes::sphere(1.0, 16, 24), relative(0.15), 3);
+}
+
+#[test]
+fn a_field_of_the_wrong_size_is_an_input_error_and_the_smoother_goes_on() {
+    let grid = Grid2d::new(20, 10).unwrap();
+    let h = fields(&grid, 4).remove(0);
+    let mut smoother = Smoother::new(grid, SmoothSettings::default()).unwrap();
+    let e = smoother.smooth(&h[..150]).unwrap_err();
+    assert_eq!(e.exit_code(), 3, "{e}");
+    assert!(e.to_string().contains("150 values"), "{e}");
+    assert!(smoother.smooth(&h).unwrap().report.certificate.passed);
+}

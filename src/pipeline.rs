@@ -944,8 +944,8 @@ fn smooth_on<D: Smoothable + Sync>(
     let Operators { m, weights, data_diag, factor, p, q, condition } = operators_result?;
     seconds.operators = operators_seconds;
     let gd = settings.data_weight;
-    // the fills' Laplacian analysis is not needed again: free it before the solver runs (the
-    // solver's factor storage was made beside the representative: 1000² peak 2.93 → 3.06 GiB)
+    // the fills' Laplacian analysis is not needed again: free it before the solver runs, whose
+    // factor storage was made beside the representative (the two together set the peak)
     if !keep_analyses {
         analyses.clear();
     }

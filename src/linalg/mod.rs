@@ -290,8 +290,8 @@ fn dissection(g: &Graph, leaf_size: usize, parallel: bool) -> (Vec<usize>, Optio
     (out, Some([la, lb]))
 }
 
-/// Graphs at least this large are dissected on two threads below the top level (1000² grid:
-/// bilaplacian 2.25 → 1.35 s, Laplacian 0.99 → 0.66 s).
+/// Graphs at least this large are dissected on two threads below the top level (below it the
+/// second thread costs more than it saves).
 const PARALLEL_DISSECTION_MIN: usize = 100_000;
 
 impl<'g> Dissect<'g> {
@@ -447,7 +447,7 @@ pub fn factor_flops(s: &SymbolicCholesky<usize>) -> f64 {
 
 /// Above this size the factorisation is supernodal: faer's automatic choice kept the
 /// simplicial one for bilaplacian patterns of a few thousand unknowns, where supernodal
-/// factors were measured 1.4–1.7× faster (penguin weights: 0.55 → 0.33 s for 4 functions).
+/// factors are faster (docs/performance.md, "constants").
 const SUPERNODAL_MIN_N: usize = 1000;
 
 fn params(n: usize) -> CholeskySymbolicParams<'static> {
@@ -463,10 +463,9 @@ fn params(n: usize) -> CholeskySymbolicParams<'static> {
 
 /// Graphs below this size are ordered by AMD only.
 const ND_MIN_N: usize = 2000;
-/// Graphs at least this large are ordered by nested dissection only: AMD took 0.9–2 s at a
-/// million unknowns and its factor needed 2.3–3.4× the flops of the two-way one on the grid
-/// patterns measured (450² and 1000²: Laplacian, triangulated Laplacian, bilaplacian), 2.0–3.6×
-/// on subdivided meshes (mountain @2 and spot @3: Laplacian and bilaplacian).
+/// Graphs at least this large are ordered by nested dissection only: there AMD costs seconds
+/// and its factors need several times the flops of the two-way one on every pattern measured
+/// (docs/performance.md, "constants").
 const ND_ONLY_N: usize = 200_000;
 /// Parts at most this large are ordered by AMD inside the dissection.
 const ND_LEAF: usize = 128;
@@ -537,7 +536,7 @@ pub enum Analysis {
 }
 
 /// Speed-up of faer's parallel kernels on this machine's two cores, for factors above
-/// [`PARALLEL_MIN_FLOPS`] (measured: spot @3 solve 88.7 s sequential, 66.6 s parallel).
+/// [`PARALLEL_MIN_FLOPS`] (measured on the largest bench mesh: docs/performance.md).
 const PARALLEL_SPEEDUP: f64 = 1.33;
 /// Below this many factor flops faer's parallel kernels were slower than sequential ones.
 const PARALLEL_MIN_FLOPS: f64 = 2e10;
@@ -656,9 +655,9 @@ impl Numeric {
     }
 
     /// Writes one value per memory page of the factor's storage, so that the operating system
-    /// maps those pages now instead of during the first factorisation (a million-unknown
-    /// factor is about a GiB of freshly zeroed pages: 3.0 s for its first factorisation against
-    /// 1.4 s for each later one).
+    /// maps those pages now, beside other work, instead of during the first factorisation (a
+    /// million-unknown factor is about a GiB of freshly zeroed pages, whose faults doubled
+    /// that factorisation's time).
     fn touch(&mut self) {
         match self {
             Numeric::Single { l, .. } => touch_pages(l),

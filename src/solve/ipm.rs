@@ -20,10 +20,8 @@ use super::status::{Outcome, SolveStatus};
 use crate::linalg as ordering;
 use faer::sparse::SparseColMatRef;
 
-/// Centrality correctors per iteration at most. Iterations without / with 2 at the same
-/// stopping rule (μ ≤ tol): 150 × 100 grid 10 / 7, 300² 11 / 8, mountain distance 7 / 6,
-/// spot @1 6 / 6, Kármán street 15 / 11; with the stricter μ ≤ tol/10 now used, 9, 9, 7, 6
-/// and 13.
+/// Centrality correctors per iteration at most: each costs one solve and saves iterations,
+/// each a factorisation (docs/performance.md, "constants").
 const CORRECTORS: usize = 2;
 /// How much longer than the corrected predictor's step a corrector aims.
 const CORRECTOR_STEP: f64 = 0.3;
@@ -200,9 +198,8 @@ fn run<T: Real, O: Objective<T>>(
         *sk = *bk - *sk;
     }
     // multipliers at the scale of the objective's gradient at the start, which they must
-    // balance (each row of A has entries ±1): 3 × mean |P x + q|. Against unit multipliers
-    // this cut the iterations from 14 to 7 (mountain distance), 27 to 15 (Kármán vorticity),
-    // 15 to 11 (300² noisy grid).
+    // balance (each row of A has entries ±1): 3 × mean |P x + q|; unit multipliers took about
+    // twice the iterations (docs/performance.md, "constants")
     let mut g = vec![zero; n];
     objective.gradient(&x, &mut g);
     let gmean = g.iter().map(|a| a.to_f64().abs()).sum::<f64>() / n.max(1) as f64;

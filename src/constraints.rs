@@ -20,8 +20,9 @@ use crate::domain::{sos_less, sos_sort, Domain};
 use crate::error::{Error, Result};
 
 /// Which edges carry an ordering constraint.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
-#[serde(rename_all = "lowercase")]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "lowercase"))]
 pub enum EdgeSet {
     /// Per free vertex its lowest and highest neighbour in u, plus every edge between a fixed
     /// and a free vertex.
@@ -253,7 +254,8 @@ pub fn choose_margin(max_margin: f64, range: f64, resolution: f64) -> Result<f64
 
 /// How much of the output the constraints hold: the constrained edges whose output rises by
 /// less than 10 margins are *active*; flat steps of the smoothing fight the constraints there.
-#[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
+#[derive(Clone, Debug, Default, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct Activity {
     /// Share of the free vertices with an incident active edge.
     pub active_fraction: f64,

@@ -25,6 +25,7 @@
 //! ```
 #![warn(missing_docs)]
 
+#[cfg(feature = "serde")]
 pub mod apps;
 pub mod domain;
 pub mod error;
@@ -35,6 +36,7 @@ pub use domain::{Grid2d, Series, TriMesh};
 pub use error::{Error, Result};
 pub use pipeline::{smooth, SmoothSettings, Smoothed, Smoother};
 pub use topology::Selection;
+#[cfg(feature = "cli")]
 pub mod commands;
 pub mod constraints;
 pub mod derive;
@@ -42,6 +44,7 @@ pub mod harmonic_order;
 pub mod io;
 pub mod linalg;
 pub mod pipeline;
+#[cfg(feature = "plot")]
 pub mod plot;
 pub mod representative;
 pub mod solve;

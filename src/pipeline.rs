@@ -33,8 +33,9 @@ use crate::verify::{certify, Certificate};
 use std::time::Instant;
 
 /// Which representative function to build on surfaces (series always use the linear one).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
-#[serde(rename_all = "lowercase")]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "lowercase"))]
 pub enum RepresentativeChoice {
     /// Separatrices interpolated, harmonic elsewhere (paper section 3.3).
     #[default]
@@ -387,7 +388,8 @@ impl SmoothSettings {
 pub const ACTIVE_WARNING: f64 = 0.25;
 
 /// Seconds per stage.
-#[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
+#[derive(Clone, Debug, Default, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct StageSeconds {
     /// Persistence and selection of the kept set.
     pub persistence: f64,
@@ -410,7 +412,8 @@ pub struct StageSeconds {
 }
 
 /// Energies of the output.
-#[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
+#[derive(Clone, Debug, Default, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct EnergyReport {
     /// Σ γ_k w_k E_k(f).
     pub smoothness: f64,
@@ -421,7 +424,8 @@ pub struct EnergyReport {
 }
 
 /// The settings of a run as the report records them.
-#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+#[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct RunSettings {
     /// The selection as given.
     pub selection: String,
@@ -452,7 +456,8 @@ pub struct RunSettings {
 }
 
 /// Everything a run measured, written by `--report`.
-#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+#[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct Report {
     /// Number of samples or vertices.
     pub vertices: usize,
@@ -504,7 +509,8 @@ pub struct Report {
 
 /// How close the output is to the optimum of the QP it solves (SPEC.md, end of "Exit status"),
 /// in the units of [`EnergyReport`]: `J(f) = Σ γ_k w_k E_k(f) + γD Σ M_ii (f_i − h_i)²`.
-#[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
+#[derive(Clone, Debug, Default, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct FitReport {
     /// Ĝ ≥ J(f) − J*, from the multipliers and the residual (no solve); `null` when some free
     /// vertex has no data weight.

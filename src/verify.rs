@@ -14,7 +14,8 @@ use crate::domain::Domain;
 use crate::topology::Role;
 
 /// One violated item of the certificate.
-#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+#[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct Failure {
     /// Certificate item (1–4, SPEC.md).
     pub item: u8,
@@ -25,7 +26,8 @@ pub struct Failure {
 }
 
 /// Result of checking a field against roles.
-#[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
+#[derive(Clone, Debug, Default, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct Certificate {
     /// All items hold.
     pub passed: bool,
@@ -155,8 +157,9 @@ pub fn certify<D: Domain>(domain: &D, f: &[f64], roles: &[Role], input: Option<&
 }
 
 /// What a connected set of fixed vertices with one prescribed value must be (no-data mode).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
-#[serde(rename_all = "lowercase")]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "lowercase"))]
 pub enum RegionKind {
     /// Every vertex adjacent to the region from outside is strictly higher.
     Min,

@@ -81,6 +81,7 @@ pub fn read_npy(path: &Path) -> Result<GridField> {
     finish(path, nx, ny, values, "values".into())
 }
 
+#[cfg(feature = "image")]
 /// Reads a grayscale raster: PNG (8/16-bit, via `image`) or TIFF (8/16/32-bit integers and
 /// 32/64-bit floats, via `tiff`). Colour images are refused rather than guessed at.
 ///
@@ -111,6 +112,7 @@ pub fn read_raster(path: &Path) -> Result<GridField> {
     finish(path, nx, ny, values, "gray".into())
 }
 
+#[cfg(feature = "image")]
 fn read_tiff(path: &Path) -> Result<GridField> {
     use tiff::decoder::{Decoder, DecodingResult};
     use tiff::ColorType;

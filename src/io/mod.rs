@@ -2,9 +2,11 @@
 //! and is renamed into place, so a failed run never leaves a half-written file.
 
 pub mod grid;
+#[cfg(feature = "io-vtk")]
 pub mod mesh;
 pub mod npz;
 pub mod series_csv;
+#[cfg(feature = "io-vtk")]
 pub mod vtk;
 
 use crate::error::{Error, Result};
@@ -67,6 +69,7 @@ pub fn temp_sibling(path: &Path) -> PathBuf {
     path.with_file_name(format!(".{name}.{}.tmp", std::process::id()))
 }
 
+#[cfg(feature = "serde")]
 /// Stages a value as pretty JSON.
 pub fn stage_json<T: serde::Serialize>(path: &Path, value: &T) -> Result<Staged> {
     stage(path, |w| {

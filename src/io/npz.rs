@@ -5,9 +5,9 @@
 //! Arrays have shape `(ny, nx)` in C order: element `(r, c)` is grid vertex `r · nx + c`, so
 //! `numpy.load(f)["smoothed"][r, c]` is the value at row `r`, column `c` of the grid.
 
-use super::{stage, stage_with, Staged};
+use super::{stage, Staged};
 use crate::error::{Error, Result};
-use std::io::{Read, Write};
+use std::io::Write;
 use std::path::Path;
 
 fn input(path: &Path, msg: impl Into<String>) -> Error {
@@ -38,6 +38,7 @@ pub fn stage_npy(path: &Path, ny: usize, nx: usize, values: &[f64]) -> Result<St
     stage(path, |w| write_npy(w, ny, nx, values))
 }
 
+#[cfg(feature = "io-npz")]
 /// Stages a `.npz` archive with one little-endian float64 array of shape `(ny, nx)` (C order)
 /// per entry of `arrays`, stored as member `NAME.npy` (deflate-compressed), so that
 /// `numpy.load(path)[NAME]` returns it.
@@ -57,7 +58,7 @@ pub fn stage_npz(path: &Path, ny: usize, nx: usize, arrays: &[(&str, &[f64])]) -
         seen.push(name);
         check_shape(path, &format!("array `{name}`"), ny, nx, values.len())?;
     }
-    stage_with(path, |tmp| {
+    super::stage_with(path, |tmp| {
         use zip::write::SimpleFileOptions;
         let file = std::fs::File::create(tmp)?;
         let mut zip = zip::ZipWriter::new(std::io::BufWriter::new(file));
@@ -77,6 +78,7 @@ pub fn stage_npz(path: &Path, ny: usize, nx: usize, arrays: &[(&str, &[f64])]) -
 /// One array of an `.npz` archive: its name, shape `[ny, nx]` and values in C order.
 pub type NpzArray = (String, [usize; 2], Vec<f64>);
 
+#[cfg(feature = "io-npz")]
 /// Reads every array of an `.npz` archive: `(name, [ny, nx], values)` in archive order, with
 /// values converted to f64 and Fortran-ordered arrays rearranged to C order (row by row).
 /// Members whose names do not end in `.npy` are skipped, as `numpy.load` does.
@@ -98,7 +100,8 @@ pub fn read_npz(path: &Path) -> Result<Vec<NpzArray>> {
             continue;
         };
         let mut bytes = Vec::with_capacity(member.size().min(1 << 30) as usize);
-        member.read_to_end(&mut bytes).map_err(|e| input(path, format!("array `{name}`: cannot read it: {e}")))?;
+        std::io::Read::read_to_end(&mut member, &mut bytes)
+            .map_err(|e| input(path, format!("array `{name}`: cannot read it: {e}")))?;
         let (shape, values) = decode_npy(&bytes).map_err(|m| input(path, format!("array `{name}`: {m}")))?;
         out.push((name, shape, values));
     }

@@ -6,7 +6,8 @@ use faer::sparse::Triplet;
 
 /// A smoothness energy: a weighted sum of polyharmonic orders (Botsch & Kobbelt 2004) and
 /// the vertices where orders ≥ 2 are not penalised.
-#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+#[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct Energy {
     /// `(order k, weight)` pairs, k in 1..=4, weight ≥ 0.
     pub terms: Vec<(u8, f64)>,

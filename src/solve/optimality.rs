@@ -15,7 +15,8 @@ use super::problem::{constraint_rows, MonotoneQp, Row};
 use faer::fx128;
 
 /// The gap bound of a point and what it is made of, in the units of the QP as given.
-#[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
+#[derive(Clone, Debug, Default, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct Optimality {
     /// Ĝ ≥ φ(f) − φ*. Without a data term on every free entry, `sᵀz + ½ ρᵀP⁻¹ρ` by one solve
     /// with `P` (infinite if that fails).

@@ -1,7 +1,8 @@
 //! Restoring strict order after an interior-point solve (NOTES.md 3).
 
 /// What the repair changed.
-#[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
+#[derive(Clone, Debug, Default, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct RepairSummary {
     /// Constrained edges that were not strictly increasing before the repair.
     pub violated_edges: usize,
@@ -44,7 +45,8 @@ pub fn repair(f: &mut [f64], fixed: &[bool], edges: &[(usize, usize)], order: &[
 }
 
 /// What [`meet_margin`] changed.
-#[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
+#[derive(Clone, Debug, Default, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct MarginSummary {
     /// Whether every constrained edge now has `f_j − f_i ≥ margin` and every bound holds, in
     /// exact arithmetic on the doubles.

@@ -1,8 +1,9 @@
 //! How the QP is solved: the solver, the formulation, the tolerances.
 
 /// Which interior-point solver runs.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
-#[serde(rename_all = "lowercase")]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "lowercase"))]
 pub enum Method {
     /// The structured solver of [`super::ipm`] (normal equations, faer Cholesky with the
     /// symbolic analysis done once); Clarabel takes over if it does not converge.
@@ -12,13 +13,14 @@ pub enum Method {
     /// Clarabel on the factored formulation whatever the conditioning (the paper's appendix:
     /// variables `(f, t)` with `t = F f` as equality constraints; needs
     /// [`super::MonotoneQp::factor`]).
-    #[serde(rename = "clarabel-auxiliary")]
+    #[cfg_attr(feature = "serde", serde(rename = "clarabel-auxiliary"))]
     ClarabelAuxiliary,
 }
 
 /// How the objective enters the solver.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
-#[serde(rename_all = "lowercase")]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "lowercase"))]
 pub enum Formulation {
     /// Factored when `P`'s condition estimate exceeds [`FACTORED_ABOVE`] and a factor is
     /// given, else assembled.
@@ -39,7 +41,8 @@ pub enum Formulation {
 pub const FACTORED_ABOVE: f64 = 1e9;
 
 /// Solver settings.
-#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+#[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct QpSettings {
     /// Largest number of interior-point iterations. {200}
     pub max_iter: u32,

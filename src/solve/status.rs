@@ -4,7 +4,8 @@
 use super::settings::{Formulation, Method};
 
 /// How the solver ended.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub enum SolveStatus {
     /// Converged to the requested accuracy.
     Solved,

@@ -103,8 +103,9 @@ pub fn count_sos_extrema<D: Domain>(domain: &D, values: &[f64]) -> (usize, usize
 }
 
 /// Kind of an extremum in an [`extrema_table`].
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
-#[serde(rename_all = "lowercase")]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "lowercase"))]
 pub enum ExtremumKind {
     /// SoS minimum.
     Min,
@@ -115,7 +116,8 @@ pub enum ExtremumKind {
 }
 
 /// One row of the `extrema` listing.
-#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+#[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct ExtremumInfo {
     /// Vertex index.
     pub index: usize,
@@ -124,7 +126,7 @@ pub struct ExtremumInfo {
     /// Input value.
     pub value: f64,
     /// Persistence; `None` for ends and `Some(inf)` for essential extrema (JSON: null).
-    #[serde(serialize_with = "finite_or_null")]
+    #[cfg_attr(feature = "serde", serde(serialize_with = "finite_or_null"))]
     pub persistence: Option<f64>,
     /// The vertex it is paired with (where it dies, or the minimum that dies at it).
     pub partner: Option<usize>,
@@ -135,6 +137,7 @@ pub struct ExtremumInfo {
     pub endpoint: bool,
 }
 
+#[cfg(feature = "serde")]
 fn finite_or_null<S: serde::Serializer>(v: &Option<f64>, s: S) -> Result<S::Ok, S::Error> {
     match v {
         Some(x) if x.is_finite() => s.serialize_f64(*x),

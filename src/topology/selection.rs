@@ -44,8 +44,9 @@ impl Selection {
 }
 
 /// Role of a vertex in the output (SPEC.md codes: −1, +1, 2, 3, 0).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
-#[serde(rename_all = "lowercase")]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "lowercase"))]
 pub enum Role {
     /// Kept minimum, fixed to its input value.
     Min,
@@ -106,12 +107,13 @@ impl Role {
 }
 
 /// One kept extremum, as the report lists it.
-#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+#[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct KeptExtremum {
     /// Vertex index.
     pub index: usize,
     /// `min` or `max`.
-    #[serde(rename = "type")]
+    #[cfg_attr(feature = "serde", serde(rename = "type"))]
     pub role: Role,
     /// Input value (kept bit for bit).
     pub value: f64,

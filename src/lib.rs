@@ -34,7 +34,8 @@ pub mod topology;
 
 pub use domain::{Grid2d, Series, TriMesh};
 pub use error::{Error, Result};
-pub use pipeline::{smooth, SmoothSettings, Smoothed, Smoother};
+pub use pipeline::{smooth, SmoothSettings, Smoothed};
+pub use smoother::{AnyDomain, AnySmoother, Smoother};
 pub use topology::Selection;
 #[cfg(feature = "cli")]
 pub mod commands;
@@ -47,5 +48,6 @@ pub mod pipeline;
 #[cfg(feature = "plot")]
 pub mod plot;
 pub mod representative;
+pub mod smoother;
 pub mod solve;
 pub mod verify;

@@ -694,71 +694,6 @@ impl DomainOperators {
     }
 }
 
-/// The library's entry point for many fields on one domain (time steps, ensemble members,
-/// colour channels): built once per domain and settings, it owns the domain's operators
-/// ([`DomainOperators`]) and the analyses of its factorisations ([`Analyses`]), and
-/// [`Smoother::smooth`] reuses them. What a second field skips: building the stiffness, the
-/// mass and the fills' Laplacian, and the symbolic analysis of the fills' Laplacian (the
-/// harmonic fills of the representative); the solver's normal matrix is analysed again unless
-/// the field keeps the same fixed vertices (its pattern is P's on the free vertices). The
-/// energy itself depends on the smoothing length, which on series follows the kept extrema,
-/// and is rebuilt. Memory for speed: the analyses stay between fields (the one-off [`smooth`]
-/// drops the fills' before the solve).
-///
-/// ```
-/// use toposmooth::domain::Grid2d;
-/// use toposmooth::pipeline::{SmoothSettings, Smoother};
-/// use toposmooth::topology::Selection;
-///
-/// let grid = Grid2d::new(24, 16).unwrap();
-/// // cancel the pairs below 20 % of the range
-/// let settings = SmoothSettings { selection: Selection::Relative(0.2), ..Default::default() };
-/// let mut smoother = Smoother::new(grid, settings).unwrap();
-/// for step in 0..2 {
-///     let h: Vec<f64> = (0..24 * 16)
-///         .map(|i| ((i % 24) as f64 * 0.4 + step as f64).sin() + ((i / 24) as f64 * 0.5).cos() + 0.05 * ((i * 7919) % 13) as f64)
-///         .collect();
-///     let out = smoother.smooth(&h).unwrap();
-///     assert!(out.report.certificate.passed);
-/// }
-/// ```
-pub struct Smoother<D: Smoothable + Sync> {
-    domain: D,
-    settings: SmoothSettings,
-    operators: DomainOperators,
-    analyses: Analyses,
-}
-
-impl<D: Smoothable + Sync> Smoother<D> {
-    /// Checks the settings and builds the domain's operators.
-    ///
-    /// # Errors
-    /// A usage error for contradictory settings.
-    pub fn new(domain: D, settings: SmoothSettings) -> Result<Self> {
-        settings.validate()?;
-        let operators = DomainOperators::new(&domain);
-        Ok(Smoother { domain, settings, operators, analyses: Analyses::default() })
-    }
-
-    /// Smooths one field (one value per vertex of the domain), as [`smooth`] does.
-    ///
-    /// # Errors
-    /// As [`smooth`].
-    pub fn smooth(&mut self, h: &[f64]) -> Result<Smoothed> {
-        smooth_on(&self.domain, &self.operators, h, &self.settings, &mut self.analyses, true)
-    }
-
-    /// The domain.
-    pub fn domain(&self) -> &D {
-        &self.domain
-    }
-
-    /// The settings.
-    pub fn settings(&self) -> &SmoothSettings {
-        &self.settings
-    }
-}
-
 /// Smooths `h` on `domain` keeping exactly the selected extrema; returns only certified output.
 ///
 /// # Errors
@@ -788,7 +723,7 @@ pub fn smooth_with<D: Smoothable + Sync>(
 
 /// The pipeline on a domain whose operators are built; `keep_analyses`: the fills' analysis
 /// stays in `analyses` through the solve (else it is dropped first, for memory).
-fn smooth_on<D: Smoothable + Sync>(
+pub(crate) fn smooth_on<D: Smoothable + Sync>(
     domain: &D,
     ops: &DomainOperators,
     h: &[f64],

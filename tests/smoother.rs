@@ -5,7 +5,8 @@ mod common;
 
 use common::uniform;
 use toposmooth::domain::{shapes, Domain, Grid2d, Series};
-use toposmooth::pipeline::{smooth, SmoothSettings, Smoothable, Smoother};
+use toposmooth::pipeline::{smooth, SmoothSettings, Smoothable};
+use toposmooth::smoother::{AnyDomain, AnySmoother, Smoother};
 use toposmooth::topology::Selection;
 
 /// Fields `step = 0, 1, 2` of a moving pattern plus noise on `domain`.
@@ -55,4 +56,17 @@ fn a_field_of_the_wrong_size_is_an_input_error_and_the_smoother_goes_on() {
     assert_eq!(e.exit_code(), 3, "{e}");
     assert!(e.to_string().contains("150 values"), "{e}");
     assert!(smoother.smooth(&h).unwrap().report.certificate.passed);
+}
+
+#[test]
+fn the_run_time_domain_smoother_is_the_generic_one() {
+    let grid = Grid2d::new(30, 20).unwrap();
+    let settings = SmoothSettings { selection: Selection::Relative(0.15), ..Default::default() };
+    let h = fields(&grid, 5);
+    let mut any = AnySmoother::new(AnyDomain::Grid(grid.clone()), settings.clone()).unwrap();
+    let mut generic = Smoother::new(grid, settings).unwrap();
+    assert_eq!(any.n_vertices(), 600);
+    for f in &h {
+        assert_eq!(any.smooth(f).unwrap().output, generic.smooth(f).unwrap().output);
+    }
 }

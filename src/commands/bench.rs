@@ -7,7 +7,8 @@ use crate::constraints::EdgeSet;
 use crate::domain::{Grid2d, Series};
 use crate::error::{Error, Result};
 use crate::operators::Energy;
-use crate::pipeline::{smooth, RepresentativeChoice, SmoothSettings, Smoothable, Smoothed, Smoother};
+use crate::pipeline::{smooth, RepresentativeChoice, SmoothSettings, Smoothable, Smoothed};
+use crate::smoother::Smoother;
 use crate::solve::{Method, QpSettings};
 use crate::topology::Selection;
 use std::time::Instant;
@@ -31,7 +32,7 @@ pub struct BenchArgs {
     pub method: Method,
     /// Representative function on grids and meshes.
     pub representative: Option<RepresentativeChoice>,
-    /// Fields per case, smoothed by one [`crate::pipeline::Smoother`] (1: the one-off path).
+    /// Fields per case, smoothed by one [`crate::smoother::Smoother`] (1: the one-off path).
     pub fields: usize,
 }
 

@@ -41,6 +41,15 @@ pub enum Error {
         /// What failed.
         message: String,
     },
+    /// A failure on valid input that is our bug or a numerical failure: an internal check
+    /// that did not hold, a factorisation of a well-posed system that failed (exit 1).
+    #[error("{}internal error: {message}", prefix(path))]
+    Internal {
+        /// File the input came from, if any.
+        path: Option<PathBuf>,
+        /// What failed.
+        message: String,
+    },
     /// The solver returned a point that does not pass the certificate, even after repair (exit 1).
     #[error("{}output NOT certified: {message}", prefix(path))]
     Uncertified {
@@ -68,6 +77,38 @@ pub enum Error {
     },
 }
 
+/// What kind of failure an [`Error`] is: one kind per exit status of SPEC.md's "Exit status"
+/// (and the failures behind it), for callers that branch on it rather than on the message.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum ErrorKind {
+    /// Invalid settings (exit 2).
+    Usage,
+    /// A file could not be read or written (exit 3).
+    Io,
+    /// Unreadable or malformed input (exit 3).
+    Input,
+    /// A kept set no strict function realizes, proven without the representative (exit 3).
+    Infeasible,
+    /// An output that fails its certificate (exit 1).
+    Uncertified,
+    /// Our bug or a numerical failure on valid input, the representative's included (exit 1).
+    Internal,
+    /// The solver returned no point (exit 4).
+    NoSolution,
+}
+
+impl ErrorKind {
+    /// Exit status of the command-line tool for this kind (SPEC.md).
+    pub fn exit_code(self) -> i32 {
+        match self {
+            ErrorKind::Uncertified | ErrorKind::Internal => 1,
+            ErrorKind::Usage => 2,
+            ErrorKind::Input | ErrorKind::Infeasible | ErrorKind::Io => 3,
+            ErrorKind::NoSolution => 4,
+        }
+    }
+}
+
 fn prefix(path: &Option<PathBuf>) -> String {
     match path {
         Some(p) => format!("{}: ", p.display()),
@@ -81,6 +122,11 @@ impl Error {
         Error::Input { path: None, message: message.into() }
     }
 
+    /// An internal error without a file.
+    pub fn internal(message: impl Into<String>) -> Self {
+        Error::Internal { path: None, message: message.into() }
+    }
+
     /// An infeasibility error without a file.
     pub fn infeasible(message: impl Into<String>) -> Self {
         Error::Infeasible { path: None, message: message.into() }
@@ -92,6 +138,7 @@ impl Error {
             Error::Input { path, .. }
             | Error::Infeasible { path, .. }
             | Error::Representative { path, .. }
+            | Error::Internal { path, .. }
             | Error::Uncertified { path, .. }
             | Error::NoSolution { path, .. } => {
                 if path.is_none() {
@@ -103,13 +150,61 @@ impl Error {
         self
     }
 
+    /// The kind of failure.
+    pub fn kind(&self) -> ErrorKind {
+        match self {
+            Error::Usage(_) => ErrorKind::Usage,
+            Error::Io { .. } => ErrorKind::Io,
+            Error::Input { .. } => ErrorKind::Input,
+            Error::Infeasible { .. } => ErrorKind::Infeasible,
+            Error::Uncertified { .. } => ErrorKind::Uncertified,
+            Error::Representative { .. } | Error::Internal { .. } => ErrorKind::Internal,
+            Error::NoSolution { .. } => ErrorKind::NoSolution,
+        }
+    }
+
+    /// The file the error names, if any.
+    pub fn path(&self) -> Option<&std::path::Path> {
+        match self {
+            Error::Input { path, .. }
+            | Error::Infeasible { path, .. }
+            | Error::Representative { path, .. }
+            | Error::Internal { path, .. }
+            | Error::Uncertified { path, .. }
+            | Error::NoSolution { path, .. } => path.as_deref(),
+            Error::Io { path, .. } => Some(path),
+            Error::Usage(_) => None,
+        }
+    }
+
     /// Exit status of the command-line tool for this error (SPEC.md).
     pub fn exit_code(&self) -> i32 {
-        match self {
-            Error::Uncertified { .. } | Error::Representative { .. } => 1,
-            Error::Usage(_) => 2,
-            Error::Input { .. } | Error::Infeasible { .. } | Error::Io { .. } => 3,
-            Error::NoSolution { .. } => 4,
+        self.kind().exit_code()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_kind_has_the_exit_status_of_the_spec() {
+        let io = Error::Io { path: "f".into(), source: std::io::Error::other("x") };
+        let cases = [
+            (Error::Usage("u".into()), ErrorKind::Usage, 2),
+            (io, ErrorKind::Io, 3),
+            (Error::input("i"), ErrorKind::Input, 3),
+            (Error::infeasible("f"), ErrorKind::Infeasible, 3),
+            (Error::Uncertified { path: None, message: "c".into() }, ErrorKind::Uncertified, 1),
+            (Error::internal("b"), ErrorKind::Internal, 1),
+            (Error::Representative { path: None, message: "r".into() }, ErrorKind::Internal, 1),
+            (Error::NoSolution { path: None, status: "s".into() }, ErrorKind::NoSolution, 4),
+        ];
+        for (e, kind, code) in cases {
+            assert_eq!((e.kind(), e.exit_code()), (kind, code), "{e}");
         }
+        let e = Error::internal("check").in_file("a.vti");
+        assert_eq!(e.path(), Some(std::path::Path::new("a.vti")));
+        assert_eq!(e.to_string(), "a.vti: internal error: check");
     }
 }

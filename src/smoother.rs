@@ -4,9 +4,9 @@
 use crate::domain::{Domain, Grid2d, Series, TriMesh};
 use crate::error::Result;
 use crate::linalg::Analyses;
-use crate::pipeline::{smooth_on, DomainOperators, SmoothSettings, Smoothable, Smoothed};
 #[cfg(doc)]
 use crate::pipeline::smooth;
+use crate::pipeline::{smooth_on, DomainOperators, SmoothSettings, Smoothable, Smoothed};
 
 /// The library's entry point for many fields on one domain (time steps, ensemble members,
 /// colour channels): built once per domain and settings, it owns the domain's operators

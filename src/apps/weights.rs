@@ -296,9 +296,9 @@ fn one_function<D: Smoothable>(
             f
         }
         WeightMethod::Unconstrained => dirichlet_solve(&ops.energy, fixed)
-            .map_err(|e| Error::input(format!("handle {which}: polyharmonic solve: {e}")))?,
+            .map_err(|e| Error::internal(format!("handle {which}: polyharmonic solve: {e}")))?,
         WeightMethod::Harmonic => dirichlet_solve(&ops.stiffness, fixed)
-            .map_err(|e| Error::input(format!("handle {which}: harmonic solve: {e}")))?,
+            .map_err(|e| Error::internal(format!("handle {which}: harmonic solve: {e}")))?,
         WeightMethod::Bounded => unreachable!("bounded weights are solved jointly"),
     };
     finish(domain, &mut out);

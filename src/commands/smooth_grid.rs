@@ -72,7 +72,7 @@ pub fn smooth_grid(args: &SmoothArgs, data: GridInput, start: Instant) -> Result
     let mut staged = vec![stage_output(&args.output, grid, &data, &result)?];
     if let Some(path) = &args.complex {
         let Some(ms) = &result.complex else {
-            return Err(crate::Error::Representative {
+            return Err(crate::Error::Internal {
                 path: Some(data.path.clone()),
                 message: format!("no Morse-Smale complex to write ({})", result.report.representative),
             });

@@ -91,7 +91,7 @@ pub fn smooth_mesh(args: &SmoothArgs, data: MeshInput, start: Instant) -> Result
     let mut staged = vec![stage_output(&args.output, &data, &result)?];
     if let Some(path) = &args.complex {
         let Some(ms) = &result.complex else {
-            return Err(Error::Representative {
+            return Err(Error::Internal {
                 path: Some(data.path.clone()),
                 message: format!("no Morse-Smale complex to write ({})", result.report.representative),
             });

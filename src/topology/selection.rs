@@ -267,10 +267,8 @@ pub fn select<D: Domain>(domain: &D, values: &[f64], selection: &Selection) -> R
         }
         if selection.by_persistence() {
             // kept sets chosen by persistence are realizable by construction; a failure here is our bug
-            check_alternation(values, &kept).map_err(|e| Error::Representative {
-                path: None,
-                message: format!("internal error: persistence selection is not realizable: {e}"),
-            })?;
+            check_alternation(values, &kept)
+                .map_err(|e| Error::internal(format!("persistence selection is not realizable: {e}")))?;
         }
     }
     Ok(KeptSet { roles, kept, threshold, warnings })

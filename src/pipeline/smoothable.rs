@@ -1,0 +1,307 @@
+//! What a domain supplies to the pipeline: its operators and its representative function
+//! (the series' linear one, the surfaces' separatrix, harmonic and flooded constructions).
+
+use crate::domain::{Domain, Grid2d, Series, TriMesh};
+use crate::error::{Error, Result};
+use crate::linalg::Analyses;
+use crate::operators::{
+    cotan_stiffness, dirichlet_solve, edge_factor, gradient_factor, grid_mass, grid_stiffness, lumped_mass,
+    positive_cotan_stiffness, series_mass, series_stiffness, Factor, Sparse,
+};
+use crate::representative::{flooded_representative, separatrix_representative, series_representative, Repairs};
+use crate::topology::morse_smale::MorseSmale;
+use crate::topology::{KeptSet, Role};
+use crate::verify::certify;
+
+/// Which representative function to build on surfaces (series always use the linear one).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "lowercase"))]
+pub enum RepresentativeChoice {
+    /// Separatrices interpolated, harmonic elsewhere (paper section 3.3).
+    #[default]
+    Separatrix,
+    /// Harmonic: kept minima at the data's minimum, kept maxima at its maximum.
+    Harmonic,
+    /// The data itself with every cancelled basin flooded to its spill value (Tierny &
+    /// Pascucci 2012; NOTES.md 9), plateaus made strict in flood order.
+    Flooded,
+}
+
+/// A representative function, the construction that produced it and the complex it used.
+#[derive(Clone, Debug)]
+pub struct Representative {
+    /// Values per vertex.
+    pub u: Vec<f64>,
+    /// Construction used: `linear`, `separatrix`, `harmonic` or `flooded`.
+    pub kind: &'static str,
+    /// Construction used, with its variant (one-sided saddles, released vertices).
+    pub name: String,
+    /// Why each construction tried before it was not used (automatic choice only).
+    pub fallbacks: Vec<String>,
+    /// The simplified Morse–Smale complex (surfaces).
+    pub complex: Option<MorseSmale>,
+}
+
+/// A domain the pipeline can smooth on: it supplies its operators and its representative.
+pub trait Smoothable: Domain {
+    /// Stiffness `K = −L`.
+    fn stiffness(&self) -> Sparse;
+    /// Lumped mass (diagonal, > 0).
+    fn mass(&self) -> Vec<f64>;
+    /// The Laplacian of harmonic fills: non-negative weights on the domain's own edges, so
+    /// that the maximum principle holds (the energy's stiffness where that already holds).
+    fn fill_stiffness(&self) -> Sparse {
+        self.own_fill_stiffness().unwrap_or_else(|| self.stiffness())
+    }
+    /// The fills' Laplacian where it differs from [`Smoothable::stiffness`], else `None`.
+    fn own_fill_stiffness(&self) -> Option<Sparse> {
+        None
+    }
+    /// `F₁` with `F₁ᵀF₁ = k` (the stiffness): one row per edge of positive weight, or `None`
+    /// when a weight is negative and the domain has no other square root.
+    fn stiffness_factor(&self, k: &Sparse) -> Option<Factor> {
+        edge_factor(k)
+    }
+    /// A function with exactly the kept extrema (checked by the pipeline), built by the
+    /// first construction in the order `choice` prefers that is not `excluded` (kind and
+    /// why: the pipeline excludes one whose order makes the constraints infeasible); `fill`
+    /// is [`Smoothable::fill_stiffness`], the factorisations' analyses are in `analyses`.
+    fn representative(
+        &self,
+        h: &[f64],
+        kept: &KeptSet,
+        choice: Option<RepresentativeChoice>,
+        fill: &Sparse,
+        excluded: &[(&'static str, String)],
+        analyses: &mut Analyses,
+    ) -> Result<Representative>;
+}
+
+impl Smoothable for Series {
+    fn stiffness(&self) -> Sparse {
+        series_stiffness(self)
+    }
+    fn mass(&self) -> Vec<f64> {
+        series_mass(self)
+    }
+    fn representative(
+        &self,
+        h: &[f64],
+        kept: &KeptSet,
+        _: Option<RepresentativeChoice>,
+        _: &Sparse,
+        _: &[(&'static str, String)],
+        _: &mut Analyses,
+    ) -> Result<Representative> {
+        let u = series_representative(self, h, kept)?;
+        Ok(Representative { u, kind: "linear", name: "linear".into(), fallbacks: Vec::new(), complex: None })
+    }
+}
+
+/// The harmonic representative: kept minima at the data's minimum, kept maxima at its
+/// maximum, harmonic elsewhere with `k` (non-negative weights: the maximum principle holds).
+fn harmonic_representative(h: &[f64], kept: &KeptSet, k: &Sparse) -> std::result::Result<Vec<f64>, String> {
+    let (lo, hi) = crate::domain::value_range(h);
+    let fixed: Vec<Option<f64>> = kept
+        .roles
+        .iter()
+        .map(|r| match r {
+            Role::Min => Some(lo),
+            Role::Max => Some(hi),
+            _ => None,
+        })
+        .collect();
+    dirichlet_solve(k, &fixed)
+}
+
+/// The representative on a triangulated surface (the complex is built either way, for
+/// `--complex`). A construction the user chose is built or refused (its check failing is an
+/// error naming the vertices); the automatic choice tries the separatrix one, then the
+/// harmonic one, then the flooded one (NOTES.md 9), and records why each one before was not
+/// used. `k` is the Laplacian of the harmonic fills (non-negative weights).
+fn surface_representative<D: Domain>(
+    domain: &D,
+    h: &[f64],
+    kept: &KeptSet,
+    choice: Option<RepresentativeChoice>,
+    k: &Sparse,
+    excluded: &[(&'static str, String)],
+    analyses: &mut Analyses,
+) -> Result<Representative> {
+    let analyses = std::cell::RefCell::new(analyses);
+    let mut why: Vec<String> = excluded.iter().map(|(kind, e)| format!("{kind} representative: {e}")).collect();
+    let skip = |kind: &str| excluded.iter().any(|(x, _)| *x == kind);
+    let complex = match MorseSmale::new(domain, h, kept) {
+        Ok(ms) => Some(ms),
+        Err(e) => {
+            why.push(format!("Morse-Smale complex: {e}"));
+            None
+        }
+    };
+    let repairs = std::cell::Cell::new(Repairs::default());
+    let one_sided_saddles = std::cell::Cell::new(0);
+    let merged_used: std::cell::RefCell<Option<MorseSmale>> = std::cell::RefCell::new(None);
+    // the matched saddles first; if u fails its check, once more with the one-sided saddles
+    // (a kept boundary extremum's partner is often one: without its separatrices the cells
+    // beside it reach along the boundary to values beyond it); then both again with failing
+    // kept extrema moved outward instead of released around (few-valued data: a kept minimum
+    // beside free vertices the fill holds below it). u is built from the values with their
+    // ties broken as the complex broke them (SoS): a saddle and an extremum of equal input
+    // value no longer give a flat separatrix.
+    let separatrix = |why: &mut Vec<String>| -> Option<Vec<f64>> {
+        let matched = complex.as_ref()?;
+        let merged = matched.with_one_sided();
+        let untied = crate::domain::sos_untied(h);
+        let complexes: Vec<&MorseSmale> = std::iter::once(matched).chain(merged.as_ref()).collect();
+        let attempts = [false, true].into_iter().flat_map(|moving| complexes.iter().map(move |&ms| (ms, moving)));
+        // the failure of the last attempt (the most mended one) is the one reported
+        let mut last_failure = None;
+        for (ms, move_kept) in attempts {
+            match separatrix_representative(domain, &untied, kept, ms, k, move_kept, &mut analyses.borrow_mut()) {
+                Ok((u, r)) => {
+                    let c = certify(domain, &u, &kept.roles, None);
+                    if c.passed {
+                        repairs.set(r);
+                        if !std::ptr::eq(ms, matched) {
+                            // the one-sided saddles are never matched ones
+                            one_sided_saddles.set(ms.saddles.len() - matched.saddles.len());
+                            *merged_used.borrow_mut() = Some(ms.clone());
+                        }
+                        return Some(u);
+                    }
+                    last_failure = Some(format!("separatrix representative: {}", c.summary()));
+                }
+                Err(e) => last_failure = Some(format!("separatrix representative: {e}")),
+            }
+        }
+        why.extend(last_failure);
+        None
+    };
+    let harmonic = |why: &mut Vec<String>| -> Option<Vec<f64>> {
+        match harmonic_representative(h, kept, k) {
+            Ok(u) => {
+                let c = certify(domain, &u, &kept.roles, None);
+                if c.passed {
+                    return Some(u);
+                }
+                why.push(format!("harmonic representative: {}", c.summary()));
+            }
+            Err(e) => why.push(format!("harmonic representative: {e}")),
+        }
+        None
+    };
+    let flooded = |why: &mut Vec<String>| -> Option<Vec<f64>> {
+        let u = flooded_representative(domain, h, kept);
+        if u.is_none() {
+            why.push("flooded representative: the floods did not settle".into());
+        }
+        u
+    };
+    let order: &[&'static str] = match choice {
+        None => &["separatrix", "harmonic", "flooded"],
+        Some(RepresentativeChoice::Separatrix) => &["separatrix"],
+        Some(RepresentativeChoice::Harmonic) => &["harmonic"],
+        Some(RepresentativeChoice::Flooded) => &["flooded"],
+    };
+    if choice.is_some() {
+        // the complex is only for --complex when the user chose the construction
+        why.clear();
+    }
+    let build = |name: &str, why: &mut Vec<String>| match name {
+        "separatrix" => separatrix(why),
+        "harmonic" => harmonic(why),
+        _ => flooded(why),
+    };
+    let named = |name: &str| {
+        let mut name = name.to_string();
+        if name == "separatrix" && one_sided_saddles.get() > 0 {
+            name = format!("separatrix with {} one-sided saddles", one_sided_saddles.get());
+        }
+        if !name.starts_with("separatrix") {
+            return name;
+        }
+        let r = repairs.get();
+        let mut changes = Vec::new();
+        if r.released > 0 {
+            changes.push(format!("{} contradicting separatrix vertices released to the harmonic fill", r.released));
+        }
+        let plural = |n: usize, one: &str, many: &str| format!("{n} {}", if n == 1 { one } else { many });
+        if r.moved > 0 {
+            changes.push(format!("{} moved outward", plural(r.moved, "kept value", "kept values")));
+        }
+        if r.pinned > 0 {
+            changes.push(format!("{} pinned beside them", plural(r.pinned, "free vertex", "free vertices")));
+        }
+        if !changes.is_empty() {
+            name = format!("{name} ({})", changes.join(", "));
+        }
+        name
+    };
+    for &kind in order {
+        if skip(kind) {
+            continue;
+        }
+        if let Some(u) = build(kind, &mut why) {
+            // --complex writes the separatrices u was built from
+            let complex = if kind == "separatrix" { merged_used.take().or(complex) } else { complex };
+            return Ok(Representative { u, kind, name: named(kind), fallbacks: why, complex });
+        }
+    }
+    let message = match choice {
+        Some(_) => format!("{} (requested explicitly: not replaced by another construction)", why.join("; ")),
+        None => why.join("; "),
+    };
+    Err(Error::Representative { path: None, message })
+}
+
+impl Smoothable for TriMesh {
+    fn stiffness(&self) -> Sparse {
+        cotan_stiffness(self.positions(), self.faces())
+    }
+    fn mass(&self) -> Vec<f64> {
+        lumped_mass(self.positions(), self.faces())
+    }
+    fn own_fill_stiffness(&self) -> Option<Sparse> {
+        Some(positive_cotan_stiffness(self.positions(), self.faces()))
+    }
+    /// One row per edge when every cotangent weight is ≥ 0, else the area-weighted triangle
+    /// gradients (three rows per triangle).
+    fn stiffness_factor(&self, k: &Sparse) -> Option<Factor> {
+        edge_factor(k).or_else(|| Some(gradient_factor(self.positions(), self.faces())))
+    }
+    /// As on grids, but the harmonic fills use [`positive_cotan_stiffness`] (`fill`):
+    /// cotangent weights of obtuse triangles can be negative and break the maximum principle
+    /// the representative relies on (paper section 5).
+    fn representative(
+        &self,
+        h: &[f64],
+        kept: &KeptSet,
+        choice: Option<RepresentativeChoice>,
+        fill: &Sparse,
+        excluded: &[(&'static str, String)],
+        analyses: &mut Analyses,
+    ) -> Result<Representative> {
+        surface_representative(self, h, kept, choice, fill, excluded, analyses)
+    }
+}
+
+impl Smoothable for Grid2d {
+    fn stiffness(&self) -> Sparse {
+        grid_stiffness(self)
+    }
+    fn mass(&self) -> Vec<f64> {
+        grid_mass(self)
+    }
+    fn representative(
+        &self,
+        h: &[f64],
+        kept: &KeptSet,
+        choice: Option<RepresentativeChoice>,
+        fill: &Sparse,
+        excluded: &[(&'static str, String)],
+        analyses: &mut Analyses,
+    ) -> Result<Representative> {
+        surface_representative(self, h, kept, choice, fill, excluded, analyses)
+    }
+}

@@ -49,7 +49,7 @@ impl Analyses {
     ///
     /// # Errors
     /// A message if the analysis fails or the pattern cannot be copied.
-    pub fn of(&mut self, pattern: SymbolicSparseColMatRef<'_, usize>) -> Result<std::rc::Rc<Analysis>, String> {
+    pub(crate) fn of(&mut self, pattern: SymbolicSparseColMatRef<'_, usize>) -> Result<std::rc::Rc<Analysis>, String> {
         let same = |a: &SymbolicSparseColMat<usize>| {
             a.nrows() == pattern.nrows() && a.col_ptr() == pattern.col_ptr() && a.row_idx() == pattern.row_idx()
         };
@@ -65,7 +65,7 @@ impl Analyses {
     }
 
     /// Keeps `analysis` (made elsewhere, e.g. on another thread) as the one of `pattern`.
-    pub fn keep(&mut self, pattern: SymbolicSparseColMat<usize>, analysis: std::rc::Rc<Analysis>) {
+    pub(crate) fn keep(&mut self, pattern: SymbolicSparseColMat<usize>, analysis: std::rc::Rc<Analysis>) {
         if self.kept.len() == Self::KEPT {
             self.kept.remove(0);
         }

@@ -218,12 +218,14 @@ fn best_level(bounds: &[usize], len: usize, min_fraction: f64) -> (f64, usize) {
 /// Smallest share of the vertices in each part at the top level of the dissection.
 const TOP_BALANCE: f64 = 0.45;
 
+#[cfg(test)]
 /// A nested-dissection ordering of `g`: `perm[new] = old`. Parts of at most `leaf_size`
 /// vertices are ordered by AMD.
 pub fn nested_dissection(g: &Graph, leaf_size: usize) -> Vec<usize> {
     nested_dissection_split(g, leaf_size).0
 }
 
+#[cfg(test)]
 /// [`nested_dissection`] and, when the whole graph was bisected at the top (it is connected
 /// and not a near-clique), the sizes `[a, b]` of the two parts: `perm[..a]` is one part,
 /// `perm[a..a + b]` the other, `perm[a + b..]` the separator between them, and no edge joins

@@ -19,19 +19,21 @@ use faer::sparse::linalg::cholesky::{
     factorize_symbolic_cholesky, CholeskySymbolicParams, LltRef, SymbolicCholesky, SymbolicCholeskyRaw,
     SymmetricOrdering,
 };
-use faer::sparse::{SparseColMatRef, SymbolicSparseColMat, SymbolicSparseColMatRef};
+use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 use faer::{Conj, Par, Side, Spec};
 
 mod analyses;
 mod dissection;
-pub mod two_way;
+pub(crate) mod two_way;
 
 pub use analyses::{solve_spd, Analyses, SpdSolver};
-pub use dissection::{compress_columns, inverse, nested_dissection, nested_dissection_split, Graph};
+#[cfg(test)]
+use dissection::nested_dissection;
+pub(crate) use dissection::{compress_columns, inverse, Graph};
 use dissection::{dissection, PARALLEL_DISSECTION_MIN};
 
 /// Flops of the Cholesky factorisation described by `s` (Σ over columns of count²).
-pub fn factor_flops(s: &SymbolicCholesky<usize>) -> f64 {
+pub(crate) fn factor_flops(s: &SymbolicCholesky<usize>) -> f64 {
     match s.raw() {
         SymbolicCholeskyRaw::Simplicial(f) => {
             let cp = f.col_ptr();
@@ -78,7 +80,7 @@ const ND_LEAF: usize = 128;
 
 /// Parallelism for a numeric factorisation: sequential below about 2e10 factor flops (on
 /// 2 cores rayon only paid off for the largest factors measured), else faer's global setting.
-pub fn parallelism_for(s: &SymbolicCholesky<usize>) -> Par {
+pub(crate) fn parallelism_for(s: &SymbolicCholesky<usize>) -> Par {
     if factor_flops(s) < 2e10 {
         Par::Seq
     } else {
@@ -89,7 +91,7 @@ pub fn parallelism_for(s: &SymbolicCholesky<usize>) -> Par {
 /// Solves `A x = b` once for a symmetric positive definite `A` given by its upper triangle
 /// (`b` is overwritten by `x`), with AMD: for a single factorisation the nested-dissection
 /// ordering costs more than it saves. `Err` if `A` is not numerically positive definite.
-pub fn solve_spd_once(a: SparseColMatRef<'_, usize, f64>, b: &mut [f64]) -> Result<(), String> {
+pub(crate) fn solve_spd_once(a: SparseColMatRef<'_, usize, f64>, b: &mut [f64]) -> Result<(), String> {
     let n = a.ncols();
     let s = factorize_symbolic_cholesky(a.symbolic(), Side::Upper, SymmetricOrdering::Amd, Default::default())
         .map_err(|e| format!("symbolic Cholesky: {e:?}"))?;
@@ -110,7 +112,8 @@ pub fn solve_spd_once(a: SparseColMatRef<'_, usize, f64>, b: &mut [f64]) -> Resu
 
 /// The pattern (upper triangle with diagonal) of a matrix given by triplets; for tests and
 /// callers that build matrices by hand.
-pub fn upper_pattern(n: usize, edges: &[(usize, usize)]) -> SymbolicSparseColMat<usize> {
+#[cfg(test)]
+pub(crate) fn upper_pattern(n: usize, edges: &[(usize, usize)]) -> faer::sparse::SymbolicSparseColMat<usize> {
     let mut cols: Vec<Vec<usize>> = (0..n).map(|j| vec![j]).collect();
     for &(i, j) in edges {
         let (lo, hi) = (i.min(j), i.max(j));
@@ -124,12 +127,12 @@ pub fn upper_pattern(n: usize, edges: &[(usize, usize)]) -> SymbolicSparseColMat
         ri.extend_from_slice(c);
         cp.push(ri.len());
     }
-    SymbolicSparseColMat::new_checked(n, n, cp, None, ri)
+    faer::sparse::SymbolicSparseColMat::new_checked(n, n, cp, None, ri)
 }
 
 /// How a fixed pattern is factorised: one faer factorisation (AMD or nested dissection,
 /// sequential or faer's parallel kernels), or two halves side by side ([`two_way`]).
-pub enum Analysis {
+pub(crate) enum Analysis {
     /// One factorisation.
     Single {
         /// faer's analysis.
@@ -155,7 +158,7 @@ const PARALLEL_MIN_FLOPS: f64 = 2e10;
 ///
 /// # Errors
 /// A message if faer's analysis fails.
-pub fn analyse(a: SymbolicSparseColMatRef<'_, usize>, split_allowed: bool) -> Result<Analysis, String> {
+pub(crate) fn analyse(a: SymbolicSparseColMatRef<'_, usize>, split_allowed: bool) -> Result<Analysis, String> {
     let n = a.ncols();
     let single = |symbolic: SymbolicCholesky<usize>| {
         let par = parallelism_for(&symbolic);
@@ -220,7 +223,7 @@ pub fn analyse(a: SymbolicSparseColMatRef<'_, usize>, split_allowed: bool) -> Re
 ///
 /// # Errors
 /// A message if faer's analysis fails.
-pub fn analyse_simplicial(a: SymbolicSparseColMatRef<'_, usize>) -> Result<SymbolicCholesky<usize>, String> {
+pub(crate) fn analyse_simplicial(a: SymbolicSparseColMatRef<'_, usize>) -> Result<SymbolicCholesky<usize>, String> {
     let n = a.ncols();
     let params = |_| CholeskySymbolicParams {
         supernodal_flop_ratio_threshold: faer::sparse::linalg::SupernodalThreshold::FORCE_SIMPLICIAL,
@@ -299,7 +302,7 @@ impl Workspace {
 
 /// A Cholesky factorisation of matrices with one analysed pattern: [`SpdFactor::factor`]
 /// refactors the values, [`SpdFactor::solve_in_place`] solves with the last factor.
-pub struct SpdFactor {
+pub(crate) struct SpdFactor {
     analysis: std::rc::Rc<Analysis>,
     numeric: Numeric,
 }

@@ -133,6 +133,7 @@ impl Symbolic {
         Some(Symbolic { n, halves: [h0?, h1?], sep, sep_entries })
     }
 
+    #[cfg(test)]
     /// Size of the separator.
     pub fn separator_len(&self) -> usize {
         self.sep.len()

@@ -2,7 +2,7 @@
 //! interior-point solver of `solve`): fill-reducing orderings computed from the matrix graph
 //! alone, and the choice of sequential or parallel factorisation.
 //!
-//! [`nested_dissection`] bisects the graph recursively by BFS level structures: from a
+//! Nested dissection (`dissection`) bisects the graph recursively by BFS level structures: from a
 //! pseudo-peripheral vertex, one BFS level separates the levels before it from those after
 //! it, so it is a vertex separator of any graph. Each part is ordered before its separator,
 //! small parts by faer's AMD. On planar-like graphs (grids, triangulated meshes) this

@@ -32,7 +32,7 @@ pub enum Direction {
 
 /// What a cell is paired with.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum Pair {
+enum Pairing {
     None,
     Critical,
     Cell(u32),
@@ -159,9 +159,9 @@ pub struct DiscreteGradient {
     c: std::sync::Arc<Complex>,
     /// Filtration rank of every vertex (cones last).
     rank: Vec<u32>,
-    vertex_pair: Vec<Pair>,
-    edge_pair: Vec<Pair>,
-    triangle_pair: Vec<Pair>,
+    vertex_pair: Vec<Pairing>,
+    edge_pair: Vec<Pairing>,
+    triangle_pair: Vec<Pairing>,
 }
 
 impl DiscreteGradient {
@@ -195,9 +195,9 @@ impl DiscreteGradient {
         }
         let mut g = DiscreteGradient {
             rank,
-            vertex_pair: vec![Pair::None; n_all],
-            edge_pair: vec![Pair::None; c.edges.len()],
-            triangle_pair: vec![Pair::None; c.triangles.len()],
+            vertex_pair: vec![Pairing::None; n_all],
+            edge_pair: vec![Pairing::None; c.edges.len()],
+            triangle_pair: vec![Pairing::None; c.triangles.len()],
             c,
         };
         let mut by_rank: Vec<u32> = (0..n_all as u32).collect();
@@ -245,7 +245,7 @@ impl DiscreteGradient {
             .filter(|&e| self.rank[self.other(e, v) as usize] < rv)
             .collect();
         if lower_edges.is_empty() {
-            self.vertex_pair[v as usize] = Pair::Critical;
+            self.vertex_pair[v as usize] = Pairing::Critical;
             return;
         }
         // the edge from v to w (a cone's star is a whole boundary loop: look it up by hash)
@@ -271,7 +271,7 @@ impl DiscreteGradient {
             f
         };
         let unpaired_faces =
-            |g: &Self, t: u32| faces(g, t).iter().filter(|&&e| g.edge_pair[e as usize] == Pair::None).count();
+            |g: &Self, t: u32| faces(g, t).iter().filter(|&&e| g.edge_pair[e as usize] == Pairing::None).count();
         let mut lower_triangles: Vec<u32> = Vec::new();
         for &e in &lower_edges {
             for &t in &self.c.edge_triangles[e as usize] {
@@ -290,21 +290,21 @@ impl DiscreteGradient {
         // lower-star triangles with face e and one unpaired face go to the first queue
         let ready = |g: &Self, e: u32, pq_one: &mut BinaryHeap<Entry>| {
             for &t in &g.c.edge_triangles[e as usize] {
-                if in_star(g, t) && g.triangle_pair[t as usize] == Pair::None && unpaired_faces(g, t) == 1 {
+                if in_star(g, t) && g.triangle_pair[t as usize] == Pairing::None && unpaired_faces(g, t) == 1 {
                     pq_one.push(triangle_entry(g, t));
                 }
             }
         };
         let delta = *lower_edges.iter().min_by_key(|&&e| self.key(Cell::Edge(e), v)).expect("non-empty");
-        self.vertex_pair[v as usize] = Pair::Cell(delta);
-        self.edge_pair[delta as usize] = Pair::Cell(v);
+        self.vertex_pair[v as usize] = Pairing::Cell(delta);
+        self.edge_pair[delta as usize] = Pairing::Cell(v);
         let mut pq_zero: BinaryHeap<Entry> =
             lower_edges.iter().filter(|&&e| e != delta).map(|&e| edge_entry(self, e)).collect();
         let mut pq_one: BinaryHeap<Entry> = BinaryHeap::new();
         ready(self, delta, &mut pq_one);
         loop {
             while let Some(Reverse((_, _, alpha))) = pq_one.pop() {
-                if self.triangle_pair[alpha as usize] != Pair::None {
+                if self.triangle_pair[alpha as usize] != Pairing::None {
                     continue;
                 }
                 if unpaired_faces(self, alpha) == 0 {
@@ -312,44 +312,44 @@ impl DiscreteGradient {
                     continue;
                 }
                 let lower =
-                    *faces(self, alpha).iter().find(|&&e| self.edge_pair[e as usize] == Pair::None).expect("one");
-                self.edge_pair[lower as usize] = Pair::Cell(alpha);
-                self.triangle_pair[alpha as usize] = Pair::Cell(lower);
+                    *faces(self, alpha).iter().find(|&&e| self.edge_pair[e as usize] == Pairing::None).expect("one");
+                self.edge_pair[lower as usize] = Pairing::Cell(alpha);
+                self.triangle_pair[alpha as usize] = Pairing::Cell(lower);
                 ready(self, lower, &mut pq_one);
             }
             let Some(Reverse((_, kind, id))) = pq_zero.pop() else { break };
             if kind == 0 {
-                if self.edge_pair[id as usize] != Pair::None {
+                if self.edge_pair[id as usize] != Pairing::None {
                     continue;
                 }
-                self.edge_pair[id as usize] = Pair::Critical;
+                self.edge_pair[id as usize] = Pairing::Critical;
                 ready(self, id, &mut pq_one);
-            } else if self.triangle_pair[id as usize] == Pair::None {
-                self.triangle_pair[id as usize] = Pair::Critical;
+            } else if self.triangle_pair[id as usize] == Pairing::None {
+                self.triangle_pair[id as usize] = Pairing::Critical;
             }
         }
         // every lower-star triangle not reached is critical (both faces were paired elsewhere)
         for &t in &lower_triangles {
-            if self.triangle_pair[t as usize] == Pair::None {
-                self.triangle_pair[t as usize] = Pair::Critical;
+            if self.triangle_pair[t as usize] == Pairing::None {
+                self.triangle_pair[t as usize] = Pairing::Critical;
             }
         }
         for &e in &lower_edges {
-            if self.edge_pair[e as usize] == Pair::None {
-                self.edge_pair[e as usize] = Pair::Critical;
+            if self.edge_pair[e as usize] == Pairing::None {
+                self.edge_pair[e as usize] = Pairing::Critical;
             }
         }
     }
 
     /// Critical vertices among the real ones (minima when descending, maxima when ascending).
     pub fn critical_vertices(&self) -> Vec<usize> {
-        (0..self.c.n_real).filter(|&v| self.vertex_pair[v] == Pair::Critical).collect()
+        (0..self.c.n_real).filter(|&v| self.vertex_pair[v] == Pairing::Critical).collect()
     }
 
     /// Critical edges (saddles) as vertex pairs; edges at a cone name the cone as `n + loop`.
     pub fn critical_edges(&self) -> Vec<[usize; 2]> {
         (0..self.c.edges.len())
-            .filter(|&e| self.edge_pair[e] == Pair::Critical)
+            .filter(|&e| self.edge_pair[e] == Pairing::Critical)
             .map(|e| self.c.edges[e].map(|v| v as usize))
             .collect()
     }
@@ -357,9 +357,9 @@ impl DiscreteGradient {
     /// Number of critical cells of each dimension on the coned complex (cones included).
     pub fn critical_counts(&self) -> [usize; 3] {
         [
-            self.vertex_pair.iter().filter(|p| **p == Pair::Critical).count(),
-            self.edge_pair.iter().filter(|p| **p == Pair::Critical).count(),
-            self.triangle_pair.iter().filter(|p| **p == Pair::Critical).count(),
+            self.vertex_pair.iter().filter(|p| **p == Pairing::Critical).count(),
+            self.edge_pair.iter().filter(|p| **p == Pairing::Critical).count(),
+            self.triangle_pair.iter().filter(|p| **p == Pairing::Critical).count(),
         ]
     }
 
@@ -371,7 +371,7 @@ impl DiscreteGradient {
 
     /// Whether every cell is paired exactly once or critical (a valid discrete vector field).
     pub fn is_complete(&self) -> bool {
-        self.vertex_pair.iter().chain(&self.edge_pair).chain(&self.triangle_pair).all(|p| *p != Pair::None)
+        self.vertex_pair.iter().chain(&self.edge_pair).chain(&self.triangle_pair).all(|p| *p != Pairing::None)
     }
 
     /// For every vertex (cones included), the critical vertex its V-path ends at; each path
@@ -384,7 +384,7 @@ impl DiscreteGradient {
             let mut x = v;
             while end[x as usize] == UNKNOWN {
                 match self.vertex_pair[x as usize] {
-                    Pair::Cell(e) => {
+                    Pairing::Cell(e) => {
                         trail.push(x);
                         x = self.other(e, x);
                     }
@@ -405,7 +405,7 @@ impl DiscreteGradient {
     #[cfg_attr(not(debug_assertions), allow(dead_code))]
     fn path_end(&self, v: u32) -> u32 {
         let mut x = v;
-        while let Pair::Cell(e) = self.vertex_pair[x as usize] {
+        while let Pairing::Cell(e) = self.vertex_pair[x as usize] {
             x = self.other(e, x);
         }
         x
@@ -446,13 +446,13 @@ impl DiscreteGradient {
         for p in order {
             let m = p.extremum as u32;
             let s = p.partner.expect("filtered") as u32;
-            if self.vertex_pair[m as usize] != Pair::Critical {
+            if self.vertex_pair[m as usize] != Pairing::Critical {
                 return Err(format!("vertex {m} is not critical any more"));
             }
             let rs = self.rank[s as usize];
             let mut done = false;
             for &e in &edges_at.vertex_edges[s as usize] {
-                if self.edge_pair[e as usize] != Pair::Critical || self.rank[self.other(e, s) as usize] > rs {
+                if self.edge_pair[e as usize] != Pairing::Critical || self.rank[self.other(e, s) as usize] > rs {
                     continue;
                 }
                 let [a, b] = self.c.edges[e as usize];
@@ -487,10 +487,10 @@ impl DiscreteGradient {
         let mut x = start;
         loop {
             let next = self.vertex_pair[x as usize];
-            self.vertex_pair[x as usize] = Pair::Cell(edge);
-            self.edge_pair[edge as usize] = Pair::Cell(x);
+            self.vertex_pair[x as usize] = Pairing::Cell(edge);
+            self.edge_pair[edge as usize] = Pairing::Cell(x);
             match next {
-                Pair::Cell(f) => {
+                Pairing::Cell(f) => {
                     edge = f;
                     x = self.other(f, x);
                 }
@@ -504,7 +504,7 @@ impl DiscreteGradient {
     /// ascending), in whose lower star the edge was made critical.
     pub fn saddles(&self) -> Vec<Saddle> {
         (0..self.c.edges.len())
-            .filter(|&e| self.edge_pair[e] == Pair::Critical)
+            .filter(|&e| self.edge_pair[e] == Pairing::Critical)
             .filter_map(|e| {
                 let [a, b] = self.c.edges[e];
                 if a as usize >= self.c.n_real || b as usize >= self.c.n_real {
@@ -530,7 +530,7 @@ impl DiscreteGradient {
     pub fn vertex_path(&self, v: usize) -> Vec<usize> {
         let mut path = vec![v];
         let mut x = v as u32;
-        while let Pair::Cell(e) = self.vertex_pair[x as usize] {
+        while let Pairing::Cell(e) = self.vertex_pair[x as usize] {
             x = self.other(e, x);
             path.push(x as usize);
         }

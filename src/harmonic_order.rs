@@ -259,6 +259,7 @@ pub fn ordered_harmonic<D: Domain>(
 #[cfg(test)]
 mod tests {
     use super::*;
+    #[cfg_attr(not(feature = "serde"), allow(unused_imports))]
     use crate::verify::{certify_no_data, RegionKind};
 
     #[test]
@@ -272,6 +273,7 @@ mod tests {
     }
 
     #[test]
+    #[cfg(feature = "serde")]
     fn a_long_appendage_keeps_its_order() {
         // a 20 × 20 block with the two handles, and an arm 4 pixels wide and 150 long without
         // handles: the harmonic variation along the arm falls far below one ulp

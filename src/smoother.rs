@@ -13,11 +13,12 @@ use crate::pipeline::{smooth_on, DomainOperators, SmoothSettings, Smoothable, Sm
 /// ([`DomainOperators`]) and the analyses of its factorisations ([`Analyses`]), and
 /// [`Smoother::smooth`] reuses them. What a second field skips: building the stiffness, the
 /// mass and the fills' Laplacian, and the symbolic analysis of the fills' Laplacian (the
-/// harmonic fills of the representative); the solver's normal matrix is analysed again unless
-/// the field keeps the same fixed vertices (its pattern is P's on the free vertices). The
-/// energy itself depends on the smoothing length, which on series follows the kept extrema,
-/// and is rebuilt. Memory for speed: the analyses stay between fields (the one-off [`smooth`]
-/// drops the fills' before the solve).
+/// harmonic fills of the representative). The solver's normal matrix depends on the fixed
+/// vertices: its analysis is made again for every field, on the other core beside the
+/// representative, with the factor storage it is used with. The energy depends on the
+/// smoothing length, which on series follows the kept extrema, and is rebuilt. Memory for
+/// speed: the analyses stay between fields (the one-off [`smooth`] drops the fills' before the
+/// solve). A smoother is `Send`: one per thread works.
 ///
 /// ```
 /// use toposmooth::domain::Grid2d;
@@ -60,7 +61,7 @@ impl<D: Smoothable + Sync> Smoother<D> {
     /// # Errors
     /// As [`smooth`].
     pub fn smooth(&mut self, h: &[f64]) -> Result<Smoothed> {
-        smooth_on(&self.domain, &self.operators, h, &self.settings, &mut self.analyses, true)
+        smooth_on(&self.domain, &mut self.operators, h, &self.settings, &mut self.analyses, true)
     }
 
     /// The domain.

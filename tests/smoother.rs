@@ -70,3 +70,17 @@ fn the_run_time_domain_smoother_is_the_generic_one() {
         assert_eq!(any.smooth(f).unwrap().output, generic.smooth(f).unwrap().output);
     }
 }
+
+#[test]
+fn a_smoother_can_move_to_another_thread() {
+    fn send<T: Send>(_: &T) {}
+    let grid = Grid2d::new(30, 20).unwrap();
+    let h = fields(&grid, 6).remove(0);
+    let mut smoother = Smoother::new(grid, SmoothSettings::default()).unwrap();
+    send(&smoother);
+    let first = smoother.smooth(&h).unwrap().output;
+    let again = std::thread::spawn(move || smoother.smooth(&h).unwrap().output).join().unwrap();
+    assert_eq!(first, again);
+    let any = AnySmoother::new(AnyDomain::Series(Series::uniform(50)), SmoothSettings::default()).unwrap();
+    send(&any);
+}

@@ -366,7 +366,8 @@ pub fn weights_prescribed<D: Smoothable + Sync>(
     let k = domain.stiffness();
     let m = domain.mass();
     let energy = polyharmonic(&k, &m, &Energy::order(settings.order), &[1.0]);
-    let ops = Operators { energy, fill: domain.fill_stiffness(), stiffness: k };
+    let fill = domain.own_fill_stiffness().unwrap_or_else(|| k.clone());
+    let ops = Operators { energy, fill, stiffness: k };
     let operator_seconds = t.elapsed().as_secs_f64();
 
     let t = Instant::now();

@@ -157,7 +157,7 @@ pub fn stage_grid_csv(path: &Path, nx: usize, values: &[f64]) -> Result<super::S
     })
 }
 
-#[cfg(test)]
+#[cfg(all(test, feature = "image"))]
 mod tests {
     use super::*;
     use crate::domain::Domain;

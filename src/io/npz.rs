@@ -169,7 +169,7 @@ pub fn decode_npy(bytes: &[u8]) -> std::result::Result<([usize; 2], Vec<f64>), S
     Ok(([ny, nx], values))
 }
 
-#[cfg(test)]
+#[cfg(all(test, feature = "io-npz"))]
 mod tests {
     use super::*;
 

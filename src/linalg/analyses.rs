@@ -4,11 +4,11 @@
 use super::{analyse, solve_spd_once, Analysis, SpdFactor};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMat, SymbolicSparseColMatRef};
 
-/// [`solve_spd_once`], or with the analysis taken from and kept in `analyses` when given (a
+/// `solve_spd_once`, or with the analysis taken from and kept in `analyses` when given (a
 /// pattern solved again and again: the weight functions' fills and gaps).
 ///
 /// # Errors
-/// As [`solve_spd_once`].
+/// As `solve_spd_once`.
 pub fn solve_spd(
     a: SparseColMatRef<'_, usize, f64>,
     b: &mut [f64],
@@ -27,7 +27,7 @@ pub fn solve_spd(
 pub struct Analyses {
     split_allowed: bool,
     /// Most recent last; at most [`Analyses::KEPT`].
-    kept: Vec<(SymbolicSparseColMat<usize>, std::rc::Rc<Analysis>)>,
+    kept: Vec<(SymbolicSparseColMat<usize>, std::sync::Arc<Analysis>)>,
 }
 
 impl Default for Analyses {
@@ -40,7 +40,7 @@ impl Analyses {
     /// Patterns kept at once (a Laplacian, the energy and a normal matrix).
     const KEPT: usize = 3;
 
-    /// An empty store; `split_allowed`: see [`analyse`].
+    /// An empty store; `split_allowed`: see `analyse`.
     pub fn new(split_allowed: bool) -> Self {
         Analyses { split_allowed, kept: Vec::new() }
     }
@@ -49,7 +49,10 @@ impl Analyses {
     ///
     /// # Errors
     /// A message if the analysis fails or the pattern cannot be copied.
-    pub(crate) fn of(&mut self, pattern: SymbolicSparseColMatRef<'_, usize>) -> Result<std::rc::Rc<Analysis>, String> {
+    pub(crate) fn of(
+        &mut self,
+        pattern: SymbolicSparseColMatRef<'_, usize>,
+    ) -> Result<std::sync::Arc<Analysis>, String> {
         let same = |a: &SymbolicSparseColMat<usize>| {
             a.nrows() == pattern.nrows() && a.col_ptr() == pattern.col_ptr() && a.row_idx() == pattern.row_idx()
         };
@@ -59,13 +62,17 @@ impl Analyses {
             self.kept.push(entry);
             return Ok(analysis);
         }
-        let analysis = std::rc::Rc::new(analyse(pattern, self.split_allowed)?);
+        let analysis = std::sync::Arc::new(analyse(pattern, self.split_allowed)?);
         self.keep(pattern.to_owned().map_err(|e| format!("{e:?}"))?, analysis.clone());
         Ok(analysis)
     }
 
     /// Keeps `analysis` (made elsewhere, e.g. on another thread) as the one of `pattern`.
-    pub(crate) fn keep(&mut self, pattern: SymbolicSparseColMat<usize>, analysis: std::rc::Rc<Analysis>) {
+    pub(crate) fn keep(&mut self, pattern: SymbolicSparseColMat<usize>, analysis: std::sync::Arc<Analysis>) {
+        // one entry per pattern: a new analysis of a kept pattern replaces the old one
+        self.kept.retain(|(q, _)| {
+            !(q.nrows() == pattern.nrows() && q.col_ptr() == pattern.col_ptr() && q.row_idx() == pattern.row_idx())
+        });
         if self.kept.len() == Self::KEPT {
             self.kept.remove(0);
         }
@@ -83,7 +90,7 @@ impl Analyses {
     }
 }
 
-/// A sparse SPD solver for a fixed pattern: the analysis ([`analyse`]) is done once, each
+/// A sparse SPD solver for a fixed pattern: the analysis (`analyse`) is done once, each
 /// [`SpdSolver::solve`] refactors the values and solves (for repeated solves with the same
 /// pattern and different values).
 pub struct SpdSolver {

@@ -8,50 +8,30 @@
 //! small parts by faer's AMD. On planar-like graphs (grids, triangulated meshes) this
 //! gives far less fill and fewer flops than minimum degree at large n (about 20 % at a million vertices with
 //! the 19-point pattern of a bilaplacian).
-//! [`analyse`] orders a pattern with both this ordering and AMD and keeps the cheapest
+//! `analyse` orders a pattern with both this ordering and AMD and keeps the cheapest
 //! factorisation: AMD, nested dissection, or nested dissection's two halves side by side
-//! ([`two_way`]); from [`ND_ONLY_N`] unknowns on it computes AMD only when the two-way split is
+//! (`two_way`); from `ND_ONLY_N` unknowns on it computes AMD only when the two-way split is
 //! not possible.
 
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::perm::PermRef;
 use faer::sparse::linalg::cholesky::{
-    factorize_symbolic_cholesky, CholeskySymbolicParams, LltRef, SymbolicCholesky, SymbolicCholeskyRaw,
-    SymmetricOrdering,
+    factorize_symbolic_cholesky, CholeskySymbolicParams, LltRef, SymbolicCholesky, SymmetricOrdering,
 };
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 use faer::{Conj, Par, Side, Spec};
 
 mod analyses;
+mod cost;
 mod dissection;
 pub(crate) mod two_way;
 
 pub use analyses::{solve_spd, Analyses, SpdSolver};
+pub(crate) use cost::{factor_flops, touch_pages};
 #[cfg(test)]
 use dissection::nested_dissection;
 pub(crate) use dissection::{compress_columns, inverse, Graph};
 use dissection::{dissection, PARALLEL_DISSECTION_MIN};
-
-/// Flops of the Cholesky factorisation described by `s` (Σ over columns of count²).
-pub(crate) fn factor_flops(s: &SymbolicCholesky<usize>) -> f64 {
-    match s.raw() {
-        SymbolicCholeskyRaw::Simplicial(f) => {
-            let cp = f.col_ptr();
-            (0..f.ncols()).map(|j| ((cp[j + 1] - cp[j]) as f64).powi(2)).sum()
-        }
-        SymbolicCholeskyRaw::Supernodal(f) => {
-            let (b, e, rp) = (f.supernode_begin(), f.supernode_end(), f.col_ptr_for_row_idx());
-            let mut flops = 0.0;
-            for s in 0..f.n_supernodes() {
-                let below = (rp[s + 1] - rp[s]) as f64;
-                for j in b[s]..e[s] {
-                    flops += ((e[s] - j) as f64 + below).powi(2);
-                }
-            }
-            flops
-        }
-    }
-}
 
 /// Above this size the factorisation is supernodal: faer's automatic choice kept the
 /// simplicial one for bilaplacian patterns of a few thousand unknowns, where supernodal
@@ -275,14 +255,6 @@ impl Numeric {
     }
 }
 
-/// Writes a zero into every 4 KiB page of `v` (through `black_box`, so that it is not
-/// optimised away for memory known to be zero).
-pub(crate) fn touch_pages(v: &mut [f64]) {
-    for i in (0..v.len()).step_by(512) {
-        v[i] = std::hint::black_box(0.0);
-    }
-}
-
 /// A factorisation's numeric storage made in advance, possibly on another thread
 /// ([`Workspace::new`]), with its pages already mapped; [`SpdFactor::with_workspace`] uses it.
 pub(crate) struct Workspace(Numeric);
@@ -303,7 +275,7 @@ impl Workspace {
 /// A Cholesky factorisation of matrices with one analysed pattern: [`SpdFactor::factor`]
 /// refactors the values, [`SpdFactor::solve_in_place`] solves with the last factor.
 pub(crate) struct SpdFactor {
-    analysis: std::rc::Rc<Analysis>,
+    analysis: std::sync::Arc<Analysis>,
     numeric: Numeric,
 }
 
@@ -312,13 +284,13 @@ impl SpdFactor {
     ///
     /// # Errors
     /// A message if the workspace cannot be allocated.
-    pub fn new(analysis: std::rc::Rc<Analysis>) -> Result<SpdFactor, String> {
+    pub fn new(analysis: std::sync::Arc<Analysis>) -> Result<SpdFactor, String> {
         let numeric = Numeric::new(&analysis)?;
         Ok(SpdFactor { analysis, numeric })
     }
 
     /// Factorisations of `analysis` in storage made for it by [`Workspace::new`].
-    pub(crate) fn with_workspace(analysis: std::rc::Rc<Analysis>, workspace: Workspace) -> SpdFactor {
+    pub(crate) fn with_workspace(analysis: std::sync::Arc<Analysis>, workspace: Workspace) -> SpdFactor {
         SpdFactor { analysis, numeric: workspace.0 }
     }
 
@@ -481,7 +453,7 @@ mod tests {
             let Analysis::TwoWay(t) = &analysis else { panic!("{nx}x{ny}: a grid is split in two") };
             // the separator is a thin cut: one or two grid lines across
             assert!(t.separator_len() <= 3 * nx.max(ny), "separator {}", t.separator_len());
-            let mut f = SpdFactor::new(std::rc::Rc::new(analysis)).unwrap();
+            let mut f = SpdFactor::new(std::sync::Arc::new(analysis)).unwrap();
             f.factor(SparseColMatRef::new(a.as_ref(), &vals)).unwrap();
             for seed in 0..3 {
                 let b: Vec<f64> = (0..n).map(|i| ((i * (seed + 3)) as f64 * 0.37).sin()).collect();
@@ -508,7 +480,7 @@ mod tests {
         let analysis = analyse(a.as_ref(), true).unwrap();
         assert!(matches!(analysis, Analysis::Single { .. }));
         let vals = spd_values(a.as_ref());
-        let mut f = SpdFactor::new(std::rc::Rc::new(analysis)).unwrap();
+        let mut f = SpdFactor::new(std::sync::Arc::new(analysis)).unwrap();
         f.factor(SparseColMatRef::new(a.as_ref(), &vals)).unwrap();
         let b: Vec<f64> = (0..n).map(|i| (i as f64 * 0.11).cos()).collect();
         let mut x = b.clone();

@@ -144,7 +144,7 @@ impl Symbolic {
     pub fn critical_flops(&self) -> f64 {
         let s = self.sep.len() as f64;
         let dense = s * s * s / 3.0;
-        let part = self.halves.iter().map(|h| super::factor_flops(&h.symbolic)).fold(0.0, f64::max);
+        let part = self.halves.iter().map(|h| super::cost::factor_flops(&h.symbolic)).fold(0.0, f64::max);
         part + dense + dense / 1.5
     }
 }
@@ -214,9 +214,9 @@ impl TwoWay {
     /// Maps every page of the storage now (see [`super::Workspace`]).
     pub(super) fn touch(&mut self) {
         for h in &mut self.halves {
-            super::touch_pages(&mut h.values);
-            super::touch_pages(&mut h.l);
-            super::touch_pages(&mut h.work);
+            super::cost::touch_pages(&mut h.values);
+            super::cost::touch_pages(&mut h.l);
+            super::cost::touch_pages(&mut h.work);
             touch_mat(&mut h.t);
         }
         touch_mat(&mut self.sigma);

@@ -79,9 +79,14 @@ impl DomainOperators {
         DomainOperators { stiffness: domain.stiffness(), mass: domain.mass(), own_fill: domain.own_fill_stiffness() }
     }
 
-    /// The harmonic fills' Laplacian ([`Smoothable::fill_stiffness`]).
+    /// The harmonic fills' Laplacian ([`Smoothable::own_fill_stiffness`], else the stiffness).
     pub fn fill(&self) -> &Sparse {
         self.own_fill.as_ref().unwrap_or(&self.stiffness)
+    }
+
+    /// Drops the fills' own Laplacian (the one-off run, once the representative is built).
+    fn drop_fill(&mut self) {
+        self.own_fill = None;
     }
 }
 
@@ -95,10 +100,10 @@ pub fn smooth<D: Smoothable + Sync>(domain: &D, h: &[f64], settings: &SmoothSett
     smooth_with(domain, h, settings, &mut Analyses::default())
 }
 
-/// [`smooth`] with the factorisations' analyses taken from and kept in `analyses`: the harmonic
-/// fills' Laplacian (made, for instance, by the geodesic distance the field came from), and
-/// the solver's normal matrix, kept for the next field with the same fixed set. The fills'
-/// analysis is dropped before the solve (a million-vertex Laplacian's is hundreds of MiB).
+/// [`smooth`] with the harmonic fills' analysis taken from `analyses` (made, for instance, by
+/// the geodesic distance the field came from). For memory, `analyses` is cleared before the
+/// solve (a million-vertex Laplacian's analysis is hundreds of MiB) and holds only the
+/// solver's normal-matrix analysis on return; a [`crate::smoother::Smoother`] keeps them all.
 ///
 /// # Errors
 /// As [`smooth`].
@@ -109,14 +114,14 @@ pub fn smooth_with<D: Smoothable + Sync>(
     analyses: &mut Analyses,
 ) -> Result<Smoothed> {
     settings.validate()?;
-    smooth_on(domain, &DomainOperators::new(domain), h, settings, analyses, false)
+    smooth_on(domain, &mut DomainOperators::new(domain), h, settings, analyses, false)
 }
 
 /// The pipeline on a domain whose operators are built; `keep_analyses`: the fills' analysis
 /// stays in `analyses` through the solve (else it is dropped first, for memory).
 pub(crate) fn smooth_on<D: Smoothable + Sync>(
     domain: &D,
-    ops: &DomainOperators,
+    ops: &mut DomainOperators,
     h: &[f64],
     settings: &SmoothSettings,
     analyses: &mut Analyses,
@@ -151,6 +156,8 @@ pub(crate) fn smooth_on<D: Smoothable + Sync>(
     // A representative whose order makes the constraints infeasible (the harmonic one can
     // order a high kept minimum below a low kept maximum) gives way to the next construction;
     // for a kept set chosen by persistence the flooded one always fits the data's order.
+    // the two-thread permission of the analyses made on the other core
+    let split = analyses.split_allowed();
     let mut representative_stage = || -> Result<_> {
         let mut excluded: Vec<(&'static str, String)> = Vec::new();
         loop {
@@ -255,7 +262,7 @@ pub(crate) fn smooth_on<D: Smoothable + Sync>(
             let seconds = t.elapsed().as_secs_f64();
             let prepared = match (&ops, settings.qp.method) {
                 // a failed analysis is redone (and reported) by the solver itself
-                (Ok(o), Method::Structured) if o.factor.is_none() => crate::solve::prepare(&o.p, &fixed).ok(),
+                (Ok(o), Method::Structured) if o.factor.is_none() => crate::solve::prepare(&o.p, &fixed, split).ok(),
                 _ => None,
             };
             (ops, seconds, prepared)
@@ -280,6 +287,7 @@ pub(crate) fn smooth_on<D: Smoothable + Sync>(
     // factor storage was made beside the representative (the two together set the peak)
     if !keep_analyses {
         analyses.clear();
+        ops.drop_fill();
     }
 
     let t = Instant::now();

@@ -49,12 +49,9 @@ pub trait Smoothable: Domain {
     fn stiffness(&self) -> Sparse;
     /// Lumped mass (diagonal, > 0).
     fn mass(&self) -> Vec<f64>;
-    /// The Laplacian of harmonic fills: non-negative weights on the domain's own edges, so
-    /// that the maximum principle holds (the energy's stiffness where that already holds).
-    fn fill_stiffness(&self) -> Sparse {
-        self.own_fill_stiffness().unwrap_or_else(|| self.stiffness())
-    }
-    /// The fills' Laplacian where it differs from [`Smoothable::stiffness`], else `None`.
+    /// The Laplacian of harmonic fills where it differs from [`Smoothable::stiffness`], else
+    /// `None`: non-negative weights on the domain's own edges, so that the maximum principle
+    /// holds (the stiffness is that Laplacian where it already holds).
     fn own_fill_stiffness(&self) -> Option<Sparse> {
         None
     }
@@ -66,7 +63,8 @@ pub trait Smoothable: Domain {
     /// A function with exactly the kept extrema (checked by the pipeline), built by the
     /// first construction in the order `choice` prefers that is not `excluded` (kind and
     /// why: the pipeline excludes one whose order makes the constraints infeasible); `fill`
-    /// is [`Smoothable::fill_stiffness`], the factorisations' analyses are in `analyses`.
+    /// is the harmonic fills' Laplacian ([`Smoothable::own_fill_stiffness`] or the stiffness), the
+    /// factorisations' analyses are in `analyses`.
     fn representative(
         &self,
         h: &[f64],

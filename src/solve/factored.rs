@@ -99,7 +99,7 @@ impl<'r> Normal<'r> {
         for (j, &d) in r.d.iter().enumerate() {
             base[pattern.pos_diag[j]] += fx128::from(d);
         }
-        let analysis = std::rc::Rc::new(linalg::analyse(pattern.symbolic.as_ref(), split)?);
+        let analysis = std::sync::Arc::new(linalg::analyse(pattern.symbolic.as_ref(), split)?);
         let spd = linalg::SpdFactor::new(analysis)?;
         Ok(Normal {
             f,

@@ -30,7 +30,7 @@ const CORRECTOR_STEP: f64 = 0.3;
 struct Assembled<'r> {
     r: &'r ReducedQp,
     normal: Normal,
-    analysis: std::rc::Rc<ordering::Analysis>,
+    analysis: std::sync::Arc<ordering::Analysis>,
     spd: ordering::SpdFactor,
     vals: Vec<f64>,
     /// `P` alone factorised (on the normal matrix's pattern), for [`Objective::energy_dual`].
@@ -145,7 +145,7 @@ pub(super) fn solve(
         None => {
             let normal = Normal::new(r, &rows.cols, &rows.len);
             let analysis = analyses.of(normal.symbolic.as_ref())?;
-            let spare = spare.filter(|(a, _)| std::rc::Rc::ptr_eq(a, &analysis));
+            let spare = spare.filter(|(a, _)| std::sync::Arc::ptr_eq(a, &analysis));
             let spd = match spare {
                 Some((_, workspace)) => ordering::SpdFactor::with_workspace(analysis.clone(), workspace),
                 None => ordering::SpdFactor::new(analysis.clone())?,

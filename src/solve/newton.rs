@@ -84,7 +84,12 @@ impl Prepared {
     ///
     /// # Errors
     /// A message if the analysis fails.
-    pub fn new(p: SymbolicSparseColMatRef<'_, usize>, slot: &[usize], n: usize) -> Result<Prepared, String> {
+    pub fn new(
+        p: SymbolicSparseColMatRef<'_, usize>,
+        slot: &[usize],
+        n: usize,
+        split_allowed: bool,
+    ) -> Result<Prepared, String> {
         let (cp, ri) = (p.col_ptr(), p.row_idx());
         let pairs = (0..p.ncols()).flat_map(|j| {
             ri[cp[j]..p.col_range(j).end].iter().filter_map(move |&i| {
@@ -94,7 +99,7 @@ impl Prepared {
         });
         let (col_ptr, row_idx) = upper_pattern(n, pairs);
         let pattern = SymbolicSparseColMat::new_checked(n, n, col_ptr, None, row_idx);
-        let analysis = ordering::analyse(pattern.as_ref(), true)?;
+        let analysis = ordering::analyse(pattern.as_ref(), split_allowed)?;
         // without it (faer's scratch could not be allocated) the solver makes the storage
         let workspace = ordering::Workspace::new(&analysis).ok();
         Ok(Prepared { pattern, analysis, workspace })
@@ -110,8 +115,8 @@ impl Prepared {
     pub(super) fn keep_in(
         self,
         analyses: &mut ordering::Analyses,
-    ) -> Option<(std::rc::Rc<ordering::Analysis>, ordering::Workspace)> {
-        let analysis = std::rc::Rc::new(self.analysis);
+    ) -> Option<(std::sync::Arc<ordering::Analysis>, ordering::Workspace)> {
+        let analysis = std::sync::Arc::new(self.analysis);
         analyses.keep(self.pattern, analysis.clone());
         self.workspace.map(|w| (analysis, w))
     }

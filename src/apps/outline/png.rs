@@ -1,7 +1,7 @@
 //! Outlines from PNG masks: the boundary of the largest 4-connected inside region, traced along
 //! pixel edges and simplified (see [`super::read_outline`] for the conventions).
 
-use super::{Outline, TRACE_TOLERANCE};
+use super::shape::{signed_area2, Outline, TRACE_TOLERANCE};
 
 type Msg = String;
 type Loops = Vec<Vec<[f64; 2]>>;
@@ -145,7 +145,7 @@ fn trace(region: &[bool], w: usize, h: usize) -> Loops {
         }
     }
     // the outer boundary is the one counter-clockwise loop
-    if let Some(k) = loops.iter().position(|l| super::signed_area2(l) > 0.0) {
+    if let Some(k) = loops.iter().position(|l| signed_area2(l) > 0.0) {
         let outer = loops.remove(k);
         loops.insert(0, outer);
     }
@@ -242,7 +242,7 @@ mod tests {
     }
 
     fn signed_area(l: &[[f64; 2]]) -> f64 {
-        super::super::signed_area2(l) / 2.0
+        super::super::shape::signed_area2(l) / 2.0
     }
 
     #[test]

@@ -1,6 +1,6 @@
 //! Outlines from SVG: shapes and paths as closed polygons (see [`super::read_outline`]).
 
-use super::CURVE_SEGMENTS;
+use super::shape::CURVE_SEGMENTS;
 use quick_xml::events::{BytesStart, Event};
 
 type Msg = String;

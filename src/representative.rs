@@ -176,7 +176,7 @@ fn strictify(u: &mut [f64], anchors: &[(usize, Role)]) {
 /// extremum or a free one flat), those vertices and their prescribed neighbours are released
 /// to the harmonic fill and the solve repeated. Around a kept extremum that is not strict the
 /// release widens ring by ring; with `move_kept` the extremum's value is moved outward instead
-/// ([`outward_moves`]; u's values at kept extrema may be rescaled, SPEC). Returns u and what
+/// (`outward_moves`; u's values at kept extrema may be rescaled, SPEC). Returns u and what
 /// was changed.
 ///
 /// # Errors

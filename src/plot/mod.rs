@@ -1,4 +1,4 @@
-//! PNG plots: smoothed series, persistence diagrams, grid heat maps ([`grid`]), fields on
+//! PNG plots: smoothed series, persistence diagrams, grid heat maps (`grid`), fields on
 //! meshes and plane triangulations.
 //!
 //! Drawing uses plotters' bitmap backend into an in-memory RGB buffer, written as PNG by the

@@ -27,7 +27,7 @@ pub(super) fn estimate(r: &ReducedQp) -> Option<f64> {
     }))
 }
 
-/// [`estimate`] on the free block of a full `P` (upper and lower triangle stored) with data
+/// `estimate` on the free block of a full `P` (upper and lower triangle stored) with data
 /// diagonal `d`, before the problem is reduced: `None` unless `d > 0` at every free entry.
 pub fn condition_estimate(p: &crate::operators::Sparse, d: &[f64], fixed: &[Option<f64>]) -> Option<f64> {
     let free: Vec<usize> = (0..d.len()).filter(|&i| fixed[i].is_none()).collect();

@@ -70,7 +70,7 @@ impl Normal {
 /// The analysis of a normal matrix made before its constraints are known: from the pattern of
 /// `P` on the free variables alone. The constrained pairs of a monotone QP are edges of the
 /// domain, inside the pattern of any energy built on its Laplacian, so the normal matrix's
-/// pattern is that one and [`super::ipm::solve`], given it, finds this analysis ready.
+/// pattern is that one and the structured solver, given it, finds this analysis ready.
 pub struct Prepared {
     pattern: SymbolicSparseColMat<usize>,
     analysis: ordering::Analysis,

@@ -5,7 +5,7 @@
 #[cfg_attr(feature = "serde", derive(serde::Serialize))]
 #[cfg_attr(feature = "serde", serde(rename_all = "lowercase"))]
 pub enum Method {
-    /// The structured solver of [`super::ipm`] (normal equations, faer Cholesky with the
+    /// The structured solver of `ipm` (normal equations, faer Cholesky with the
     /// symbolic analysis done once); Clarabel takes over if it does not converge.
     Structured,
     /// Clarabel on the full KKT system, in the formulation the structured solver would use.

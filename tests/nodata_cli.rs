@@ -524,20 +524,7 @@ fn order_four_weights_stay_with_the_structured_solver() {
     let mesh = out(&dir, "horse.obj");
     succeeds(&["mesh", &dataset("horse_mask.png"), "--max-area", "7.5", "-o", &mesh]);
     let p = read_mesh(Path::new(&mesh)).unwrap().positions;
-    let n = p.len();
-    let d2 = |a: [f64; 3], b: [f64; 3]| (0..3).map(|k| (a[k] - b[k]).powi(2)).sum::<f64>();
-    let c = p.iter().fold([0.0; 3], |a, q| [a[0] + q[0], a[1] + q[1], a[2] + q[2]]).map(|x| x / n as f64);
-    let mut chosen = vec![(0..n).max_by(|&a, &b| d2(p[a], c).total_cmp(&d2(p[b], c))).unwrap()];
-    while chosen.len() < 4 {
-        let next = (0..n)
-            .max_by(|&a, &b| {
-                let da = chosen.iter().map(|&h| d2(p[a], p[h])).fold(f64::INFINITY, f64::min);
-                let db = chosen.iter().map(|&h| d2(p[b], p[h])).fold(f64::INFINITY, f64::min);
-                da.total_cmp(&db)
-            })
-            .unwrap();
-        chosen.push(next);
-    }
+    let chosen = toposmooth::apps::handles::farthest_points(&p, 4);
     let list: Vec<String> =
         chosen.iter().enumerate().map(|(i, v)| format!("{{\"name\": \"h{i}\", \"vertices\": [{v}]}}")).collect();
     let handles = write(&dir, "h.json", &format!("{{\"handles\": [{}]}}", list.join(", ")));

@@ -326,6 +326,28 @@ pub fn resolve(mesh: &TriMesh, handles: &[Handle]) -> Result<Vec<Vec<usize>>> {
     Ok(sets)
 }
 
+/// `count` (at least 2) vertices spread over the points by farthest-point sampling, from the
+/// point farthest from the centroid (the bench's and the tests' point handles).
+pub fn farthest_points(p: &[[f64; 3]], count: usize) -> Vec<usize> {
+    let n = p.len();
+    if n == 0 {
+        return Vec::new();
+    }
+    let c = p.iter().fold([0.0; 3], |a, q| [a[0] + q[0], a[1] + q[1], a[2] + q[2]]).map(|x| x / n as f64);
+    let d2 = |a: [f64; 3], b: [f64; 3]| (0..3).map(|k| (a[k] - b[k]).powi(2)).sum::<f64>();
+    let first = (0..n).max_by(|&a, &b| d2(p[a], c).total_cmp(&d2(p[b], c))).unwrap_or(0);
+    let mut chosen = vec![first];
+    let mut dist: Vec<f64> = (0..n).map(|v| d2(p[v], p[first])).collect();
+    while chosen.len() < count.max(2).min(n) {
+        let next = (0..n).max_by(|&a, &b| dist[a].total_cmp(&dist[b])).unwrap_or(0);
+        chosen.push(next);
+        for v in 0..n {
+            dist[v] = dist[v].min(d2(p[v], p[next]));
+        }
+    }
+    chosen
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -378,20 +378,7 @@ pub fn bench_weights(cases: &[String], orders: &[u8], handles: usize) -> Result<
             mesh = mesh.subdivide()?;
         }
         let n = mesh.n_vertices();
-        // farthest-point sampling, from the vertex farthest from the centroid
-        let p = mesh.positions();
-        let c = p.iter().fold([0.0; 3], |a, q| [a[0] + q[0], a[1] + q[1], a[2] + q[2]]).map(|x| x / n as f64);
-        let d2 = |a: [f64; 3], b: [f64; 3]| (0..3).map(|k| (a[k] - b[k]).powi(2)).sum::<f64>();
-        let first = (0..n).max_by(|&a, &b| d2(p[a], c).total_cmp(&d2(p[b], c))).unwrap_or(0);
-        let mut chosen = vec![first];
-        let mut dist: Vec<f64> = (0..n).map(|v| d2(p[v], p[first])).collect();
-        while chosen.len() < handles.max(2) {
-            let next = (0..n).max_by(|&a, &b| dist[a].total_cmp(&dist[b])).unwrap_or(0);
-            chosen.push(next);
-            for v in 0..n {
-                dist[v] = dist[v].min(d2(p[v], p[next]));
-            }
-        }
+        let chosen = crate::apps::handles::farthest_points(mesh.positions(), handles);
         let sets: Vec<Vec<usize>> = chosen.iter().map(|&v| vec![v]).collect();
         for &k in orders {
             let one = weights(&mesh, &sets, &WeightSettings { order: k, threads: 1, ..Default::default() })?;

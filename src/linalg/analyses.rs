@@ -30,6 +30,11 @@ pub struct Analyses {
     kept: Vec<(SymbolicSparseColMat<usize>, std::sync::Arc<Analysis>)>,
 }
 
+/// Whether two patterns are the same (sizes, column pointers and row indices).
+fn same_pattern(a: SymbolicSparseColMatRef<'_, usize>, b: SymbolicSparseColMatRef<'_, usize>) -> bool {
+    a.nrows() == b.nrows() && a.col_ptr() == b.col_ptr() && a.row_idx() == b.row_idx()
+}
+
 impl Default for Analyses {
     fn default() -> Self {
         Analyses::new(true)
@@ -53,10 +58,7 @@ impl Analyses {
         &mut self,
         pattern: SymbolicSparseColMatRef<'_, usize>,
     ) -> Result<std::sync::Arc<Analysis>, String> {
-        let same = |a: &SymbolicSparseColMat<usize>| {
-            a.nrows() == pattern.nrows() && a.col_ptr() == pattern.col_ptr() && a.row_idx() == pattern.row_idx()
-        };
-        if let Some(at) = self.kept.iter().position(|(q, _)| same(q)) {
+        if let Some(at) = self.kept.iter().position(|(q, _)| same_pattern(q.as_ref(), pattern)) {
             let entry = self.kept.remove(at);
             let analysis = entry.1.clone();
             self.kept.push(entry);
@@ -70,9 +72,7 @@ impl Analyses {
     /// Keeps `analysis` (made elsewhere, e.g. on another thread) as the one of `pattern`.
     pub(crate) fn keep(&mut self, pattern: SymbolicSparseColMat<usize>, analysis: std::sync::Arc<Analysis>) {
         // one entry per pattern: a new analysis of a kept pattern replaces the old one
-        self.kept.retain(|(q, _)| {
-            !(q.nrows() == pattern.nrows() && q.col_ptr() == pattern.col_ptr() && q.row_idx() == pattern.row_idx())
-        });
+        self.kept.retain(|(q, _)| !same_pattern(q.as_ref(), pattern.as_ref()));
         if self.kept.len() == Self::KEPT {
             self.kept.remove(0);
         }

@@ -54,7 +54,6 @@ pub struct Smoothed {
 
 /// The energy's matrices, built beside the representative.
 struct Operators {
-    m: Vec<f64>,
     weights: Vec<f64>,
     data_diag: Vec<f64>,
     factor: Option<Factor>,
@@ -82,11 +81,6 @@ impl DomainOperators {
     /// The harmonic fills' Laplacian ([`Smoothable::own_fill_stiffness`], else the stiffness).
     pub fn fill(&self) -> &Sparse {
         self.own_fill.as_ref().unwrap_or(&self.stiffness)
-    }
-
-    /// Drops the fills' own Laplacian (the one-off run, once the representative is built).
-    fn drop_fill(&mut self) {
-        self.own_fill = None;
     }
 }
 
@@ -225,14 +219,14 @@ pub(crate) fn smooth_on<D: Smoothable + Sync>(
     // The energy and the solver's analysis of its normal matrix need only the kept set: they
     // are built on the other core while the complex and the representative are.
     let operators = || -> Result<Operators> {
-        let m = ops.mass.clone();
+        let m = &ops.mass;
         let weights: Vec<f64> = settings
             .energy
             .terms
             .iter()
             .map(|&(order, _)| settings.smooth_weight.unwrap_or(ell.powi(2 * order as i32)))
             .collect();
-        let q_energy = polyharmonic(k, &m, &settings.energy, &weights);
+        let q_energy = polyharmonic(k, m, &settings.energy, &weights);
         let gd = settings.data_weight;
         let data_diag: Vec<f64> = m.iter().map(|mi| gd * mi).collect();
         // P = energy + data diagonal, in the energy's storage (one matrix of the size of a
@@ -249,11 +243,11 @@ pub(crate) fn smooth_on<D: Smoothable + Sync>(
         // without a data term there is no estimate: the factor is made for a retry should the
         // assembled normal matrix lose its definiteness
         let factor = if factored || condition.is_none() {
-            domain.stiffness_factor(k).and_then(|k1| polyharmonic_factor(k, &k1, &m, &settings.energy, &weights))
+            domain.stiffness_factor(k).and_then(|k1| polyharmonic_factor(k, &k1, m, &settings.energy, &weights))
         } else {
             None
         };
-        Ok(Operators { m, weights, data_diag, factor, p, q, condition })
+        Ok(Operators { weights, data_diag, factor, p, q, condition })
     };
     let (representative_result, (operators_result, operators_seconds, prepared)) = std::thread::scope(|scope| {
         let background = scope.spawn(|| {
@@ -280,14 +274,16 @@ pub(crate) fn smooth_on<D: Smoothable + Sync>(
         eps_max,
         eps,
     ) = representative_result?;
-    let Operators { m, weights, data_diag, factor, p, q, condition } = operators_result?;
+    let Operators { weights, data_diag, factor, p, q, condition } = operators_result?;
+    let m = &ops.mass;
     seconds.operators = operators_seconds;
     let gd = settings.data_weight;
     // the fills' Laplacian analysis is not needed again: free it before the solver runs, whose
     // factor storage was made beside the representative (the two together set the peak)
     if !keep_analyses {
         analyses.clear();
-        ops.drop_fill();
+        // and the mesh's own fills' Laplacian with it
+        ops.own_fill = None;
     }
 
     let t = Instant::now();
@@ -346,7 +342,7 @@ pub(crate) fn smooth_on<D: Smoothable + Sync>(
         &f,
         &sol,
         factor.as_ref(),
-        (range, eps, gd, &m),
+        (range, eps, gd, m),
     );
     let constraint_activity = activity(&f, &edges, &is_fixed, eps * range);
     let mut warnings = kept.warnings.clone();

@@ -1,7 +1,8 @@
 //! `toposmooth`: parses the command line and calls the library's commands.
 
-use clap::{Args, Parser, Subcommand, ValueEnum};
+use clap::{Args, Parser, Subcommand};
 use std::path::PathBuf;
+use toposmooth::apps::skinning::Skinning;
 use toposmooth::apps::weights::WeightMethod;
 use toposmooth::commands::input::{Derive, DomainKind, GridOptions};
 use toposmooth::commands::{self, BenchArgs, ExtremaArgs, SmoothArgs, VerifyArgs};
@@ -92,8 +93,8 @@ enum Command {
         #[arg(short, long)]
         output: PathBuf,
         /// Skinning method.
-        #[arg(long, value_enum, default_value_t = SkinningCli::Lbs)]
-        skinning: SkinningCli,
+        #[arg(long, value_enum, default_value_t = Skinning::Lbs)]
+        skinning: Skinning,
         /// Rest and posed shapes side by side.
         #[arg(long, value_name = "PNG")]
         plot: Option<PathBuf>,
@@ -120,8 +121,8 @@ enum Command {
         #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u8).range(1..=4))]
         order: u8,
         /// Weights: monotone (convex blend, certified) or unconstrained etc. for comparison.
-        #[arg(long, value_enum, default_value_t = WeightMethodCli::Monotone)]
-        method: WeightMethodCli,
+        #[arg(long, value_enum, default_value_t = WeightMethod::Monotone)]
+        method: WeightMethod,
         /// Picture: the image enlarged with the colour points drawn, or the coloured mesh.
         #[arg(long, value_name = "PNG")]
         plot: Option<PathBuf>,
@@ -173,17 +174,17 @@ enum Command {
         #[arg(long, default_value = "1%")]
         persistence: String,
         /// Constraint set.
-        #[arg(long, value_enum, default_value_t = Edges::Minimal)]
-        edges: Edges,
+        #[arg(long, value_enum, default_value_t = EdgeSet::Minimal)]
+        edges: EdgeSet,
         /// RNG seed.
         #[arg(long, default_value_t = 1)]
         seed: u64,
         /// QP solver.
-        #[arg(long, value_enum, default_value_t = Solver::Structured)]
-        solver: Solver,
+        #[arg(long, value_enum, default_value_t = Method::Structured)]
+        solver: Method,
         /// Representative function on grids and meshes (default: automatic).
         #[arg(long, value_enum)]
-        representative: Option<RepresentativeCli>,
+        representative: Option<RepresentativeChoice>,
         /// Fields per case through one `Smoother` (the case's field, then the same with a smooth
         /// wave of 1 % of its range added): one row each.
         #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=1000))]
@@ -198,8 +199,8 @@ enum Command {
 struct GridCli {
     /// Read the input as a series, a grid or a mesh (default: by extension — .obj, .off, .ply,
     /// .vtu, .vtp are meshes; a CSV whose first line is three or more numbers is a grid matrix).
-    #[arg(long, value_enum, default_value_t = DomainCli::Auto)]
-    domain: DomainCli,
+    #[arg(long, value_enum, default_value_t = DomainKind::Auto)]
+    domain: DomainKind,
     /// Point array of a VTK file or PLY vertex property (default: the only scalar array, or
     /// with --derive the only vector array); on a mesh also `x`, `y` or `z`.
     #[arg(long, value_name = "NAME")]
@@ -210,7 +211,7 @@ struct GridCli {
     /// Grid: smooth a scalar derived from a velocity field (a 2- or 3-component array, or
     /// --u and --v).
     #[arg(long, value_enum)]
-    derive: Option<DeriveCli>,
+    derive: Option<Derive>,
     /// Grid: x velocity component file (with --v and --derive, instead of an input file).
     #[arg(long = "u", value_name = "FILE", requires_all = ["v", "derive"])]
     u: Option<PathBuf>,
@@ -226,37 +227,7 @@ struct GridCli {
     values: Option<PathBuf>,
 }
 
-#[derive(Clone, Copy, ValueEnum)]
-enum DomainCli {
-    Auto,
-    Series,
-    Grid,
-    Mesh,
-}
-
-#[derive(Clone, Copy, ValueEnum)]
-enum DeriveCli {
-    Vorticity,
-    Magnitude,
-}
-
-#[derive(Clone, Copy, ValueEnum)]
-enum RepresentativeCli {
-    Separatrix,
-    Harmonic,
-    Flooded,
-}
-
 impl GridCli {
-    fn kind(&self) -> DomainKind {
-        match self.domain {
-            DomainCli::Auto => DomainKind::Auto,
-            DomainCli::Series => DomainKind::Series,
-            DomainCli::Grid => DomainKind::Grid,
-            DomainCli::Mesh => DomainKind::Mesh,
-        }
-    }
-
     fn options(&self) -> Result<GridOptions> {
         let spacing = match &self.spacing {
             None => None,
@@ -281,10 +252,7 @@ impl GridCli {
         Ok(GridOptions {
             array: self.array.clone(),
             spacing,
-            derive: self.derive.map(|d| match d {
-                DeriveCli::Vorticity => Derive::Vorticity,
-                DeriveCli::Magnitude => Derive::Magnitude,
-            }),
+            derive: self.derive,
             uv: self.u.clone().zip(self.v.clone()),
             fill_missing: self.fill_missing,
             values: self.values.clone(),
@@ -322,29 +290,6 @@ fn parse_view(view: Option<&str>) -> Result<MeshView> {
     }
 }
 
-#[derive(Clone, Copy, ValueEnum)]
-enum SkinningCli {
-    Lbs,
-    Dqs,
-}
-
-#[derive(Clone, Copy, ValueEnum)]
-enum WeightMethodCli {
-    Monotone,
-    Bounded,
-    Unconstrained,
-    Harmonic,
-}
-
-fn weight_method(m: WeightMethodCli) -> WeightMethod {
-    match m {
-        WeightMethodCli::Monotone => WeightMethod::Monotone,
-        WeightMethodCli::Bounded => WeightMethod::Bounded,
-        WeightMethodCli::Unconstrained => WeightMethod::Unconstrained,
-        WeightMethodCli::Harmonic => WeightMethod::Harmonic,
-    }
-}
-
 #[derive(Args)]
 struct WeightsCli {
     /// Mesh: .obj, .off, .ply, .vtu, .vtp (a planar mesh for 2D shapes).
@@ -360,14 +305,14 @@ struct WeightsCli {
     order: u8,
     /// monotone: no spurious extremum (certified); bounded: BBW (0 ≤ w ≤ 1, partition of
     /// unity); unconstrained: plain polyharmonic; harmonic: Laplace.
-    #[arg(long, value_enum, default_value_t = WeightMethodCli::Monotone)]
-    method: WeightMethodCli,
+    #[arg(long, value_enum, default_value_t = WeightMethod::Monotone)]
+    method: WeightMethod,
     /// Also run the other three methods and report their spurious extrema.
     #[arg(long)]
     compare: bool,
     /// Constraint set of the monotone method.
-    #[arg(long, value_enum, default_value_t = Edges::Minimal)]
-    edges: Edges,
+    #[arg(long, value_enum, default_value_t = EdgeSet::Minimal)]
+    edges: EdgeSet,
     /// Worker threads (the functions are independent).
     #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u16).range(1..=256))]
     threads: u16,
@@ -386,26 +331,6 @@ struct WeightsCli {
     /// Cages: largest triangle area of the cage's triangulation [default: the shape's mean].
     #[arg(long, value_name = "A")]
     cage_max_area: Option<f64>,
-}
-
-#[derive(Clone, Copy, ValueEnum)]
-enum Solver {
-    Structured,
-    Clarabel,
-    ClarabelAuxiliary,
-}
-
-#[derive(Clone, Copy, ValueEnum)]
-enum FormulationCli {
-    Auto,
-    Assembled,
-    Factored,
-}
-
-#[derive(Clone, Copy, ValueEnum)]
-enum Edges {
-    Minimal,
-    All,
 }
 
 #[derive(Args)]
@@ -430,7 +355,7 @@ struct SmoothCli {
     /// when the data cannot follow its order, 1 when it fails its own check); by default the
     /// separatrix one, then harmonic, then flooded, each fallback reported.
     #[arg(long, value_enum)]
-    representative: Option<RepresentativeCli>,
+    representative: Option<RepresentativeChoice>,
     /// Mesh plot: camera azimuth and elevation in degrees (y up).
     #[arg(long, value_name = "AZ,EL", allow_hyphen_values = true)]
     view: Option<String>,
@@ -481,41 +406,26 @@ struct SmoothCli {
     #[arg(long, value_name = "FRACTION")]
     smooth_length: Option<f64>,
     /// Constraint set.
-    #[arg(long, value_enum, default_value_t = Edges::Minimal)]
-    edges: Edges,
+    #[arg(long, value_enum, default_value_t = EdgeSet::Minimal)]
+    edges: EdgeSet,
     /// Largest number of solver iterations (at least 1).
     #[arg(long, default_value_t = 200, value_parser = clap::value_parser!(u32).range(1..))]
     max_iter: u32,
     /// QP solver: the structured interior-point method (Clarabel takes over if it fails), or
     /// Clarabel alone.
-    #[arg(long, value_enum, default_value_t = Solver::Structured)]
-    solver: Solver,
+    #[arg(long, value_enum, default_value_t = Method::Structured)]
+    solver: Method,
     /// How the energy enters the solver: assembled (normal equations in double precision),
     /// factored (FᵀF, the paper's auxiliary variables: double-double normal equations in the
     /// structured solver), or auto (factored when the condition estimate exceeds 1e9).
-    #[arg(long, value_enum, default_value_t = FormulationCli::Auto)]
-    formulation: FormulationCli,
+    #[arg(long, value_enum, default_value_t = Formulation::Auto)]
+    formulation: Formulation,
     /// Figure: series input (grey), output and kept extrema; grids as heat maps side by side.
     #[arg(long, value_name = "PNG")]
     plot: Option<PathBuf>,
     /// JSON report: settings, kept extrema, seconds per stage, energy, deviations, certificate.
     #[arg(long, value_name = "JSON")]
     report: Option<PathBuf>,
-}
-
-fn edge_set(e: Edges) -> EdgeSet {
-    match e {
-        Edges::Minimal => EdgeSet::Minimal,
-        Edges::All => EdgeSet::All,
-    }
-}
-
-fn method(s: Solver) -> Method {
-    match s {
-        Solver::Structured => Method::Structured,
-        Solver::Clarabel => Method::Clarabel,
-        Solver::ClarabelAuxiliary => Method::ClarabelAuxiliary,
-    }
 }
 
 fn smooth_args(c: SmoothCli) -> Result<SmoothArgs> {
@@ -542,22 +452,13 @@ fn smooth_args(c: SmoothCli) -> Result<SmoothArgs> {
         data_weight: c.data_weight,
         smooth_weight: c.smooth_weight,
         smooth_length: c.smooth_length,
-        edges: edge_set(c.edges),
-        qp: QpSettings {
-            max_iter: c.max_iter,
-            method: method(c.solver),
-            formulation: match c.formulation {
-                FormulationCli::Auto => Formulation::Auto,
-                FormulationCli::Assembled => Formulation::Assembled,
-                FormulationCli::Factored => Formulation::Factored,
-            },
-            ..Default::default()
-        },
-        representative: representative_choice(c.representative),
+        edges: c.edges,
+        qp: QpSettings { max_iter: c.max_iter, method: c.solver, formulation: c.formulation, ..Default::default() },
+        representative: c.representative,
     };
     Ok(SmoothArgs {
         input: c.input,
-        kind: c.grid.kind(),
+        kind: c.grid.domain,
         csv: c.csv.options(),
         grid: c.grid.options()?,
         complex: c.complex,
@@ -574,7 +475,7 @@ fn run(cli: Cli) -> Result<String> {
     match cli.command {
         Command::Extrema { input, csv, grid, json, plot, persistence } => commands::extrema(&ExtremaArgs {
             input,
-            kind: grid.kind(),
+            kind: grid.domain,
             csv: csv.options(),
             grid: grid.options()?,
             json,
@@ -594,8 +495,8 @@ fn run(cli: Cli) -> Result<String> {
             output: c.output,
             settings: toposmooth::apps::weights::WeightSettings {
                 order: c.order,
-                method: weight_method(c.method),
-                edges: edge_set(c.edges),
+                method: c.method,
+                edges: c.edges,
                 threads: usize::from(c.threads),
                 ..Default::default()
             },
@@ -612,10 +513,7 @@ fn run(cli: Cli) -> Result<String> {
                 weights,
                 transforms,
                 output,
-                skinning: match skinning {
-                    SkinningCli::Lbs => toposmooth::apps::skinning::Skinning::Lbs,
-                    SkinningCli::Dqs => toposmooth::apps::skinning::Skinning::Dqs,
-                },
+                skinning,
                 plot,
                 view: parse_view(view.as_deref())?,
             })
@@ -626,11 +524,7 @@ fn run(cli: Cli) -> Result<String> {
                 colors,
                 output,
                 weights,
-                settings: toposmooth::apps::weights::WeightSettings {
-                    order,
-                    method: weight_method(method),
-                    ..Default::default()
-                },
+                settings: toposmooth::apps::weights::WeightSettings { order, method, ..Default::default() },
                 plot,
                 report,
                 view: parse_view(view.as_deref())?,
@@ -654,23 +548,15 @@ fn run(cli: Cli) -> Result<String> {
                 cases: sizes.iter().map(|s| commands::BenchCase::parse(s)).collect::<Result<_>>()?,
                 energy: Energy::parse(&order)?,
                 persistence,
-                edges: edge_set(edges),
+                edges,
                 seed,
                 single,
-                method: method(solver),
-                representative: representative_choice(representative),
+                method: solver,
+                representative,
                 fields: fields as usize,
             })
         }
     }
-}
-
-fn representative_choice(r: Option<RepresentativeCli>) -> Option<RepresentativeChoice> {
-    r.map(|r| match r {
-        RepresentativeCli::Separatrix => RepresentativeChoice::Separatrix,
-        RepresentativeCli::Harmonic => RepresentativeChoice::Harmonic,
-        RepresentativeCli::Flooded => RepresentativeChoice::Flooded,
-    })
 }
 
 fn main() {

@@ -1,6 +1,7 @@
 //! Many fields on one domain: [`Smoother`], generic over the domain, and [`AnySmoother`], the
 //! same over a domain chosen at run time (for bindings that cannot be generic).
 
+pub use crate::domain::AnyDomain;
 use crate::domain::{Domain, Grid2d, Series, TriMesh};
 use crate::error::Result;
 use crate::linalg::Analyses;
@@ -73,17 +74,6 @@ impl<D: Smoothable + Sync> Smoother<D> {
     pub fn settings(&self) -> &SmoothSettings {
         &self.settings
     }
-}
-
-/// A domain chosen at run time.
-#[derive(Clone, Debug)]
-pub enum AnyDomain {
-    /// A series.
-    Series(Series),
-    /// An implicit grid.
-    Grid(Grid2d),
-    /// A triangle mesh.
-    Mesh(TriMesh),
 }
 
 /// [`Smoother`] over an [`AnyDomain`].

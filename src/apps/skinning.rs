@@ -44,6 +44,7 @@ impl Transform {
 
 /// How the handles' transforms are blended at a vertex.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 pub enum Skinning {
     /// Linear blend skinning: the weighted sum of the transformed positions.
     Lbs,

@@ -30,6 +30,7 @@ use std::time::Instant;
 /// How each weight function is computed.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
 #[serde(rename_all = "lowercase")]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 pub enum WeightMethod {
     /// Polyharmonic energy with the monotonicity constraints: no spurious extremum (certified).
     #[default]

@@ -76,7 +76,7 @@ pub fn diffuse(args: &DiffuseArgs) -> Result<String> {
     let points = parse_colors(&text).map_err(|e| e.in_file(&args.colors))?;
     let image = is_image(&args.input);
     if image {
-        super::smooth_mesh::check_mesh_output(&weights_path)?;
+        crate::io::export::check_mesh_output(&weights_path)?;
     }
     if !image && args.weights.is_some() {
         return Err(Error::Usage(
@@ -98,7 +98,7 @@ pub fn diffuse(args: &DiffuseArgs) -> Result<String> {
         let pm = pixel_mesh(w, h, &inside).map_err(|e| e.in_file(&args.input))?;
         (None, Some(pm))
     } else {
-        super::smooth_mesh::check_mesh_output(&args.output)?;
+        crate::io::export::check_mesh_output(&args.output)?;
         (Some(read_trimesh(&args.input)?.0), None)
     };
     let mesh: &TriMesh = match (&read, &pm) {
@@ -183,7 +183,7 @@ pub fn diffuse(args: &DiffuseArgs) -> Result<String> {
                 owned.push((format!("role_{}", names[h]), super::weights::weight_roles(mesh, &f.prescribed)));
             }
             let arrays: Vec<(&str, &[f64])> = owned.iter().map(|(n, v)| (n.as_str(), v.as_slice())).collect();
-            staged.push(super::smooth_mesh::stage_mesh_output(&args.output, mesh, &arrays)?);
+            staged.push(crate::io::export::stage_mesh(&args.output, mesh, &arrays)?);
             if let Some(path) = &args.plot {
                 let name = |p: &Path| p.file_name().unwrap_or_default().to_string_lossy().to_string();
                 let title = format!("{} coloured by {}", name(&args.input), name(&args.colors));

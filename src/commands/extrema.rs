@@ -1,13 +1,13 @@
 //! `toposmooth extrema`: list the extrema with persistence and strictness; draw the diagram.
 
-use super::input::{read_field, DomainKind, FieldInput, GridOptions};
+use super::input::{read_field, DomainKind, Field, GridOptions};
 use super::{check_png_name, sig6, stage_plot};
-use crate::domain::{Domain, Series};
+use crate::domain::{AnyDomain, Domain};
 use crate::error::{Error, Result};
 use crate::io::series_csv::SeriesCsvOptions;
 use crate::plot::{plot_persistence_diagram, DiagramPoint};
 use crate::topology::{extrema_table, select, ExtremumKind, Role, Selection};
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 /// Options of `extrema`.
 #[derive(Clone, Debug)]
@@ -55,48 +55,45 @@ struct Row<'a> {
 /// Runs `extrema`; returns the text printed on standard output.
 pub fn extrema(args: &ExtremaArgs) -> Result<String> {
     check_png_name(args.plot.as_deref())?;
-    match read_field(args.input.as_deref(), args.kind, &args.csv, &args.grid)? {
-        FieldInput::Series(data) => {
-            let path = args.input.clone().unwrap_or_default();
-            let series = Series::with_coordinates(data.x.clone()).map_err(|e| e.in_file(&path))?;
-            let label = |i: usize| data.x_text[i].clone();
-            list(args, &path, &series, &data.values, &data.column, None, None, &label)
+    let path = args.input.clone().unwrap_or_default();
+    let field = read_field(args.input.as_deref(), args.kind, &args.csv, &args.grid)?.into_field(&path)?;
+    let text = match &field.domain {
+        AnyDomain::Series(d) => list(args, &field, d)?,
+        AnyDomain::Grid(d) => list(args, &field, d)?,
+        AnyDomain::Mesh(d) => list(args, &field, d)?,
+    };
+    if args.json {
+        return Ok(text);
+    }
+    Ok(field.notes.iter().map(|n| format!("note: {n}\n")).collect::<String>() + &text)
+}
+
+/// Where a vertex is, as the table prints it: the x text, `(row,col)` or `(x,y,z)`.
+fn label(field: &Field, i: usize) -> String {
+    match &field.domain {
+        AnyDomain::Series(_) => field.axis.as_ref().map(|a| a.x_text[i].clone()).unwrap_or_else(|| i.to_string()),
+        AnyDomain::Grid(g) => {
+            let (r, c) = g.row_col(i);
+            format!("({r},{c})")
         }
-        FieldInput::Grid(data) => {
-            let g = &data.grid;
-            let label = |i: usize| {
-                let (r, c) = g.row_col(i);
-                format!("({r},{c})")
-            };
-            list(args, &data.path, g, &data.values, &data.description, Some([g.nx(), g.ny()]), None, &label)
-        }
-        FieldInput::Mesh(data) => {
-            let m = &data.mesh;
-            let label = |i: usize| {
-                let p = m.positions()[i];
-                format!("({},{},{})", sig6(p[0]), sig6(p[1]), sig6(p[2]))
-            };
-            let what = format!("mesh of {}", m.describe());
-            let text = list(args, &data.path, m, &data.values, &data.description, None, Some(what), &label)?;
-            if args.json {
-                return Ok(text);
-            }
-            Ok(data.notes.iter().map(|n| format!("note: {n}\n")).collect::<String>() + &text)
+        AnyDomain::Mesh(m) => {
+            let p = m.positions()[i];
+            format!("({},{},{})", sig6(p[0]), sig6(p[1]), sig6(p[2]))
         }
     }
 }
 
-#[allow(clippy::too_many_arguments)]
-fn list<D: Domain>(
-    args: &ExtremaArgs,
-    path: &Path,
-    domain: &D,
-    h: &[f64],
-    column: &str,
-    grid: Option<[usize; 2]>,
-    mesh: Option<String>,
-    label: &dyn Fn(usize) -> String,
-) -> Result<String> {
+fn list<D: Domain>(args: &ExtremaArgs, field: &Field, domain: &D) -> Result<String> {
+    let (path, h, column) = (&field.path, &field.values, field.description.as_str());
+    let grid = match &field.domain {
+        AnyDomain::Grid(g) => Some([g.nx(), g.ny()]),
+        _ => None,
+    };
+    let mesh = match &field.domain {
+        AnyDomain::Mesh(m) => Some(format!("mesh of {}", m.describe())),
+        _ => None,
+    };
+    let label = |i: usize| label(field, i);
     let surface = grid.is_some() || mesh.is_some();
     let table = extrema_table(domain, h);
     let kept = select(domain, h, &args.selection).map_err(|e| e.in_file(path))?;

@@ -2,10 +2,10 @@
 
 use super::check_distinct;
 use super::input::read_trimesh;
-use super::smooth_mesh::stage_mesh_output;
 use crate::apps::geodesic::{heat_geodesic, GeodesicSeconds};
 use crate::domain::Domain;
 use crate::error::{Error, Result};
+use crate::io::export::stage_mesh;
 use crate::io::stage_json;
 use std::path::PathBuf;
 use std::time::Instant;
@@ -52,7 +52,7 @@ pub fn geodesic(args: &GeodesicArgs) -> Result<String> {
     let t = Instant::now();
     let (farthest, max) =
         distance.iter().enumerate().fold((0, f64::NEG_INFINITY), |a, (i, &d)| if d > a.1 { (i, d) } else { a });
-    let mut staged = vec![stage_mesh_output(&args.output, &mesh, &[("distance", &distance)])?];
+    let mut staged = vec![stage_mesh(&args.output, &mesh, &[("distance", &distance)])?];
     let write_seconds = t.elapsed().as_secs_f64();
     if let Some(path) = &args.report {
         let report = GeodesicReport {

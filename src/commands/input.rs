@@ -6,13 +6,15 @@ use crate::derive::{describe_missing, fill_missing, magnitude, vorticity};
 use crate::domain::{Domain, Grid2d, TriMesh};
 use crate::error::{Error, Result};
 use crate::io::grid::{read_grid_csv, read_npy, read_raster, GridField};
-use crate::io::mesh::{is_mesh_file, read_mesh, MeshData};
+use crate::io::mesh::is_mesh_file;
+pub use crate::io::mesh::read_trimesh;
 use crate::io::series_csv::{read_series, SeriesCsv, SeriesCsvOptions};
 use crate::io::vtk::read_image;
 use std::path::{Path, PathBuf};
 
 /// What kind of domain a file holds.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 pub enum DomainKind {
     /// Decide from the extension; a CSV is a grid when its first line is three or more
     /// numbers (a matrix without header), else a series.
@@ -29,6 +31,7 @@ pub enum DomainKind {
 /// A scalar to derive from a velocity field.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
 #[serde(rename_all = "lowercase")]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 pub enum Derive {
     /// ω = ∂v/∂x − ∂u/∂y.
     Vorticity,
@@ -95,18 +98,6 @@ pub enum FieldInput {
     Grid(GridInput),
     /// A field on a triangle mesh.
     Mesh(MeshInput),
-}
-
-/// Reads a mesh and validates it.
-///
-/// # Errors
-/// Input errors naming the file.
-pub fn read_trimesh(path: &Path) -> Result<(TriMesh, MeshData)> {
-    let mut data = read_mesh(path)?;
-    // the triangles move into the mesh; the positions stay for `MeshData::array("x")`
-    let triangles = std::mem::take(&mut data.triangles);
-    let mesh = TriMesh::new(data.positions.clone(), triangles).map_err(|e| e.in_file(path))?;
-    Ok((mesh, data))
 }
 
 /// Reads the field on a mesh: `--values FILE`, `--array NAME` (a vertex array or the
@@ -411,5 +402,74 @@ fn derive(grid: &Grid2d, d: Derive, u: &[f64], v: &[f64]) -> Vec<f64> {
     match d {
         Derive::Vorticity => vorticity(grid, u, v),
         Derive::Magnitude => magnitude(u, v),
+    }
+}
+
+/// The x axis of a series as read: coordinates, their text and where they came from.
+#[derive(Clone, Debug)]
+pub struct SeriesAxis {
+    /// x coordinates (days for dates).
+    pub x: Vec<f64>,
+    /// The x column's text per row, written back out.
+    pub x_text: Vec<String>,
+    /// Where x came from.
+    pub source: crate::io::series_csv::XSource,
+}
+
+/// A field read by a command, whatever its domain.
+#[derive(Clone, Debug)]
+pub struct Field {
+    /// The domain.
+    pub domain: crate::domain::AnyDomain,
+    /// The values to smooth (after deriving and filling).
+    pub values: Vec<f64>,
+    /// The file read (the first velocity file with `--u/--v`).
+    pub path: PathBuf,
+    /// What the values are: the column, the array read or the derivation.
+    pub description: String,
+    /// Vertices filled by `--fill-missing` (true), when any were.
+    pub filled: Option<Vec<bool>>,
+    /// What reading and validation changed (meshes: polygons split, triangles flipped).
+    pub notes: Vec<String>,
+    /// Series: the x axis as read.
+    pub axis: Option<SeriesAxis>,
+}
+
+impl FieldInput {
+    /// The field with its domain as an [`crate::domain::AnyDomain`]; `path` names a series' file.
+    ///
+    /// # Errors
+    /// A series whose x coordinates do not increase (input error naming the file).
+    pub fn into_field(self, path: &Path) -> Result<Field> {
+        use crate::domain::{AnyDomain, Series};
+        Ok(match self {
+            FieldInput::Series(data) => Field {
+                domain: AnyDomain::Series(Series::with_coordinates(data.x.clone()).map_err(|e| e.in_file(path))?),
+                values: data.values,
+                path: path.to_path_buf(),
+                description: data.column,
+                filled: None,
+                notes: Vec::new(),
+                axis: Some(SeriesAxis { x: data.x, x_text: data.x_text, source: data.x_source }),
+            },
+            FieldInput::Grid(g) => Field {
+                domain: AnyDomain::Grid(g.grid),
+                values: g.values,
+                path: g.path,
+                description: g.description,
+                filled: g.filled,
+                notes: Vec::new(),
+                axis: None,
+            },
+            FieldInput::Mesh(m) => Field {
+                domain: AnyDomain::Mesh(m.mesh),
+                values: m.values,
+                path: m.path,
+                description: m.description,
+                filled: m.filled,
+                notes: m.notes,
+                axis: None,
+            },
+        })
     }
 }

@@ -1,12 +1,12 @@
 //! `toposmooth mesh`: a triangle mesh of the inside of a 2D outline (JSON, SVG or PNG mask),
 //! by constrained Delaunay refinement with an area bound and an angle bound.
 
-use super::smooth_mesh::stage_mesh_output;
 use super::{check_distinct, check_png_name, sig6, stage_plot};
 use crate::apps::outline::{check_settings, read_outline, triangulate};
 use crate::domain::triangle_area;
 use crate::domain::Domain;
 use crate::error::{Error, Result};
+use crate::io::export::stage_mesh;
 use crate::io::mesh::{stage_obj, stage_off};
 use crate::plot::plot_triangulation;
 use std::path::PathBuf;
@@ -50,7 +50,7 @@ pub fn mesh_outline(args: &MeshOutlineArgs) -> Result<String> {
     let mut staged = vec![match ext.as_str() {
         "obj" => stage_obj(&args.output, positions, faces)?,
         "off" => stage_off(&args.output, positions, faces)?,
-        _ => stage_mesh_output(&args.output, &mesh, &[])?,
+        _ => stage_mesh(&args.output, &mesh, &[])?,
     }];
     let (tri, smallest) = mesh.smallest_angle();
     let areas: Vec<f64> =

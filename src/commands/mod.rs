@@ -2,7 +2,6 @@
 //! `main.rs` only parses arguments into these option structs and maps errors to exit codes.
 
 mod bench;
-mod critical_output;
 mod deform;
 mod diffuse;
 mod extrema;
@@ -11,8 +10,6 @@ pub mod input;
 mod mesh_outline;
 mod smooth;
 mod smooth_args;
-mod smooth_grid;
-mod smooth_mesh;
 mod verify;
 mod weights;
 

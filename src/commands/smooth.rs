@@ -1,26 +1,56 @@
-//! `toposmooth smooth`: the whole pipeline on a file, with output, plot and report.
+//! `toposmooth smooth`: the whole pipeline on a file of any domain, with the output, the
+//! complex, the figure and the report.
 
-use super::input::{read_field, FieldInput};
-use super::smooth_args::{fit_and_solver_lines, SmoothArgs};
+use super::input::{read_field, Field};
+use super::smooth_args::{fit_and_solver_lines, seconds_line, SmoothArgs};
 use super::{check_distinct, check_png_name, sig6, stage_plot, x_axis};
-use crate::domain::Series;
+use crate::domain::AnyDomain;
 use crate::error::{Error, Result};
-use crate::io::series_csv::{stage_series_output, SeriesCsv, SeriesOutput};
-use crate::io::stage_json;
-use crate::pipeline::{smooth as run_pipeline, Report};
-use crate::plot::{plot_series, Marker};
+use crate::io::export::{check_complex_output, check_output, stage_complex, stage_results, Results};
+use crate::io::{stage_json, Staged};
+use crate::pipeline::{smooth_any, Report, Smoothed};
+use crate::plot::{plot_grid_fields, plot_mesh_fields, plot_series, GridMarker, GridPanel, GridPlotOptions, Marker};
 use crate::topology::Role;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
+/// What the report says about the domain, beside the pipeline's [`Report`].
+#[derive(serde::Serialize)]
+#[serde(untagged)]
+enum DomainFacts<'a> {
+    Series {
+        column: &'a str,
+    },
+    Grid {
+        columns: usize,
+        rows: usize,
+        spacing: [f64; 2],
+        origin: [f64; 2],
+    },
+    Mesh {
+        triangles: usize,
+        components: usize,
+        boundary_loops: usize,
+        genus: Option<i64>,
+        negative_cotangent_edges: usize,
+        reading_notes: &'a [String],
+    },
+}
+
+/// The JSON report of a run: the files, the domain, the seconds around the pipeline's.
 #[derive(serde::Serialize)]
 struct RunReport<'a> {
     input_file: String,
-    column: &'a str,
+    field: &'a str,
+    #[serde(flatten)]
+    domain: DomainFacts<'a>,
+    filled_missing: usize,
     output_file: String,
     read_seconds: f64,
     write_seconds: f64,
     total_seconds: f64,
+    saddles: Option<usize>,
+    separatrices: Option<usize>,
     #[serde(flatten)]
     report: &'a Report,
 }
@@ -46,134 +76,209 @@ pub fn smooth(args: &SmoothArgs) -> Result<String> {
         ],
     )?;
     let start = Instant::now();
-    let field = read_field(args.input.as_deref(), args.kind, &args.csv, &args.grid)?;
-    match field {
-        FieldInput::Series(data) => {
-            if args.complex.is_some() {
-                return Err(Error::Usage("--complex is for grids (a series has no separatrices)".into()));
-            }
-            check_output_extension(&args.output, &["csv"], "a series")?;
-            smooth_series(args, &input_path, data, start)
-        }
-        FieldInput::Grid(data) => {
-            check_output_extension(&args.output, &["vti", "npz", "npy", "csv"], "a grid")?;
-            if let Some(c) = &args.complex {
-                check_output_extension(c, &["vtp"], "--complex")?;
-            }
-            super::smooth_grid::smooth_grid(args, data, start)
-        }
-        FieldInput::Mesh(data) => {
-            check_output_extension(&args.output, &["vtu", "vtp", "ply"], "a mesh")?;
-            if let Some(c) = &args.complex {
-                check_output_extension(c, &["vtp"], "--complex")?;
-            }
-            super::smooth_mesh::smooth_mesh(args, data, start)
-        }
+    let field = read_field(args.input.as_deref(), args.kind, &args.csv, &args.grid)?.into_field(&input_path)?;
+    if let Some(c) = &args.complex {
+        check_complex_output(c, &field.domain)?;
     }
-}
-
-fn check_output_extension(path: &Path, allowed: &[&str], what: &str) -> Result<()> {
-    let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
-    if allowed.contains(&ext.as_str()) {
-        Ok(())
-    } else {
-        Err(Error::Usage(format!(
-            "{}: the output of {what} is written as {}",
-            path.display(),
-            allowed.iter().map(|e| format!(".{e}")).collect::<Vec<_>>().join(", ")
-        )))
-    }
-}
-
-fn smooth_series(args: &SmoothArgs, input: &Path, data: SeriesCsv, start: Instant) -> Result<String> {
-    let series = Series::with_coordinates(data.x.clone()).map_err(|e| e.in_file(input))?;
+    check_output(&args.output, &field.domain)?;
     let read_seconds = start.elapsed().as_secs_f64();
-    let result = run_pipeline(&series, &data.values, &args.settings).map_err(|e| e.in_file(input))?;
+    let result = smooth_any(&field.domain, &field.values, &args.settings).map_err(|e| e.in_file(&field.path))?;
+
     let t = Instant::now();
-    let out = SeriesOutput {
-        x_text: data.x_text.clone(),
-        input: data.values.clone(),
-        output: result.output.clone(),
-        u: result.u.clone(),
-        roles: result.roles.clone(),
-    };
     // every output is staged first and committed together at the end
-    let mut staged = vec![stage_series_output(&args.output, &out)?];
+    let results = Results {
+        input: &field.values,
+        smoothed: &result.output,
+        representative: &result.u,
+        roles: &result.roles,
+        filled: field.filled.as_deref(),
+    };
+    let x_text = field.axis.as_ref().map(|a| a.x_text.as_slice());
+    let mut staged = vec![stage_results(&args.output, &field.domain, x_text, &results)?];
+    if let Some(path) = &args.complex {
+        let Some(ms) = &result.complex else {
+            return Err(Error::Internal {
+                path: Some(field.path.clone()),
+                message: format!("no Morse-Smale complex to write ({})", result.report.representative),
+            });
+        };
+        staged.push(stage_complex(path, &field.domain, &field.values, &result.roles, ms)?);
+    }
+    let mut hidden = 0;
     if let Some(path) = &args.plot {
-        let (axis, x) = x_axis(&data.x_source, &data.x);
-        let markers: Vec<Marker> = result
-            .roles
-            .iter()
-            .enumerate()
-            .filter_map(|(i, r)| match r {
-                Role::Min => Some(Marker { index: i, is_max: false }),
-                Role::Max => Some(Marker { index: i, is_max: true }),
-                _ => None,
-            })
-            .collect();
-        let r = &result.report;
-        let title = format!(
-            "{} — {}: {} of {} extrema kept, certified (RMS change {:.3e})",
-            input.file_name().unwrap_or_default().to_string_lossy(),
-            data.column,
-            r.kept.len(),
-            r.input_minima + r.input_maxima,
-            r.rms_deviation
-        );
-        staged.push(stage_plot(path, |p| {
-            plot_series(p, &x, &axis, &data.column, &data.values, &result.output, &markers, &title, (1400, 700))
-        })?);
+        let (figure, h) = stage_figure(path, args, &field, &result)?;
+        staged.push(figure);
+        hidden = h;
     }
     let write_seconds = t.elapsed().as_secs_f64();
-    let r = &result.report;
+    let filled = field.filled.as_ref().map(|m| m.iter().filter(|&&b| b).count()).unwrap_or(0);
     if let Some(path) = &args.report {
         let run = RunReport {
-            input_file: input.display().to_string(),
-            column: &data.column,
+            input_file: field.path.display().to_string(),
+            field: &field.description,
+            domain: facts(&field),
+            filled_missing: filled,
             output_file: args.output.display().to_string(),
             read_seconds,
             write_seconds,
             total_seconds: start.elapsed().as_secs_f64(),
-            report: r,
+            saddles: result.complex.as_ref().map(|c| c.saddles.len()),
+            separatrices: result.complex.as_ref().map(|c| c.descending.len() + c.ascending.len()),
+            report: &result.report,
         };
         staged.push(stage_json(path, &run)?);
     }
     for s in staged {
         s.commit()?;
     }
-    let s = &r.seconds;
+
+    let r = &result.report;
     let mut text = String::new();
     for w in &r.warnings {
         text += &format!("warning: {w}\n");
     }
+    for n in &field.notes {
+        text += &format!("note: {n}\n");
+    }
+    text += &input_line(&field, r, filled);
     let kmin = r.kept.iter().filter(|k| k.role == Role::Min).count();
     text += &format!(
-        "{}: {} samples of `{}`, {} minima and {} maxima in the input (SoS, ends included)\n",
-        input.display(),
-        r.vertices,
-        data.column,
-        r.input_minima,
-        r.input_maxima
-    );
-    text += &format!(
-        "kept {} minima and {} maxima{}\n",
-        kmin,
+        "kept {kmin} minima and {} maxima{}; representative: {}\n",
         r.kept.len() - kmin,
-        r.settings.threshold.map(|t| format!(" (persistence ≥ {})", sig6(t))).unwrap_or_default()
+        r.settings.threshold.map(|t| format!(" (persistence ≥ {})", sig6(t))).unwrap_or_default(),
+        r.representative
     );
     text += &fit_and_solver_lines(r);
-    text += &format!(
-        "seconds: read {:.3}, persistence {:.3}, representative {:.3}, operators {:.3}, constraints {:.3}, solve {:.3}, repair {:.3}, verify {:.3}, write {:.3}, total {:.3}\n",
-        read_seconds, s.persistence, s.representative, s.operators, s.constraints, s.solve, s.repair, s.verify, write_seconds,
-        start.elapsed().as_secs_f64()
-    );
-    text += &format!("wrote {}", args.output.display());
-    if let Some(p) = &args.plot {
-        text += &format!(", {}", p.display());
+    text += &seconds_line(&field.domain, read_seconds, &r.seconds, write_seconds, start.elapsed().as_secs_f64());
+    if hidden > 0 {
+        text += &format!("plot: {hidden} kept extrema face away from the camera (try --view)\n");
     }
-    if let Some(p) = &args.report {
-        text += &format!(", {}", p.display());
+    let mut wrote = vec![args.output.display().to_string()];
+    for p in [&args.complex, &args.plot, &args.report].into_iter().flatten() {
+        wrote.push(p.display().to_string());
     }
-    text.push('\n');
+    text += &format!("wrote {}\n", wrote.join(", "));
     Ok(text)
+}
+
+fn facts(field: &Field) -> DomainFacts<'_> {
+    match &field.domain {
+        AnyDomain::Series(_) => DomainFacts::Series { column: &field.description },
+        AnyDomain::Grid(g) => {
+            DomainFacts::Grid { columns: g.nx(), rows: g.ny(), spacing: g.spacing(), origin: g.origin() }
+        }
+        AnyDomain::Mesh(m) => DomainFacts::Mesh {
+            triangles: m.faces().len(),
+            components: m.n_components(),
+            boundary_loops: m.boundary_loops(),
+            genus: m.is_orientable().then(|| m.genus()),
+            negative_cotangent_edges: crate::operators::negative_cotan_edges(m.positions(), m.faces()),
+            reading_notes: &field.notes,
+        },
+    }
+}
+
+/// The summary's first line: the file, the field, the domain and the input's extrema.
+fn input_line(field: &Field, r: &Report, filled: usize) -> String {
+    let path = field.path.display();
+    let extrema = format!("{} minima and {} maxima in the input", r.input_minima, r.input_maxima);
+    match &field.domain {
+        AnyDomain::Series(_) => {
+            format!("{path}: {} samples of `{}`, {extrema} (SoS, ends included)\n", r.vertices, field.description)
+        }
+        AnyDomain::Grid(g) => format!(
+            "{path}: {} of a {} × {} grid (spacing {}, {}){}; {extrema} (SoS, boundary included)\n",
+            field.description,
+            g.nx(),
+            g.ny(),
+            sig6(g.spacing()[0]),
+            sig6(g.spacing()[1]),
+            if filled > 0 { format!(", {filled} missing samples filled harmonically") } else { String::new() },
+        ),
+        AnyDomain::Mesh(m) => format!(
+            "{}{path}: {} on a mesh of {} ({} interior edges with negative cotangent weight); {extrema} (SoS, boundary included)\n",
+            if filled > 0 { format!("filled {filled} missing (NaN) values harmonically\n") } else { String::new() },
+            field.description,
+            m.describe(),
+            crate::operators::negative_cotan_edges(m.positions(), m.faces()),
+        ),
+    }
+}
+
+/// The kept extrema as plot markers.
+fn kept_markers(roles: &[Role]) -> Vec<GridMarker> {
+    roles
+        .iter()
+        .enumerate()
+        .filter_map(|(i, r)| match r {
+            Role::Min => Some(GridMarker { index: i, is_max: false }),
+            Role::Max => Some(GridMarker { index: i, is_max: true }),
+            _ => None,
+        })
+        .collect()
+}
+
+/// Stages the figure: the series over x, or input and output side by side as heat maps
+/// (grids) or shaded views (meshes). Returns it with the number of kept extrema hidden from
+/// the mesh camera.
+fn stage_figure(path: &Path, args: &SmoothArgs, field: &Field, result: &Smoothed) -> Result<(Staged, usize)> {
+    let r = &result.report;
+    let h = &field.values;
+    let name = field.path.file_name().unwrap_or_default().to_string_lossy().to_string();
+    let (lo, hi) = crate::domain::value_range(h);
+    let kmin = r.kept.iter().filter(|k| k.role == Role::Min).count();
+    let kmax = r.kept.len() - kmin;
+    let panels = [
+        GridPanel { title: format!("input: {} minima, {} maxima", r.input_minima, r.input_maxima), values: h },
+        GridPanel { title: format!("smoothed: {kmin} minima, {kmax} maxima (certified)"), values: &result.output },
+    ];
+    let title = format!("{name} — {} (RMS change {})", field.description, sig6(r.rms_deviation));
+    let mut hidden = 0;
+    let staged = match &field.domain {
+        AnyDomain::Series(_) => {
+            let axis = field.axis.as_ref().ok_or_else(|| Error::Internal {
+                path: Some(field.path.clone()),
+                message: "a series without its x axis".into(),
+            })?;
+            let (x_axis, x) = x_axis(&axis.source, &axis.x);
+            let markers: Vec<Marker> =
+                kept_markers(&result.roles).into_iter().map(|m| Marker { index: m.index, is_max: m.is_max }).collect();
+            let title = format!(
+                "{name} — {}: {} of {} extrema kept, certified (RMS change {:.3e})",
+                field.description,
+                r.kept.len(),
+                r.input_minima + r.input_maxima,
+                r.rms_deviation
+            );
+            stage_plot(path, |p| {
+                plot_series(p, &x, &x_axis, &field.description, h, &result.output, &markers, &title, (1400, 700))
+            })?
+        }
+        AnyDomain::Grid(g) => {
+            let options = GridPlotOptions {
+                isolines: args.isolines,
+                diverging: lo < 0.0 && hi > 0.0,
+                aspect: (g.spacing()[1] / g.spacing()[0]).abs(),
+            };
+            let markers = kept_markers(&result.roles);
+            stage_plot(path, |p| plot_grid_fields(p, g.nx(), g.ny(), &panels, &markers, &title, &options))?
+        }
+        AnyDomain::Mesh(m) => {
+            let markers = kept_markers(&result.roles);
+            stage_plot(path, |p| {
+                hidden = plot_mesh_fields(
+                    p,
+                    m.positions(),
+                    m.faces(),
+                    &panels,
+                    &markers,
+                    &title,
+                    args.view,
+                    lo < 0.0 && hi > 0.0,
+                )?;
+                Ok(())
+            })?
+        }
+    };
+    Ok((staged, hidden))
 }

@@ -1,8 +1,8 @@
-//! What the three `smooth` paths (series, grids, meshes) share: the command's options and the
-//! lines of its summary.
+//! The options of `smooth` and the shared lines of its summary.
 
 use super::input::{DomainKind, GridOptions};
 use super::sig6;
+use crate::domain::AnyDomain;
 use crate::io::series_csv::SeriesCsvOptions;
 use crate::pipeline::{Report, SmoothSettings, StageSeconds};
 use std::path::PathBuf;
@@ -34,7 +34,7 @@ pub struct SmoothArgs {
     pub report: Option<PathBuf>,
 }
 
-/// The certificate, deviation and solver lines of `smooth`'s summary (series and grids).
+/// The certificate, deviation and solver lines of `smooth`'s summary.
 pub fn fit_and_solver_lines(r: &Report) -> String {
     format!(
         "{}; RMS deviation {}, max deviation {}\n{}\nsolver {:?} {:?} in {} iterations{}, {} constraints, margin {:.3e}; margin met exactly by moving {} vertices (at most {:.1e}); strictness repair changed {} vertices\n",
@@ -54,10 +54,14 @@ pub fn fit_and_solver_lines(r: &Report) -> String {
     )
 }
 
-/// The `seconds:` line of a surface run.
-pub fn surface_seconds_line(read: f64, s: &StageSeconds, write: f64, total: f64) -> String {
+/// The `seconds:` line of a run (series have no complex to build or simplify).
+pub fn seconds_line(domain: &AnyDomain, read: f64, s: &StageSeconds, write: f64, total: f64) -> String {
+    let complex = match domain {
+        AnyDomain::Series(_) => String::new(),
+        _ => format!("complex {:.3}, simplify {:.3}, ", s.complex, s.simplify),
+    };
     format!(
-        "seconds: read {:.3}, persistence {:.3}, complex {:.3}, simplify {:.3}, representative {:.3}, operators {:.3}, constraints {:.3}, solve {:.3}, repair {:.3}, verify {:.3}, write {:.3}, total {:.3}\n",
-        read, s.persistence, s.complex, s.simplify, s.representative, s.operators, s.constraints, s.solve, s.repair, s.verify, write, total
+        "seconds: read {read:.3}, persistence {:.3}, {complex}representative {:.3}, operators {:.3}, constraints {:.3}, solve {:.3}, repair {:.3}, verify {:.3}, write {write:.3}, total {total:.3}\n",
+        s.persistence, s.representative, s.operators, s.constraints, s.solve, s.repair, s.verify
     )
 }

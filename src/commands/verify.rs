@@ -1,13 +1,12 @@
 //! `toposmooth verify`: re-check an output file from what it carries, independently of `smooth`.
 
-use super::input::{read_grid, read_mesh_field, read_trimesh, GridOptions};
-use crate::domain::{Domain, Grid2d, Series};
+use super::input::{read_field, read_trimesh, DomainKind, GridOptions};
+use crate::domain::{AnyDomain, Domain};
 use crate::error::{Error, Result};
-use crate::io::npz::read_npz;
-use crate::io::series_csv::{read_series, read_series_output, SeriesCsvOptions};
-use crate::io::vtk::read_image;
+use crate::io::export::{read_results, results_on_mesh, Stored, MESH_OUTPUTS};
+use crate::io::series_csv::SeriesCsvOptions;
 use crate::topology::Role;
-use crate::verify::certify;
+use crate::verify::certify_any;
 use std::path::{Path, PathBuf};
 
 /// Options of `verify`.
@@ -27,8 +26,19 @@ pub struct VerifyArgs {
 pub fn verify(args: &VerifyArgs) -> Result<String> {
     let ext = args.file.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
     match ext.as_str() {
-        "vti" | "npz" => verify_grid(args, &ext),
-        "vtu" | "vtp" | "ply" => verify_mesh(args),
+        e if MESH_OUTPUTS.contains(&e) => {
+            let (mesh, data) = read_trimesh(&args.file)?;
+            if data.arrays.iter().any(|a| a.name.starts_with("weight_") && a.name.ends_with("_raw")) {
+                return verify_weights(args, &mesh, &data);
+            }
+            if data.arrays.iter().any(|a| a.name.starts_with("weight_") && a.name.ends_with("_interpolated")) {
+                return Err(Error::Usage(format!(
+                    "{}: cage weights interpolated onto a shape are reported, not certified; verify the cage file `weights` wrote beside it (<output>_cage.vtu)",
+                    args.file.display()
+                )));
+            }
+            verify_results(args, results_on_mesh(&args.file, mesh, &data)?)
+        }
         "obj" | "off" | "vtk" if crate::io::mesh::is_mesh_file(&args.file) => Err(Error::Usage(format!(
             "{}: a mesh file holds no smoothing output; verify the .vtu, .vtp or .ply that `smooth` wrote",
             args.file.display()
@@ -37,109 +47,46 @@ pub fn verify(args: &VerifyArgs) -> Result<String> {
             "{}: a .npy export holds the smoothed array only and cannot be verified alone; verify the .vti or .npz output",
             args.file.display()
         ))),
-        _ => verify_series(args),
+        _ => verify_results(args, read_results(&args.file)?),
     }
 }
 
-/// The arrays a verifiable grid output carries.
-struct GridOutput {
-    grid: Grid2d,
-    input: Vec<f64>,
-    smoothed: Vec<f64>,
-    representative: Vec<f64>,
-    roles: Vec<Role>,
-}
-
-fn read_grid_output(path: &Path, ext: &str) -> Result<GridOutput> {
-    let (grid, mut arrays): (Grid2d, Vec<(String, Vec<f64>)>) = if ext == "vti" {
-        let img = read_image(path)?;
-        let grid = Grid2d::with_geometry(img.nx, img.ny, img.spacing, img.origin).map_err(|e| e.in_file(path))?;
-        (grid, img.arrays.into_iter().filter(|a| a.components == 1).map(|a| (a.name, a.values)).collect())
-    } else {
-        let arrays = read_npz(path)?;
-        let Some((_, [ny, nx], _)) = arrays.first() else {
-            return Err(Error::input("the archive holds no arrays").in_file(path));
-        };
-        let grid = Grid2d::new(*nx, *ny).map_err(|e| e.in_file(path))?;
-        if let Some((name, shape, _)) = arrays.iter().find(|(_, s, _)| *s != [*ny, *nx]) {
-            return Err(
-                Error::input(format!("array `{name}` has shape {shape:?}, the first {:?}", [*ny, *nx])).in_file(path)
-            );
-        }
-        (grid, arrays.into_iter().map(|(n, _, v)| (n, v)).collect())
-    };
-    let mut take = |name: &str| -> Result<Vec<f64>> {
-        let names: Vec<String> = arrays.iter().map(|(n, _)| n.clone()).collect();
-        match arrays.iter().position(|(n, _)| n == name) {
-            Some(i) => Ok(arrays.swap_remove(i).1),
-            None => Err(Error::input(format!(
-                "no array `{name}` (a verifiable output holds input, smoothed, representative, role; found {})",
-                names.join(", ")
-            ))
-            .in_file(path)),
-        }
-    };
-    let (input, smoothed, representative, role) =
-        (take("input")?, take("smoothed")?, take("representative")?, take("role")?);
-    let roles = role
-        .iter()
-        .enumerate()
-        .map(|(i, &c)| {
-            Role::from_code(c).ok_or_else(|| {
-                let (r, col) = grid.row_col(i);
-                Error::input(format!("role {c} at (row {r}, column {col}) is not one of −1, 0, 1, 2, 3")).in_file(path)
-            })
-        })
-        .collect::<Result<Vec<Role>>>()?;
-    Ok(GridOutput { grid, input, smoothed, representative, roles })
-}
-
-fn verify_grid(args: &VerifyArgs, ext: &str) -> Result<String> {
-    let out = read_grid_output(&args.file, ext)?;
-    let g = &out.grid;
-    let n = g.nx() * g.ny();
+/// Checks a smoothing result read back from its file, on any domain: the input matches the
+/// original (when given), the roles are those a smoothing output carries, and the smoothed
+/// and representative arrays have exactly the kept extrema.
+fn verify_results(args: &VerifyArgs, out: Stored) -> Result<String> {
+    let d = &out.domain;
+    let series = matches!(d, AnyDomain::Series(_));
     let mut problems = Vec::new();
     if let Some(orig) = &args.input {
-        // the .vti carries the spacing the input was read with (the harmonic fill and derived
-        // quantities depend on it)
-        let mut opts = args.grid.clone();
-        if opts.spacing.is_none() && ext == "vti" {
-            opts.spacing = Some(g.spacing());
-        }
-        let data = read_grid(orig, &opts)?;
-        if (data.grid.nx(), data.grid.ny()) != (g.nx(), g.ny()) {
-            problems.push(format!(
-                "{} is {} × {}, {} is {} × {}",
-                orig.display(),
-                data.grid.nx(),
-                data.grid.ny(),
-                args.file.display(),
-                g.nx(),
-                g.ny()
-            ));
-        } else if let Some(i) = (0..n).find(|&i| data.values[i].to_bits() != out.input[i].to_bits()) {
-            let (r, c) = g.row_col(i);
-            problems.push(format!(
-                "input array differs from {} at (row {r}, column {c}): {} vs {}",
-                orig.display(),
-                out.input[i],
-                data.values[i]
-            ));
-        }
+        problems.extend(compare_input(args, orig, &out)?);
     }
-    if let Some(i) = out.roles.iter().position(|&r| r == Role::End || r == Role::Fixed) {
-        let (r, c) = g.row_col(i);
-        problems
-            .push(format!("(row {r}, column {c}) has role {}: grid outputs keep extrema only", out.roles[i].code()));
+    let n = out.roles.len();
+    for (i, &role) in out.roles.iter().enumerate() {
+        let allowed = match role {
+            Role::End => series && (i == 0 || i + 1 == n),
+            Role::Fixed => false,
+            _ => true,
+        };
+        if !allowed {
+            problems.push(format!(
+                "{} has role {} ({}): smoothing outputs keep extrema only{}",
+                d.describe_vertex(i),
+                role.code(),
+                role.label(),
+                if role == Role::End { " (and series their two ends)" } else { "" }
+            ));
+            break;
+        }
     }
     if !out.roles.contains(&Role::Min) || !out.roles.contains(&Role::Max) {
         problems.push("the role array keeps no minimum or no maximum".into());
     }
-    let cert = certify(g, &out.smoothed, &out.roles, Some(&out.input));
+    let cert = certify_any(d, &out.smoothed, &out.roles, Some(&out.input));
     if !cert.passed {
         problems.push(format!("smoothed: {}", cert.summary()));
     }
-    let ucert = certify(g, &out.representative, &out.roles, None);
+    let ucert = certify_any(d, &out.representative, &out.roles, None);
     if !ucert.passed {
         problems.push(format!("representative: {}", ucert.summary()));
     }
@@ -149,147 +96,49 @@ fn verify_grid(args: &VerifyArgs, ext: &str) -> Result<String> {
     let kmin = out.roles.iter().filter(|&&r| r == Role::Min).count();
     let kmax = out.roles.iter().filter(|&&r| r == Role::Max).count();
     Ok(format!(
-        "{}: {} ({} × {} grid, {kmin} minima and {kmax} maxima kept at their input values, representative consistent{})\n",
+        "{}: {} ({}, {kmin} minima and {kmax} maxima kept at their input values, representative consistent{})\n",
         args.file.display(),
         cert.summary(),
-        g.nx(),
-        g.ny(),
-        if args.input.is_some() { ", input array matches" } else { "" }
+        d.describe(),
+        if args.input.is_some() { ", input matches" } else { "" }
     ))
 }
 
-fn verify_series(args: &VerifyArgs) -> Result<String> {
-    let out = read_series_output(&args.file)?;
-    let n = out.input.len();
-    let series = Series::uniform(n);
-    let mut problems = Vec::new();
-    if let Some(orig) = &args.input {
-        let data = read_series(orig, &args.csv)?;
-        if data.values.len() != n {
-            problems.push(format!(
-                "{} has {} samples, {} has {n}",
-                orig.display(),
-                data.values.len(),
-                args.file.display()
-            ));
-        } else if let Some(i) = (0..n).find(|&i| data.values[i].to_bits() != out.input[i].to_bits()) {
-            problems.push(format!(
-                "input column differs from {} at sample {i}: {} vs {}",
-                orig.display(),
-                out.input[i],
-                data.values[i]
-            ));
+/// Compares the result's `input` with the original file read as the result's domain. A `.vti`
+/// carries the spacing the input was read with (the harmonic fill and derived quantities
+/// depend on it), so a grid original is read with it unless `--spacing` says otherwise.
+fn compare_input(args: &VerifyArgs, orig: &Path, out: &Stored) -> Result<Option<String>> {
+    let mut opts = args.grid.clone();
+    let kind = match &out.domain {
+        AnyDomain::Series(_) => DomainKind::Series,
+        AnyDomain::Grid(g) => {
+            let vti = args.file.extension().is_some_and(|e| e.eq_ignore_ascii_case("vti"));
+            if opts.spacing.is_none() && vti {
+                opts.spacing = Some(g.spacing());
+            }
+            DomainKind::Grid
         }
-    }
-    // roles a series output can carry: free ends only at the two ends, no fixed regions, at
-    // least one kept minimum and one kept maximum
-    if let Some(i) = (1..n.saturating_sub(1)).find(|&i| out.roles[i] == Role::End) {
-        problems.push(format!("sample {i} is marked `end` but is not an end of the series"));
-    }
-    if let Some(i) = out.roles.iter().position(|&r| r == Role::Fixed) {
-        problems.push(format!("sample {i} is marked `fixed`: series outputs keep extrema, not regions"));
-    }
-    if !out.roles.contains(&Role::Min) || !out.roles.contains(&Role::Max) {
-        problems.push("the role column keeps no minimum or no maximum".into());
-    }
-    let cert = certify(&series, &out.output, &out.roles, Some(&out.input));
-    if !cert.passed {
-        problems.push(format!("output: {}", cert.summary()));
-    }
-    let ucert = certify(&series, &out.u, &out.roles, None);
-    if !ucert.passed {
-        problems.push(format!("representative u: {}", ucert.summary()));
-    }
-    if !problems.is_empty() {
-        return Err(Error::Uncertified { path: Some(args.file.clone()), message: problems.join("; ") });
-    }
-    let kept = out.roles.iter().filter(|r| r.is_fixed()).count();
-    Ok(format!(
-        "{}: {} ({n} samples, {kept} kept extrema at their input values, u consistent{})\n",
-        args.file.display(),
-        cert.summary(),
-        if args.input.is_some() { ", input column matches" } else { "" }
-    ))
-}
-
-fn verify_mesh(args: &VerifyArgs) -> Result<String> {
-    let (mesh, data) = read_trimesh(&args.file)?;
-    if data.arrays.iter().any(|a| a.name.starts_with("weight_") && a.name.ends_with("_raw")) {
-        return verify_weights(args, &mesh, &data);
-    }
-    if data.arrays.iter().any(|a| a.name.starts_with("weight_") && a.name.ends_with("_interpolated")) {
-        return Err(Error::Usage(format!(
-            "{}: cage weights interpolated onto a shape are reported, not certified; verify the cage file `weights` wrote beside it (<output>_cage.vtu)",
-            args.file.display()
-        )));
-    }
-    let n = mesh.n_vertices();
-    let take = |name: &str| -> Result<Vec<f64>> {
-        let a = data.array(name).map_err(|m| {
-            Error::input(format!("{m} (a verifiable output holds input, smoothed, representative, role)"))
-                .in_file(&args.file)
-        })?;
-        if a.components != 1 || a.values.len() != n {
-            return Err(Error::input(format!(
-                "array `{name}` has {} components ({} values for {n} vertices); a scalar is needed",
-                a.components,
-                a.values.len()
-            ))
-            .in_file(&args.file));
-        }
-        Ok(a.values)
+        AnyDomain::Mesh(_) => DomainKind::Mesh,
     };
-    let (input, smoothed, representative, role) =
-        (take("input")?, take("smoothed")?, take("representative")?, take("role")?);
-    let roles = role
-        .iter()
-        .enumerate()
-        .map(|(i, &c)| {
-            Role::from_code(c).ok_or_else(|| {
-                Error::input(format!("role {c} at vertex {i} is not one of −1, 0, 1, 2, 3")).in_file(&args.file)
-            })
-        })
-        .collect::<Result<Vec<Role>>>()?;
-    let mut problems = Vec::new();
-    if let Some(orig) = &args.input {
-        let original = read_mesh_field(orig, &args.grid)?;
-        if original.mesh.n_vertices() != n || original.mesh.faces() != mesh.faces() {
-            problems.push(format!("{} is not the mesh of {}", orig.display(), args.file.display()));
-        } else if let Some(i) = (0..n).find(|&i| original.values[i].to_bits() != input[i].to_bits()) {
-            problems.push(format!(
-                "input array differs from {} at vertex {i}: {} vs {}",
-                orig.display(),
-                input[i],
-                original.values[i]
-            ));
-        }
+    let original = read_field(Some(orig), kind, &args.csv, &opts)?.into_field(orig)?;
+    let (file, o) = (args.file.display(), orig.display());
+    let same = match (&original.domain, &out.domain) {
+        (AnyDomain::Series(a), AnyDomain::Series(b)) => a.n_vertices() == b.n_vertices(),
+        (AnyDomain::Grid(a), AnyDomain::Grid(b)) => (a.nx(), a.ny()) == (b.nx(), b.ny()),
+        (AnyDomain::Mesh(a), AnyDomain::Mesh(b)) => a.n_vertices() == b.n_vertices() && a.faces() == b.faces(),
+        _ => false,
+    };
+    if !same {
+        return Ok(Some(format!("{o} is a {}, {file} a {}", original.domain.describe(), out.domain.describe())));
     }
-    if let Some(i) = roles.iter().position(|&r| r == Role::End || r == Role::Fixed) {
-        problems.push(format!("vertex {i} has role {}: smoothing outputs keep extrema only", roles[i].code()));
-    }
-    if !roles.contains(&Role::Min) || !roles.contains(&Role::Max) {
-        problems.push("the role array keeps no minimum or no maximum".into());
-    }
-    let cert = certify(&mesh, &smoothed, &roles, Some(&input));
-    if !cert.passed {
-        problems.push(format!("smoothed: {}", cert.summary()));
-    }
-    let ucert = certify(&mesh, &representative, &roles, None);
-    if !ucert.passed {
-        problems.push(format!("representative: {}", ucert.summary()));
-    }
-    if !problems.is_empty() {
-        return Err(Error::Uncertified { path: Some(args.file.clone()), message: problems.join("; ") });
-    }
-    let kmin = roles.iter().filter(|&&r| r == Role::Min).count();
-    let kmax = roles.iter().filter(|&&r| r == Role::Max).count();
-    Ok(format!(
-        "{}: {} (mesh of {}, {kmin} minima and {kmax} maxima kept at their input values, representative consistent{})\n",
-        args.file.display(),
-        cert.summary(),
-        mesh.describe(),
-        if args.input.is_some() { ", input array matches" } else { "" }
-    ))
+    Ok((0..out.input.len()).find(|&i| original.values[i].to_bits() != out.input[i].to_bits()).map(|i| {
+        format!(
+            "input differs from {o} at {}: {} vs {}",
+            out.domain.describe_vertex(i),
+            out.input[i],
+            original.values[i]
+        )
+    }))
 }
 
 /// A weights file (SPEC.md formats): per handle `weight_<name>_raw` certified against

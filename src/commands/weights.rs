@@ -117,7 +117,7 @@ pub fn stage_weights(path: &Path, mesh: &TriMesh, names: &[String], w: &Weights)
         owned.push((format!("role_{name}"), weight_roles(mesh, &f.prescribed)));
     }
     let arrays: Vec<(&str, &[f64])> = owned.iter().map(|(n, v)| (n.as_str(), v.as_slice())).collect();
-    super::smooth_mesh::stage_mesh_output(path, mesh, &arrays)
+    crate::io::export::stage_mesh(path, mesh, &arrays)
 }
 
 /// Runs `weights`.
@@ -134,9 +134,9 @@ pub fn weights(args: &WeightsArgs) -> Result<String> {
         ],
     )?;
     crate::apps::cage::check_max_area(args.cage_max_area)?;
-    super::smooth_mesh::check_mesh_output(&args.output)?;
+    crate::io::export::check_mesh_output(&args.output)?;
     if let Some(c) = &args.cage_output {
-        super::smooth_mesh::check_mesh_output(c)?;
+        crate::io::export::check_mesh_output(c)?;
     }
     let (mesh, _) = read_trimesh(&args.input)?;
     let text =
@@ -184,7 +184,7 @@ fn run_cage(args: &WeightsArgs, shape: &TriMesh, cage: &[[f64; 2]], start: Insta
         owned.push((format!("weight_{j}_interpolated"), c.raw_on_shape[j].clone()));
     }
     let arrays: Vec<(&str, &[f64])> = owned.iter().map(|(n, v)| (n.as_str(), v.as_slice())).collect();
-    staged.push(super::smooth_mesh::stage_mesh_output(&args.output, shape, &arrays)?);
+    staged.push(crate::io::export::stage_mesh(&args.output, shape, &arrays)?);
     if let Some(path) = &args.plot {
         let shown = m.min(4);
         let panels: Vec<GridPanel> = (0..shown)

@@ -10,12 +10,14 @@
 //! assert_eq!(s.neighbors(2).collect::<Vec<_>>(), vec![1, 3]);
 //! ```
 
+mod any;
 mod grid;
 mod mesh;
 mod order;
 mod series;
 pub mod vec3;
 
+pub use any::AnyDomain;
 pub use grid::{Grid2d, MAX_SPACING, MIN_SPACING};
 pub use mesh::{shapes, triangle_area, TriMesh};
 pub use order::{sos_greater, sos_less, sos_sort, sos_untied, value_range};

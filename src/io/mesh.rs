@@ -25,6 +25,18 @@ pub struct MeshData {
     pub notes: Vec<String>,
 }
 
+/// Reads a mesh and validates it.
+///
+/// # Errors
+/// Input errors naming the file.
+pub fn read_trimesh(path: &Path) -> Result<(crate::domain::TriMesh, MeshData)> {
+    let mut data = read_mesh(path)?;
+    // the triangles move into the mesh; the positions stay for `MeshData::array("x")`
+    let triangles = std::mem::take(&mut data.triangles);
+    let mesh = crate::domain::TriMesh::new(data.positions.clone(), triangles).map_err(|e| e.in_file(path))?;
+    Ok((mesh, data))
+}
+
 impl MeshData {
     /// Names of the per-vertex arrays, then the coordinates `x`, `y`, `z`.
     pub fn names(&self) -> Vec<String> {

@@ -1,6 +1,8 @@
 //! Reading and writing files. Every output goes to a temporary file in the target's directory
 //! and is renamed into place, so a failed run never leaves a half-written file.
 
+#[cfg(all(feature = "io-vtk", feature = "io-npz"))]
+pub mod export;
 pub mod grid;
 #[cfg(feature = "io-vtk")]
 pub mod mesh;

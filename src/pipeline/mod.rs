@@ -94,6 +94,19 @@ pub fn smooth<D: Smoothable + Sync>(domain: &D, h: &[f64], settings: &SmoothSett
     smooth_with(domain, h, settings, &mut Analyses::default())
 }
 
+/// [`smooth`] on a domain chosen at run time.
+///
+/// # Errors
+/// As [`smooth`].
+pub fn smooth_any(domain: &crate::domain::AnyDomain, h: &[f64], settings: &SmoothSettings) -> Result<Smoothed> {
+    use crate::domain::AnyDomain;
+    match domain {
+        AnyDomain::Series(d) => smooth(d, h, settings),
+        AnyDomain::Grid(d) => smooth(d, h, settings),
+        AnyDomain::Mesh(d) => smooth(d, h, settings),
+    }
+}
+
 /// [`smooth`] with the harmonic fills' analysis taken from `analyses` (made, for instance, by
 /// the geodesic distance the field came from). For memory, `analyses` is cleared before the
 /// solve (a million-vertex Laplacian's analysis is hundreds of MiB) and holds only the

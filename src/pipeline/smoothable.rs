@@ -17,6 +17,7 @@ use crate::verify::certify;
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize))]
 #[cfg_attr(feature = "serde", serde(rename_all = "lowercase"))]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 pub enum RepresentativeChoice {
     /// Separatrices interpolated, harmonic elsewhere (paper section 3.3).
     #[default]

@@ -4,15 +4,15 @@
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize))]
 #[cfg_attr(feature = "serde", serde(rename_all = "lowercase"))]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 pub enum Method {
-    /// The structured solver of `ipm` (normal equations, faer Cholesky with the
+    /// The structured interior-point solver (normal equations, faer Cholesky with the
     /// symbolic analysis done once); Clarabel takes over if it does not converge.
     Structured,
     /// Clarabel on the full KKT system, in the formulation the structured solver would use.
     Clarabel,
     /// Clarabel on the factored formulation whatever the conditioning (the paper's appendix:
-    /// variables `(f, t)` with `t = F f` as equality constraints; needs
-    /// [`super::MonotoneQp::factor`]).
+    /// variables (f, t) with t = F f as equality constraints; needs the energy's factor F).
     #[cfg_attr(feature = "serde", serde(rename = "clarabel-auxiliary"))]
     ClarabelAuxiliary,
 }
@@ -21,16 +21,17 @@ pub enum Method {
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize))]
 #[cfg_attr(feature = "serde", serde(rename_all = "lowercase"))]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 pub enum Formulation {
-    /// Factored when `P`'s condition estimate exceeds [`FACTORED_ABOVE`] and a factor is
-    /// given, else assembled.
+    /// Factored when the condition estimate of P exceeds 10⁹ (`FACTORED_ABOVE`) and a
+    /// factor is given, else assembled.
     #[default]
     Auto,
-    /// `P` as one matrix: normal equations in double precision.
+    /// P as one matrix: normal equations in double precision.
     Assembled,
-    /// `P = FᵀF + diag(d)`: the structured solver forms its normal matrix from `F` in
+    /// P = FᵀF + diag(d): the structured solver forms its normal matrix from F in
     /// double-double arithmetic and keeps the iterate in it; Clarabel gets the auxiliary
-    /// variables `t = F f`.
+    /// variables t = F f.
     Factored,
 }
 

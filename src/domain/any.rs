@@ -1,0 +1,61 @@
+//! A domain chosen at run time: what a file holds, a command runs on, or a binding passes.
+
+use super::{Domain, Grid2d, Series, TriMesh};
+
+/// A domain chosen at run time.
+#[derive(Clone, Debug)]
+pub enum AnyDomain {
+    /// A series.
+    Series(Series),
+    /// An implicit grid.
+    Grid(Grid2d),
+    /// A triangle mesh.
+    Mesh(TriMesh),
+}
+
+impl AnyDomain {
+    /// Vertices of the domain (the length a field must have).
+    pub fn n_vertices(&self) -> usize {
+        match self {
+            AnyDomain::Series(d) => d.n_vertices(),
+            AnyDomain::Grid(d) => d.n_vertices(),
+            AnyDomain::Mesh(d) => d.n_vertices(),
+        }
+    }
+
+    /// A vertex as a reader finds it: `sample i`, `(row r, column c)` or `vertex i`.
+    pub fn describe_vertex(&self, v: usize) -> String {
+        match self {
+            AnyDomain::Series(_) => format!("sample {v}"),
+            AnyDomain::Grid(g) => {
+                let (r, c) = g.row_col(v);
+                format!("(row {r}, column {c})")
+            }
+            AnyDomain::Mesh(_) => format!("vertex {v}"),
+        }
+    }
+
+    /// The domain in a few words: `50 samples`, `30 × 20 grid`, `mesh of …`.
+    pub fn describe(&self) -> String {
+        match self {
+            AnyDomain::Series(s) => format!("{} samples", s.n_vertices()),
+            AnyDomain::Grid(g) => format!("{} × {} grid", g.nx(), g.ny()),
+            AnyDomain::Mesh(m) => format!("mesh of {}", m.describe()),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn vertices_are_described_in_the_domain_s_terms() {
+        let g = AnyDomain::Grid(Grid2d::new(4, 3).unwrap());
+        assert_eq!(g.n_vertices(), 12);
+        assert_eq!(g.describe_vertex(6), "(row 1, column 2)");
+        assert_eq!(g.describe(), "4 × 3 grid");
+        let s = AnyDomain::Series(Series::uniform(5));
+        assert_eq!((s.n_vertices(), s.describe_vertex(3).as_str()), (5, "sample 3"));
+    }
+}

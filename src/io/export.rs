@@ -1,0 +1,368 @@
+//! Any domain's results as files, and back: the one place that knows which formats hold a
+//! series', a grid's or a mesh's output (SPEC.md "Formats"), how the verifiable arrays
+//! `input`, `smoothed`, `representative`, `role` are laid out in each, and how the kept
+//! critical points and separatrices become VTK PolyData.
+
+use super::grid::stage_grid_csv;
+use super::mesh::{read_trimesh, stage_ply, MeshData};
+use super::npz::{read_npz, stage_npy, stage_npz};
+use super::series_csv::{read_series_output, stage_series_output, SeriesOutput};
+use super::vtk::{read_image, stage_vti, stage_vtp, stage_vtu, PolyData};
+use super::Staged;
+use crate::domain::{AnyDomain, Domain, Grid2d, Series, TriMesh};
+use crate::error::{Error, Result};
+use crate::topology::morse_smale::MorseSmale;
+use crate::topology::Role;
+use std::path::Path;
+
+/// Extensions of a series' output.
+pub const SERIES_OUTPUTS: &[&str] = &["csv"];
+/// Extensions of a grid's output (`.npy` and `.csv` hold the smoothed array only).
+pub const GRID_OUTPUTS: &[&str] = &["vti", "npz", "npy", "csv"];
+/// Extensions of a mesh's output.
+pub const MESH_OUTPUTS: &[&str] = &["vtu", "vtp", "ply"];
+
+fn extension(path: &Path) -> String {
+    path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase()
+}
+
+/// The output extensions of a domain, and how to name the domain in a message.
+fn formats(domain: &AnyDomain) -> (&'static [&'static str], &'static str) {
+    match domain {
+        AnyDomain::Series(_) => (SERIES_OUTPUTS, "a series"),
+        AnyDomain::Grid(_) => (GRID_OUTPUTS, "a grid"),
+        AnyDomain::Mesh(_) => (MESH_OUTPUTS, "a mesh"),
+    }
+}
+
+fn check_extension(path: &Path, allowed: &[&str], what: &str) -> Result<()> {
+    if allowed.contains(&extension(path).as_str()) {
+        return Ok(());
+    }
+    Err(Error::Usage(format!(
+        "{}: the output of {what} is written as {}",
+        path.display(),
+        allowed.iter().map(|e| format!(".{e}")).collect::<Vec<_>>().join(", ")
+    )))
+}
+
+/// Checks before any work that `path` names an output format of `domain`.
+///
+/// # Errors
+/// [`Error::Usage`] naming the path and the formats there are.
+pub fn check_output(path: &Path, domain: &AnyDomain) -> Result<()> {
+    let (allowed, what) = formats(domain);
+    check_extension(path, allowed, what)
+}
+
+/// Checks before any work that `path` names a mesh output format (`.vtu`, `.vtp`, `.ply`).
+///
+/// # Errors
+/// [`Error::Usage`] naming the path.
+pub fn check_mesh_output(path: &Path) -> Result<()> {
+    check_extension(path, MESH_OUTPUTS, "a mesh")
+}
+
+/// Checks that the complex can be written at `path` (`.vtp`, surfaces only).
+///
+/// # Errors
+/// [`Error::Usage`] for a series (it has no separatrices) or another extension.
+pub fn check_complex_output(path: &Path, domain: &AnyDomain) -> Result<()> {
+    if let AnyDomain::Series(_) = domain {
+        return Err(Error::Usage("--complex is for grids (a series has no separatrices)".into()));
+    }
+    check_extension(path, &["vtp"], "--complex")
+}
+
+/// Role codes as Float64 (SPEC.md: −1 kept min, +1 kept max, 2 fixed, 3 end, 0 other).
+pub fn role_codes(roles: &[Role]) -> Vec<f64> {
+    roles.iter().map(|r| f64::from(r.code())).collect()
+}
+
+/// The verifiable arrays of a smoothing result.
+pub struct Results<'a> {
+    /// The values smoothed (after deriving and filling).
+    pub input: &'a [f64],
+    /// The certified output.
+    pub smoothed: &'a [f64],
+    /// The representative function.
+    pub representative: &'a [f64],
+    /// Role per vertex.
+    pub roles: &'a [Role],
+    /// Vertices whose input was filled (`--fill-missing`), when any were.
+    pub filled: Option<&'a [bool]>,
+}
+
+/// Stages a smoothing result at `path` in the format its extension names: a series as
+/// `x,input,output,u,role` CSV (`x_text` is the x column as read, dates as dates); a grid as
+/// `.vti` or `.npz` (every array) or `.npy` / CSV (the smoothed array); a mesh as `.vtu`, `.vtp`
+/// or `.ply` (every array).
+///
+/// # Errors
+/// Usage errors for an extension the domain has no format for; I/O errors naming the file.
+pub fn stage_results(path: &Path, domain: &AnyDomain, x_text: Option<&[String]>, r: &Results) -> Result<Staged> {
+    check_output(path, domain)?;
+    let roles = role_codes(r.roles);
+    let filled: Option<Vec<f64>> = r.filled.map(|m| m.iter().map(|&b| f64::from(u8::from(b))).collect());
+    let mut arrays: Vec<(&str, &[f64])> =
+        vec![("input", r.input), ("smoothed", r.smoothed), ("representative", r.representative), ("role", &roles)];
+    if let Some(f) = &filled {
+        arrays.push(("filled", f));
+    }
+    match domain {
+        AnyDomain::Series(s) => {
+            let x_text = match x_text {
+                Some(t) => t.to_vec(),
+                None => (0..s.n_vertices()).map(|i| i.to_string()).collect(),
+            };
+            let out = SeriesOutput {
+                x_text,
+                input: r.input.to_vec(),
+                output: r.smoothed.to_vec(),
+                u: r.representative.to_vec(),
+                roles: r.roles.to_vec(),
+            };
+            stage_series_output(path, &out)
+        }
+        AnyDomain::Grid(g) => match extension(path).as_str() {
+            "vti" => stage_vti(path, g.nx(), g.ny(), g.spacing(), g.origin(), &arrays),
+            "npz" => stage_npz(path, g.ny(), g.nx(), &arrays),
+            "npy" => stage_npy(path, g.ny(), g.nx(), r.smoothed),
+            _ => stage_grid_csv(path, g.nx(), r.smoothed),
+        },
+        AnyDomain::Mesh(m) => stage_mesh(path, m, &arrays),
+    }
+}
+
+/// Stages a mesh with per-vertex arrays as `.vtu`, `.vtp` or `.ply`.
+///
+/// # Errors
+/// Usage errors for another extension; I/O errors naming the file.
+pub fn stage_mesh(path: &Path, mesh: &TriMesh, arrays: &[(&str, &[f64])]) -> Result<Staged> {
+    match extension(path).as_str() {
+        "vtu" => stage_vtu(path, mesh.positions(), mesh.faces(), arrays),
+        "vtp" => stage_vtp(
+            path,
+            &PolyData {
+                points: mesh.positions().to_vec(),
+                polys: mesh.faces().to_vec(),
+                point_arrays: arrays.iter().map(|(n, v)| (n.to_string(), v.to_vec())).collect(),
+                ..Default::default()
+            },
+        ),
+        "ply" => stage_ply(path, mesh.positions(), mesh.faces(), arrays),
+        _ => check_mesh_output(path).map(|()| unreachable!("not a mesh extension")),
+    }
+}
+
+/// Physical position of a grid vertex: origin + (c·dx, r·dy) with the signed spacing, as VTK
+/// places ImageData points.
+fn grid_point(grid: &Grid2d, v: usize) -> [f64; 3] {
+    let (r, c) = grid.row_col(v);
+    let ([dx, dy], [ox, oy]) = (grid.spacing(), grid.origin());
+    [ox + c as f64 * dx, oy + r as f64 * dy, 0.0]
+}
+
+/// The kept extrema, surviving saddles and separatrices as PolyData: vertex cells first
+/// (cell array `type`: −1 minimum, +1 maximum, 0 saddle), then one polyline per separatrix
+/// (`type` −1 descending to a minimum, +1 ascending to a maximum), with the input `h` as the
+/// point array `input`. Grid points are placed as VTK places ImageData points.
+pub fn complex_polydata(domain: &AnyDomain, h: &[f64], roles: &[Role], ms: &MorseSmale) -> PolyData {
+    let place = |v: usize| match domain {
+        AnyDomain::Series(_) => [v as f64, 0.0, 0.0],
+        AnyDomain::Grid(g) => grid_point(g, v),
+        AnyDomain::Mesh(m) => m.point(v),
+    };
+    let mut slot = std::collections::HashMap::new();
+    let mut points = Vec::new();
+    let mut values = Vec::new();
+    let mut id = |v: usize, points: &mut Vec<[f64; 3]>, values: &mut Vec<f64>| -> usize {
+        *slot.entry(v).or_insert_with(|| {
+            points.push(place(v));
+            values.push(h[v]);
+            points.len() - 1
+        })
+    };
+    let mut verts = Vec::new();
+    let mut types = Vec::new();
+    for (v, r) in roles.iter().enumerate() {
+        if matches!(r, Role::Min | Role::Max) {
+            verts.push(id(v, &mut points, &mut values));
+            types.push(f64::from(r.code()));
+        }
+    }
+    for &s in &ms.saddles {
+        verts.push(id(s, &mut points, &mut values));
+        types.push(0.0);
+    }
+    let mut lines = Vec::new();
+    for (list, t) in [(&ms.descending, -1.0), (&ms.ascending, 1.0)] {
+        for sep in list {
+            lines.push(sep.path.iter().map(|&v| id(v, &mut points, &mut values)).collect::<Vec<usize>>());
+            types.push(t);
+        }
+    }
+    PolyData {
+        points,
+        verts,
+        lines,
+        point_arrays: vec![("input".into(), values)],
+        cell_arrays: vec![("type".into(), types)],
+        ..Default::default()
+    }
+}
+
+/// Stages the complex at `path` as `.vtp` ([`complex_polydata`]).
+///
+/// # Errors
+/// As [`check_complex_output`]; I/O errors naming the file.
+pub fn stage_complex(path: &Path, domain: &AnyDomain, h: &[f64], roles: &[Role], ms: &MorseSmale) -> Result<Staged> {
+    check_complex_output(path, domain)?;
+    stage_vtp(path, &complex_polydata(domain, h, roles, ms))
+}
+
+/// A smoothing result read back from its file (for `verify`).
+#[derive(Clone, Debug)]
+pub struct Stored {
+    /// The domain: a series of the file's length, the grid with the file's geometry (`.npz`:
+    /// unit spacing), the validated mesh.
+    pub domain: AnyDomain,
+    /// The `input` array.
+    pub input: Vec<f64>,
+    /// The `smoothed` array (the series' `output` column).
+    pub smoothed: Vec<f64>,
+    /// The `representative` array (the series' `u` column).
+    pub representative: Vec<f64>,
+    /// The roles decoded from the `role` array or column.
+    pub roles: Vec<Role>,
+}
+
+/// Reads a result that [`stage_results`] wrote: `.vti`, `.npz`, a mesh (`.vtu`, `.vtp`,
+/// `.ply`) or a series CSV (any other extension).
+///
+/// # Errors
+/// I/O and input errors naming the file: a missing array, a role code that is none of SPEC's.
+pub fn read_results(path: &Path) -> Result<Stored> {
+    match extension(path).as_str() {
+        "vti" => {
+            let img = read_image(path)?;
+            let grid = Grid2d::with_geometry(img.nx, img.ny, img.spacing, img.origin).map_err(|e| e.in_file(path))?;
+            let arrays = img.arrays.into_iter().filter(|a| a.components == 1).map(|a| (a.name, a.values)).collect();
+            stored(path, AnyDomain::Grid(grid), arrays)
+        }
+        "npz" => {
+            let arrays = read_npz(path)?;
+            let Some((_, [ny, nx], _)) = arrays.first() else {
+                return Err(Error::input("the archive holds no arrays").in_file(path));
+            };
+            let grid = Grid2d::new(*nx, *ny).map_err(|e| e.in_file(path))?;
+            if let Some((name, shape, _)) = arrays.iter().find(|(_, s, _)| *s != [*ny, *nx]) {
+                return Err(Error::input(format!("array `{name}` has shape {shape:?}, the first {:?}", [*ny, *nx]))
+                    .in_file(path));
+            }
+            stored(path, AnyDomain::Grid(grid), arrays.into_iter().map(|(n, _, v)| (n, v)).collect())
+        }
+        e if MESH_OUTPUTS.contains(&e) => {
+            let (mesh, data) = read_trimesh(path)?;
+            results_on_mesh(path, mesh, &data)
+        }
+        _ => {
+            let out = read_series_output(path)?;
+            let domain = AnyDomain::Series(Series::uniform(out.input.len()));
+            Ok(Stored { domain, input: out.input, smoothed: out.output, representative: out.u, roles: out.roles })
+        }
+    }
+}
+
+/// The result arrays of a mesh already read.
+///
+/// # Errors
+/// As [`read_results`]; an array that is not one scalar per vertex.
+pub fn results_on_mesh(path: &Path, mesh: TriMesh, data: &MeshData) -> Result<Stored> {
+    let n = mesh.n_vertices();
+    let mut arrays = Vec::new();
+    for a in &data.arrays {
+        let verifiable = ["input", "smoothed", "representative", "role"].contains(&a.name.as_str());
+        if a.components == 1 && a.values.len() == n {
+            arrays.push((a.name.clone(), a.values.clone()));
+        } else if verifiable {
+            return Err(Error::input(format!(
+                "array `{}` has {} components ({} values for {n} vertices); a scalar is needed",
+                a.name,
+                a.components,
+                a.values.len()
+            ))
+            .in_file(path));
+        }
+    }
+    stored(path, AnyDomain::Mesh(mesh), arrays)
+}
+
+fn stored(path: &Path, domain: AnyDomain, mut arrays: Vec<(String, Vec<f64>)>) -> Result<Stored> {
+    let names: Vec<String> = arrays.iter().map(|(n, _)| n.clone()).collect();
+    let mut take = |name: &str| -> Result<Vec<f64>> {
+        match arrays.iter().position(|(n, _)| n == name) {
+            Some(i) => Ok(arrays.swap_remove(i).1),
+            None => Err(Error::input(format!(
+                "no array `{name}` (a verifiable output holds input, smoothed, representative, role; found {})",
+                names.join(", ")
+            ))
+            .in_file(path)),
+        }
+    };
+    let (input, smoothed, representative, role) =
+        (take("input")?, take("smoothed")?, take("representative")?, take("role")?);
+    let roles = role
+        .iter()
+        .enumerate()
+        .map(|(i, &c)| {
+            Role::from_code(c).ok_or_else(|| {
+                Error::input(format!("role {c} at {} is not one of −1, 0, 1, 2, 3", domain.describe_vertex(i)))
+                    .in_file(path)
+            })
+        })
+        .collect::<Result<Vec<Role>>>()?;
+    Ok(Stored { domain, input, smoothed, representative, roles })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn each_domain_names_its_own_formats() {
+        let grid = AnyDomain::Grid(Grid2d::new(3, 2).unwrap());
+        let series = AnyDomain::Series(Series::uniform(4));
+        assert!(check_output(Path::new("a.VTI"), &grid).is_ok());
+        let e = check_output(Path::new("a.vtu"), &grid).unwrap_err().to_string();
+        assert!(e.contains("a.vtu: the output of a grid is written as .vti, .npz, .npy, .csv"), "{e}");
+        assert!(check_output(Path::new("a.csv"), &series).is_ok());
+        assert!(check_output(Path::new("a.vti"), &series).is_err());
+        assert!(check_complex_output(Path::new("c.vtp"), &series).is_err());
+        assert!(check_complex_output(Path::new("c.vtp"), &grid).is_ok());
+        assert!(check_complex_output(Path::new("c.vtu"), &grid).is_err());
+    }
+
+    #[test]
+    fn a_grid_result_reads_back_as_written() {
+        let dir = std::env::temp_dir().join(format!("toposmooth-export-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let grid = Grid2d::with_geometry(3, 2, [0.5, -2.0], [1.0, 4.0]).unwrap();
+        let domain = AnyDomain::Grid(grid);
+        let h = [0.0, 1.0, 2.0, 3.0, 4.0, 5.5];
+        let roles = [Role::Min, Role::Other, Role::Other, Role::Other, Role::Other, Role::Max];
+        let r = Results { input: &h, smoothed: &h, representative: &h, roles: &roles, filled: None };
+        for ext in ["vti", "npz"] {
+            let path = dir.join(format!("r.{ext}"));
+            stage_results(&path, &domain, None, &r).unwrap().commit().unwrap();
+            let back = read_results(&path).unwrap();
+            assert_eq!((back.input, back.roles.as_slice()), (h.to_vec(), roles.as_slice()), "{ext}");
+            let AnyDomain::Grid(g) = back.domain else { panic!("{ext}: not a grid") };
+            assert_eq!((g.nx(), g.ny()), (3, 2));
+            if ext == "vti" {
+                assert_eq!((g.spacing(), g.origin()), ([0.5, -2.0], [1.0, 4.0]));
+            }
+        }
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}

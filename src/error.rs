@@ -32,6 +32,16 @@ pub enum Error {
     /// Invalid combination of settings (exit 2).
     #[error("usage: {0}")]
     Usage(String),
+    /// A setting out of range or not applicable to the domain (exit 2). `setting` is the
+    /// library's name for it (a field of the settings, as the Python keywords spell it); the
+    /// command-line tool words it as its flag ([`Error::setting`] makes one).
+    #[error("usage: {setting}: {message}")]
+    Setting {
+        /// The setting's name in the library (`data_weight`, `pairs`, `max_area`, …).
+        setting: &'static str,
+        /// What is wrong with it, without naming it.
+        message: String,
+    },
     /// The representative function could not be built for a kept set chosen by persistence:
     /// always our bug or a numerical failure (exit 1).
     #[error("{}representative function failed: {message}", prefix(path))]
@@ -75,6 +85,44 @@ pub enum Error {
         #[source]
         source: std::io::Error,
     },
+}
+
+/// A factorisation, solve or solver iteration that failed (faer's words, or the interior-point
+/// method's: no convergence, a vanishing step). On a well-posed system it is a numerical
+/// failure (a pivot lost to rounding, memory), never bad input: callers report it as
+/// an internal error or fall back to another solver.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("{0}")]
+pub struct NumericalError(pub String);
+
+impl From<String> for NumericalError {
+    fn from(message: String) -> Self {
+        NumericalError(message)
+    }
+}
+
+impl From<&str> for NumericalError {
+    fn from(message: &str) -> Self {
+        NumericalError(message.to_string())
+    }
+}
+
+impl From<NumericalError> for Error {
+    fn from(e: NumericalError) -> Self {
+        Error::internal(e.0)
+    }
+}
+
+/// Why a construction the pipeline may fall back from (a representative function, an ordered
+/// harmonic function) could not be made: the reason is reported beside the fallback.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum ConstructionError {
+    /// A linear solve failed.
+    #[error(transparent)]
+    Numerical(#[from] NumericalError),
+    /// The construction does not fit the data or the domain (what, where).
+    #[error("{0}")]
+    Unfit(String),
 }
 
 /// What kind of failure an [`Error`] is: one kind per exit status of SPEC.md's "Exit status"
@@ -122,6 +170,11 @@ impl Error {
         Error::Input { path: None, message: message.into() }
     }
 
+    /// A setting error ([`Error::Setting`]).
+    pub fn setting(setting: &'static str, message: impl Into<String>) -> Self {
+        Error::Setting { setting, message: message.into() }
+    }
+
     /// An internal error without a file.
     pub fn internal(message: impl Into<String>) -> Self {
         Error::Internal { path: None, message: message.into() }
@@ -145,7 +198,7 @@ impl Error {
                     *path = Some(file.into());
                 }
             }
-            Error::Usage(_) | Error::Io { .. } => {}
+            Error::Usage(_) | Error::Setting { .. } | Error::Io { .. } => {}
         }
         self
     }
@@ -153,7 +206,7 @@ impl Error {
     /// The kind of failure.
     pub fn kind(&self) -> ErrorKind {
         match self {
-            Error::Usage(_) => ErrorKind::Usage,
+            Error::Usage(_) | Error::Setting { .. } => ErrorKind::Usage,
             Error::Io { .. } => ErrorKind::Io,
             Error::Input { .. } => ErrorKind::Input,
             Error::Infeasible { .. } => ErrorKind::Infeasible,
@@ -173,7 +226,7 @@ impl Error {
             | Error::Uncertified { path, .. }
             | Error::NoSolution { path, .. } => path.as_deref(),
             Error::Io { path, .. } => Some(path),
-            Error::Usage(_) => None,
+            Error::Usage(_) | Error::Setting { .. } => None,
         }
     }
 
@@ -192,6 +245,7 @@ mod tests {
         let io = Error::Io { path: "f".into(), source: std::io::Error::other("x") };
         let cases = [
             (Error::Usage("u".into()), ErrorKind::Usage, 2),
+            (Error::setting("data_weight", "must be ≥ 0"), ErrorKind::Usage, 2),
             (io, ErrorKind::Io, 3),
             (Error::input("i"), ErrorKind::Input, 3),
             (Error::infeasible("f"), ErrorKind::Infeasible, 3),

@@ -12,6 +12,7 @@
 //! ranks (a strictly increasing relabelling), which orient every edge as the exact sums do.
 
 use crate::domain::Domain;
+use crate::error::ConstructionError;
 use crate::operators::{dirichlet_solve, Sparse};
 use faer::sparse::Triplet;
 use std::cmp::Ordering;
@@ -104,7 +105,7 @@ pub fn ordered_harmonic<D: Domain>(
     k: &Sparse,
     fixed: &[Option<f64>],
     analyses: Option<&mut crate::linalg::Analyses>,
-) -> Result<(Vec<f64>, usize), String> {
+) -> Result<(Vec<f64>, usize), ConstructionError> {
     let n = domain.n_vertices();
     let u = crate::operators::dirichlet_solve_with(k, fixed, analyses)?;
     let mut phi: Vec<Vec<f64>> = u.iter().map(|&x| vec![x]).collect();
@@ -132,11 +133,11 @@ pub fn ordered_harmonic<D: Domain>(
             })
             .collect();
         if levels == MAX_LEVELS {
-            return Err(format!(
+            return Err(ConstructionError::Unfit(format!(
                 "{} vertices (first {}) are still not strictly regular after {MAX_LEVELS} refinements of the harmonic order",
                 bad.len(),
                 bad[0]
-            ));
+            )));
         }
         levels += 1;
         // the region: irregular and flat vertices grown by one ring of free vertices
@@ -181,15 +182,17 @@ pub fn ordered_harmonic<D: Domain>(
             boundary.sort_unstable();
             boundary.dedup();
             if boundary.is_empty() {
-                return Err(format!("vertex {s} lies in a part of the domain that touches no handle"));
+                return Err(ConstructionError::Unfit(format!(
+                    "vertex {s} lies in a part of the domain that touches no handle"
+                )));
             }
             let base = phi[boundary[0]].clone();
             let data: Vec<f64> = boundary.iter().map(|&b| approx_difference(&phi[b], &base)).collect();
             if data.iter().all(|&d| d == 0.0) {
-                return Err(format!(
+                return Err(ConstructionError::Unfit(format!(
                     "the harmonic order is exactly flat around vertex {s} (all {} boundary values equal)",
                     boundary.len()
-                ));
+                )));
             }
             // local Dirichlet problem on part ∪ boundary
             let mut slot = vec![usize::MAX; n];
@@ -209,7 +212,8 @@ pub fn ordered_harmonic<D: Domain>(
                 }
             }
             let m = local.len();
-            let sub = Sparse::try_new_from_triplets(m, m, &t).map_err(|e| format!("{e:?}"))?;
+            let sub =
+                Sparse::try_new_from_triplets(m, m, &t).map_err(|e| crate::error::NumericalError(format!("{e:?}")))?;
             let mut lf: Vec<Option<f64>> = vec![None; m];
             for (j, &d) in data.iter().enumerate() {
                 lf[part.len() + j] = Some(d);

@@ -563,7 +563,7 @@ fn main() {
     match run(Cli::parse()) {
         Ok(text) => print!("{text}"),
         Err(e) => {
-            eprintln!("error: {e}");
+            eprintln!("error: {}", commands::cli_message(&e));
             std::process::exit(e.exit_code());
         }
     }

@@ -18,7 +18,7 @@
 //! ```
 
 use crate::domain::{Domain, Series};
-use crate::error::{Error, Result};
+use crate::error::{ConstructionError, Error, Result};
 use crate::topology::{KeptSet, Role};
 
 /// Builds u on a series from the kept set: linear in x between consecutive kept extrema,
@@ -190,7 +190,7 @@ pub fn separatrix_representative<D: crate::domain::Domain>(
     k: &crate::operators::Sparse,
     move_kept: bool,
     analyses: &mut crate::linalg::Analyses,
-) -> std::result::Result<(Vec<f64>, Repairs), String> {
+) -> std::result::Result<(Vec<f64>, Repairs), ConstructionError> {
     let n = h.len();
     let mut down = vec![f64::INFINITY; n];
     let mut up = vec![f64::NEG_INFINITY; n];
@@ -336,7 +336,9 @@ pub fn separatrix_representative<D: crate::domain::Domain>(
             return Ok((u, repairs));
         }
     }
-    Err(format!("separatrix vertices still contradict each other after {MAX_RELEASE_ROUNDS} rounds of releasing them"))
+    Err(ConstructionError::Unfit(format!(
+        "separatrix vertices still contradict each other after {MAX_RELEASE_ROUNDS} rounds of releasing them"
+    )))
 }
 
 /// What [`separatrix_representative`] changed in the paper's construction.
@@ -366,7 +368,7 @@ fn outward_moves<D: crate::domain::Domain>(
     dirichlet: &mut crate::operators::Dirichlet,
     k: &crate::operators::Sparse,
     unit: f64,
-) -> std::result::Result<Vec<(usize, f64)>, String> {
+) -> std::result::Result<Vec<(usize, f64)>, ConstructionError> {
     // +1 for a maximum (moves up), −1 for a minimum
     let outward = |v: usize| if kept.roles[v] == Role::Max { 1.0 } else { -1.0 };
     let failing: Vec<usize> = (0..u.len())

@@ -197,7 +197,7 @@ fn input_errors_exit_3_naming_the_file() {
     );
     assert_input_error(
         &["smooth", &good, "--sharp", "17", "-o", &o],
-        &["good.csv", "--sharp vertex 17", "out of range"],
+        &["good.csv", "sharp vertex 17", "out of range"],
         Some(&out),
     );
     let missing = dir.join("nope.csv").display().to_string();

@@ -124,7 +124,7 @@ fn interpolate(mesh: &TriMesh, fields: &[Vec<f64>], points: &[[f64; 3]]) -> Resu
 /// Checks a requested largest triangle area of the cage's triangulation (finite, > 0).
 ///
 /// # Errors
-/// [`Error::Usage`] naming `--cage-max-area`.
+/// [`Error::Setting`] naming `cage_max_area`.
 pub fn check_max_area(max_area: Option<f64>) -> Result<()> {
     match max_area {
         Some(a) if !(a.is_finite() && a > 0.0) => {
@@ -133,7 +133,7 @@ pub fn check_max_area(max_area: Option<f64>) -> Result<()> {
             } else {
                 format!("{a}")
             };
-            Err(Error::Usage(format!("--cage-max-area must be finite and > 0, got {shown}")))
+            Err(Error::setting("cage_max_area", format!("must be finite and > 0, got {shown}")))
         }
         _ => Ok(()),
     }
@@ -178,10 +178,13 @@ pub fn cage_weights(
     let area = max_area.unwrap_or(mean_area);
     let estimate = outline.area() / area;
     if estimate > MAX_TRIANGLES {
-        return Err(Error::Usage(format!(
-            "a largest triangle area of {area:e}{} asks for about {estimate:.3e} triangles in the cage (at most {MAX_TRIANGLES:e}): raise --cage-max-area",
-            if max_area.is_none() { " (the shape's mean)" } else { "" }
-        )));
+        return Err(Error::setting(
+            "cage_max_area",
+            format!(
+                "a largest triangle area of {area:e}{} asks for about {estimate:.3e} triangles in the cage (at most {MAX_TRIANGLES:e}): raise it",
+                if max_area.is_none() { " (the shape's mean)" } else { "" }
+            ),
+        ));
     }
     let cage_mesh = triangulate(&outline, Some(area), 25.0)?;
     let params = boundary_parameters(&cage_mesh, cage);

@@ -10,6 +10,7 @@
 
 use crate::domain::vec3::{cross, dot, sub};
 use crate::domain::TriMesh;
+use crate::error::{Error, Result};
 use crate::linalg::SpdSolver;
 use crate::operators::{cotan_stiffness, lumped_mass, Sparse};
 
@@ -69,7 +70,7 @@ fn upper(
 /// # Errors
 /// A message for no source, a source out of range, or a factorisation failure (a component
 /// with no source gets no finite distance: refused).
-pub fn heat_geodesic(mesh: &TriMesh, sources: &[usize]) -> Result<(Vec<f64>, GeodesicSeconds), String> {
+pub fn heat_geodesic(mesh: &TriMesh, sources: &[usize]) -> Result<(Vec<f64>, GeodesicSeconds)> {
     heat_geodesic_with(mesh, sources, &mut crate::linalg::Analyses::default())
 }
 
@@ -82,17 +83,17 @@ pub fn heat_geodesic_with(
     mesh: &TriMesh,
     sources: &[usize],
     analyses: &mut crate::linalg::Analyses,
-) -> Result<(Vec<f64>, GeodesicSeconds), String> {
+) -> Result<(Vec<f64>, GeodesicSeconds)> {
     let t0 = std::time::Instant::now();
     let mut seconds = GeodesicSeconds::default();
     let p = mesh.positions();
     let tris = mesh.faces();
     let n = p.len();
     if sources.is_empty() {
-        return Err("no source vertex".into());
+        return Err(Error::input("no source vertex"));
     }
     if let Some(&s) = sources.iter().find(|&&s| s >= n) {
-        return Err(format!("source vertex {s} is out of range (the mesh has {n} vertices)"));
+        return Err(Error::input(format!("source vertex {s} is out of range (the mesh has {n} vertices)")));
     }
     let comps = mesh.components();
     let mut reached = vec![false; mesh.n_components()];
@@ -101,7 +102,9 @@ pub fn heat_geodesic_with(
     }
     if let Some(c) = reached.iter().position(|r| !r) {
         let v = comps.iter().position(|&x| x == c).unwrap_or(0);
-        return Err(format!("component {c} (vertex {v}, …) has no source: its distance would be infinite"));
+        return Err(Error::input(format!(
+            "component {c} (vertex {v}, …) has no source: its distance would be infinite"
+        )));
     }
     let k = cotan_stiffness(p, tris);
     let m = lumped_mass(p, tris);
@@ -120,12 +123,12 @@ pub fn heat_geodesic_with(
     let (pattern, heat_values) = upper(&k, time, &m, &none);
     let mut solver = SpdSolver::new(pattern.as_ref(), analyses)?;
     seconds.setup = t0.elapsed().as_secs_f64();
-    let factor_failed = |e: String| {
+    let factor_failed = |e: crate::error::NumericalError| {
         let (worst, angle) = mesh.smallest_angle();
-        format!(
+        Error::input(format!(
             "the sparse Cholesky factorisation failed ({e}): the mesh has nearly degenerate triangles \
              (smallest angle {angle:.2e}° in triangle {worst})"
-        )
+        ))
     };
 
     // heat: (M + tK) u = δ_sources. With t = h² the heat decays like exp(−d²/4t): on a fine
@@ -148,7 +151,7 @@ pub fn heat_geodesic_with(
             break u;
         }
         if scale >= 4f64.powi(10) {
-            return Err(format!("the heat does not reach {cold} vertices even with t = {scale} h²"));
+            return Err(Error::input(format!("the heat does not reach {cold} vertices even with t = {scale} h²")));
         }
         scale *= 4.0;
         heat_values = upper(&k, time * scale, &m, &none).1;
@@ -266,6 +269,6 @@ mod tests {
     fn bad_sources_are_refused() {
         let m = shapes::disk(4, 12, &[]);
         assert!(heat_geodesic(&m, &[]).is_err());
-        assert!(heat_geodesic(&m, &[10_000]).unwrap_err().contains("out of range"));
+        assert!(heat_geodesic(&m, &[10_000]).unwrap_err().to_string().contains("out of range"));
     }
 }

@@ -161,12 +161,16 @@ pub fn parse_handles(text: &str) -> Result<HandleFile> {
 ///
 /// # Errors
 /// A message saying what is wrong with the name.
-pub fn check_name(name: &str) -> std::result::Result<(), String> {
+pub fn check_name(name: &str) -> Result<()> {
     if name.is_empty() || !name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-') {
-        return Err(format!("name `{name}` must be non-empty ASCII letters, digits, `_` or `-` (it names arrays)"));
+        return Err(Error::input(format!(
+            "name `{name}` must be non-empty ASCII letters, digits, `_` or `-` (it names arrays)"
+        )));
     }
     if name.ends_with("_raw") || name.ends_with("_interpolated") {
-        return Err(format!("name `{name}` must not end in `_raw` or `_interpolated` (suffixes of other arrays)"));
+        return Err(Error::input(format!(
+            "name `{name}` must not end in `_raw` or `_interpolated` (suffixes of other arrays)"
+        )));
     }
     Ok(())
 }

@@ -66,9 +66,9 @@ pub fn read_outline(path: &Path) -> Result<Outline> {
         "json" => read_json(&bytes),
         "svg" => svg::read_svg(&bytes),
         "png" => png::read_png(&bytes),
-        other => Err(format!("`.{other}` is not an outline format (json, svg, png)")),
+        other => Err(Error::input(format!("`.{other}` is not an outline format (json, svg, png)"))),
     }
-    .map_err(|m| Error::input(m).in_file(path))?;
+    .map_err(|e| e.in_file(path))?;
     let outline = Outline { loops }.cleaned();
     if outline.loops.is_empty() {
         return Err(Error::input("the file holds no outline").in_file(path));
@@ -76,34 +76,36 @@ pub fn read_outline(path: &Path) -> Result<Outline> {
     Ok(outline)
 }
 
-fn read_json(bytes: &[u8]) -> std::result::Result<Vec<Vec<[f64; 2]>>, String> {
+fn read_json(bytes: &[u8]) -> Result<Vec<Vec<[f64; 2]>>> {
     const FORM: &str = r#"{"outline": [[x, y], ...], "holes": [[[x, y], ...], ...]}"#;
-    let value: serde_json::Value = serde_json::from_slice(bytes).map_err(|e| format!("not valid JSON: {e}"))?;
-    let obj = value.as_object().ok_or_else(|| format!("the outline must be a JSON object {FORM}"))?;
+    let value: serde_json::Value =
+        serde_json::from_slice(bytes).map_err(|e| Error::input(format!("not valid JSON: {e}")))?;
+    let obj = value.as_object().ok_or_else(|| Error::input(format!("the outline must be a JSON object {FORM}")))?;
     if let Some(key) = obj.keys().find(|k| !["outline", "cage", "holes"].contains(&k.as_str())) {
-        return Err(format!("unknown key `{key}`; expected {FORM}"));
+        return Err(Error::input(format!("unknown key `{key}`; expected {FORM}")));
     }
     let (key, outer) = match (obj.get("outline"), obj.get("cage")) {
         (Some(o), None) => ("outline", o),
         (None, Some(c)) => ("cage", c),
-        (Some(_), Some(_)) => return Err("give either `outline` or `cage`, not both".into()),
-        (None, None) => return Err(format!("no `outline` key; expected {FORM}")),
+        (Some(_), Some(_)) => return Err(Error::input("give either `outline` or `cage`, not both")),
+        (None, None) => return Err(Error::input(format!("no `outline` key; expected {FORM}"))),
     };
-    let points = |v: &serde_json::Value, what: &str| -> std::result::Result<Vec<[f64; 2]>, String> {
-        let list = v.as_array().ok_or_else(|| format!("{what} must be a list of [x, y] points"))?;
+    let points = |v: &serde_json::Value, what: &str| -> Result<Vec<[f64; 2]>> {
+        let list = v.as_array().ok_or_else(|| Error::input(format!("{what} must be a list of [x, y] points")))?;
         list.iter()
             .enumerate()
             .map(|(i, p)| match p.as_array().map(|a| a.iter().map(|x| x.as_f64()).collect::<Vec<_>>()) {
                 Some(c) if c.len() == 2 && c.iter().all(Option::is_some) => {
                     Ok([c[0].unwrap_or_default(), c[1].unwrap_or_default()])
                 }
-                _ => Err(format!("{what}: point {i} is `{p}`, not [x, y]")),
+                _ => Err(Error::input(format!("{what}: point {i} is `{p}`, not [x, y]"))),
             })
             .collect()
     };
     let mut loops = vec![points(outer, &format!("`{key}`"))?];
     if let Some(holes) = obj.get("holes") {
-        let list = holes.as_array().ok_or("`holes` must be a list of loops [[[x, y], ...], ...]")?;
+        let list =
+            holes.as_array().ok_or_else(|| Error::input("`holes` must be a list of loops [[[x, y], ...], ...]"))?;
         for (h, hole) in list.iter().enumerate() {
             loops.push(points(hole, &format!("`holes` loop {h} (hole {})", h + 1))?);
         }
@@ -115,17 +117,20 @@ fn read_json(bytes: &[u8]) -> std::result::Result<Vec<Vec<[f64; 2]>>, String> {
 /// `0..=`[`MAX_MIN_ANGLE`].
 ///
 /// # Errors
-/// [`Error::Usage`] naming the setting.
+/// [`Error::Setting`] naming the setting.
 pub fn check_settings(max_area: Option<f64>, min_angle_deg: f64) -> Result<()> {
     if let Some(a) = max_area {
         if !(a.is_finite() && a > 0.0) {
-            return Err(Error::Usage(format!("--max-area must be a positive number, got {a}")));
+            return Err(Error::setting("max_area", format!("must be a positive number, got {a}")));
         }
     }
     if !(min_angle_deg.is_finite() && (0.0..=MAX_MIN_ANGLE).contains(&min_angle_deg)) {
-        return Err(Error::Usage(format!(
-            "--min-angle must be between 0 and {MAX_MIN_ANGLE} degrees (refinement may not end above ~30°), got {min_angle_deg}"
-        )));
+        return Err(Error::setting(
+            "min_angle",
+            format!(
+                "must be between 0 and {MAX_MIN_ANGLE} degrees (refinement may not end above ~30°), got {min_angle_deg}"
+            ),
+        ));
     }
     Ok(())
 }
@@ -142,7 +147,7 @@ pub fn check_settings(max_area: Option<f64>, min_angle_deg: f64) -> Result<()> {
 /// The caller reports the counts and [`TriMesh::smallest_angle`].
 ///
 /// # Errors
-/// [`Error::Usage`] for settings out of range ([`check_settings`]) or a `max_area` asking for
+/// [`Error::Setting`] for settings out of range ([`check_settings`]) or a `max_area` asking for
 /// more than [`MAX_TRIANGLES`] triangles; [`Error::Input`] for an invalid outline, a
 /// coordinate the triangulation cannot take (|x| above about 1e60 or below 1e-42, other
 /// than 0), or a refinement that stops at its vertex limit (sharp corners of the outline with
@@ -155,10 +160,13 @@ pub fn triangulate(outline: &Outline, max_area: Option<f64>, min_angle_deg: f64)
     let max_area = max_area.unwrap_or((hi[0] - lo[0]) * (hi[1] - lo[1]) / DEFAULT_AREA_DIVISOR);
     let estimate = outline.area() / max_area;
     if estimate > MAX_TRIANGLES {
-        return Err(Error::Usage(format!(
-            "--max-area {max_area} asks for more than {estimate:.3e} triangles over an area of {}; at most {MAX_TRIANGLES:e} are made: raise it",
-            short(outline.area())
-        )));
+        return Err(Error::setting(
+            "max_area",
+            format!(
+                "{max_area} asks for more than {estimate:.3e} triangles over an area of {}; at most {MAX_TRIANGLES:e} are made: raise it",
+                short(outline.area())
+            ),
+        ));
     }
     let mut cdt = ConstrainedDelaunayTriangulation::<Point2<f64>>::new();
     let mut handles = Vec::with_capacity(outline.loops.len());

@@ -330,7 +330,7 @@ pub fn weights<D: Smoothable + Sync>(domain: &D, handles: &[Vec<usize>], setting
         return Err(Error::input(format!("at least two handles are needed, got {}", handles.len())));
     }
     if !(1..=4).contains(&settings.order) {
-        return Err(Error::Usage(format!("--order must be 1, 2, 3 or 4, got {}", settings.order)));
+        return Err(Error::setting("order", format!("must be 1, 2, 3 or 4, got {}", settings.order)));
     }
     let mut owner = vec![usize::MAX; n];
     for (k, set) in handles.iter().enumerate() {
@@ -567,6 +567,9 @@ mod tests {
         assert!(weights(&g, &[vec![0], vec![0]], &s).unwrap_err().to_string().contains("both select vertex 0"));
         assert!(weights(&g, &[vec![0], vec![]], &s).is_err());
         assert!(weights(&g, &[vec![0], vec![10_000]], &s).is_err());
-        assert!(matches!(weights(&g, &[vec![0], vec![1]], &WeightSettings { order: 5, ..s }), Err(Error::Usage(_))));
+        assert!(matches!(
+            weights(&g, &[vec![0], vec![1]], &WeightSettings { order: 5, ..s }),
+            Err(Error::Setting { setting: "order", .. })
+        ));
     }
 }

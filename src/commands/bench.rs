@@ -235,8 +235,8 @@ fn run_single(case: BenchCase, args: &BenchArgs) -> Result<String> {
             let tg = Instant::now();
             // the smoothing's harmonic fills reuse the Laplacian's analysis the heat method made
             let mut analyses = crate::linalg::Analyses::default();
-            let (h, _) = crate::apps::geodesic::heat_geodesic_with(&mesh, &[0], &mut analyses)
-                .map_err(|m| Error::input(m).in_file(path))?;
+            let (h, _) =
+                crate::apps::geodesic::heat_geodesic_with(&mesh, &[0], &mut analyses).map_err(|e| e.in_file(path))?;
             let geodesic = tg.elapsed().as_secs_f64();
             extra = serde_json::json!({ "read": read, "geodesic": geodesic, "triangles": mesh.faces().len() });
             settings.selection = Selection::AllMaxima;

@@ -48,7 +48,7 @@ pub fn geodesic(args: &GeodesicArgs) -> Result<String> {
     let start = Instant::now();
     let (mesh, _) = read_trimesh(&args.input)?;
     let read_seconds = start.elapsed().as_secs_f64();
-    let (distance, seconds) = heat_geodesic(&mesh, &args.sources).map_err(|m| Error::input(m).in_file(&args.input))?;
+    let (distance, seconds) = heat_geodesic(&mesh, &args.sources).map_err(|e| e.in_file(&args.input))?;
     let t = Instant::now();
     let (farthest, max) =
         distance.iter().enumerate().fold((0, f64::NEG_INFINITY), |a, (i, &d)| if d > a.1 { (i, d) } else { a });

@@ -138,7 +138,7 @@ pub fn read_mesh_field(path: &Path, opts: &GridOptions) -> Result<MeshInput> {
             (values, format!("values from {}", file.display()), file.clone())
         }
         (None, Some(name)) => {
-            let a = data.array(name).map_err(|m| Error::input(m).in_file(path))?;
+            let a = data.array(name).map_err(|e| e.in_file(path))?;
             if a.components != 1 {
                 return Err(Error::input(format!(
                     "array `{name}` has {} components; a scalar is needed",

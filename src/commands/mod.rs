@@ -45,6 +45,24 @@ pub fn parse_persistence(s: &str) -> Result<Selection> {
     Ok(if relative { Selection::Relative(v / 100.0) } else { Selection::Absolute(v) })
 }
 
+/// An error as the command line words it: a setting the library names (`data_weight`) is
+/// named by its flag (`--data-weight`).
+pub fn cli_message(e: &Error) -> String {
+    match e {
+        Error::Setting { setting, message } => format!("usage: {}: {message}", flag(setting)),
+        e => e.to_string(),
+    }
+}
+
+/// The flag of a setting of the library.
+fn flag(setting: &str) -> String {
+    match setting {
+        "all_extrema" => "--keep-all-maxima/--keep-all-minima".into(),
+        "count" => "--minima/--maxima".into(),
+        s => format!("--{}", s.replace('_', "-")),
+    }
+}
+
 /// A number rounded to 6 significant digits, printed in its shortest form (for tables).
 pub fn sig6(v: f64) -> String {
     if v != 0.0 && v.abs() < 1e-4 {
@@ -141,5 +159,8 @@ mod tests {
         assert_eq!(sig6(1.8600000000000003), "1.86");
         assert_eq!(sig6(0.011692000000000001), "0.011692");
         assert!(parse_indices("1,x").is_err());
+        let e = Error::setting("data_weight", "must be finite and ≥ 0, got -1");
+        assert_eq!(cli_message(&e), "usage: --data-weight: must be finite and ≥ 0, got -1");
+        assert_eq!(cli_message(&Error::setting("count", "x")), "usage: --minima/--maxima: x");
     }
 }

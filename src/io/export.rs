@@ -69,9 +69,9 @@ pub fn check_mesh_output(path: &Path) -> Result<()> {
 /// [`Error::Usage`] for a series (it has no separatrices) or another extension.
 pub fn check_complex_output(path: &Path, domain: &AnyDomain) -> Result<()> {
     if let AnyDomain::Series(_) = domain {
-        return Err(Error::Usage("--complex is for grids (a series has no separatrices)".into()));
+        return Err(Error::setting("complex", "is for grids and meshes (a series has no separatrices)"));
     }
-    check_extension(path, &["vtp"], "--complex")
+    check_extension(path, &["vtp"], "the complex")
 }
 
 /// Role codes as Float64 (SPEC.md: −1 kept min, +1 kept max, 2 fixed, 3 end, 0 other).

@@ -77,7 +77,7 @@ pub fn read_grid_csv(path: &Path) -> Result<GridField> {
 /// Input errors: not an .npy file, a shape that is not 2D, an unsupported dtype, truncated data.
 pub fn read_npy(path: &Path) -> Result<GridField> {
     let bytes = std::fs::read(path).map_err(|e| io_err(path, e))?;
-    let ([ny, nx], values) = super::npz::decode_npy(&bytes).map_err(|e| err(path, e))?;
+    let ([ny, nx], values) = super::npz::decode_npy(&bytes).map_err(|e| e.in_file(path))?;
     finish(path, nx, ny, values, "values".into())
 }
 

@@ -47,7 +47,7 @@ impl MeshData {
     ///
     /// # Errors
     /// A message listing the arrays there are.
-    pub fn array(&self, name: &str) -> std::result::Result<PointArray, String> {
+    pub fn array(&self, name: &str) -> Result<PointArray> {
         if let Some(a) = self.arrays.iter().find(|a| a.name == name) {
             return Ok(a.clone());
         }
@@ -58,7 +58,7 @@ impl MeshData {
                 values: self.positions.iter().map(|p| p[k]).collect(),
             });
         }
-        Err(format!("no vertex array `{name}`; there are: {}", self.names().join(", ")))
+        Err(Error::input(format!("no vertex array `{name}`; there are: {}", self.names().join(", "))))
     }
 }
 
@@ -109,9 +109,9 @@ pub fn read_mesh(path: &Path) -> Result<MeshData> {
         "off" => read_off(&bytes),
         "ply" => read_ply(&bytes),
         "vtu" | "vtp" | "vtk" => read_vtk(&bytes, &extension(path)),
-        other => Err(format!("`.{other}` is not a mesh format (obj, off, ply, vtu, vtp, vtk)")),
+        other => Err(Error::input(format!("`.{other}` is not a mesh format (obj, off, ply, vtu, vtp, vtk)"))),
     }
-    .map_err(|m| input(path, m))?;
+    .map_err(|e| e.in_file(path))?;
     if data.triangles.is_empty() {
         return Err(input(path, "the file holds no triangle"));
     }
@@ -157,8 +157,8 @@ fn polygon_note(split: usize, notes: &mut Vec<String>) {
 /// Written here rather than with tobj: tobj numbers vertices in the order faces first use
 /// them and drops unused ones, but vertex indices must follow the file (`--values`,
 /// `--source`, `--keep-min` refer to them) and unused vertices must be reported.
-fn read_obj(bytes: &[u8]) -> std::result::Result<MeshData, String> {
-    let text = std::str::from_utf8(bytes).map_err(|_| "an OBJ file must be text (UTF-8)".to_string())?;
+fn read_obj(bytes: &[u8]) -> Result<MeshData> {
+    let text = std::str::from_utf8(bytes).map_err(|_| Error::input("an OBJ file must be text (UTF-8)"))?;
     let mut data = MeshData::default();
     let mut split = 0;
     let mut faces: Vec<(usize, Vec<i64>, i64)> = Vec::new();
@@ -169,8 +169,10 @@ fn read_obj(bytes: &[u8]) -> std::result::Result<MeshData, String> {
             Some("v") => {
                 let mut c = [0.0f64; 3];
                 for (k, slot) in c.iter_mut().enumerate() {
-                    let t = tokens.next().ok_or_else(|| format!("line {}: a vertex has {k} coordinates", l + 1))?;
-                    *slot = t.parse().map_err(|_| format!("line {}: `{t}` is not a number", l + 1))?;
+                    let t = tokens
+                        .next()
+                        .ok_or_else(|| Error::input(format!("line {}: a vertex has {k} coordinates", l + 1)))?;
+                    *slot = t.parse().map_err(|_| Error::input(format!("line {}: `{t}` is not a number", l + 1)))?;
                 }
                 data.positions.push(c);
             }
@@ -178,9 +180,10 @@ fn read_obj(bytes: &[u8]) -> std::result::Result<MeshData, String> {
                 let idx: Vec<i64> = tokens
                     .map(|t| {
                         let v = t.split('/').next().unwrap_or("");
-                        v.parse::<i64>().map_err(|_| format!("line {}: `{t}` is not a vertex reference", l + 1))
+                        v.parse::<i64>()
+                            .map_err(|_| Error::input(format!("line {}: `{t}` is not a vertex reference", l + 1)))
                     })
-                    .collect::<std::result::Result<_, _>>()?;
+                    .collect::<Result<_, _>>()?;
                 faces.push((l + 1, idx, data.positions.len() as i64));
             }
             _ => {}
@@ -189,7 +192,7 @@ fn read_obj(bytes: &[u8]) -> std::result::Result<MeshData, String> {
     let n = data.positions.len() as i64;
     for (line, idx, before) in faces {
         if idx.len() < 3 {
-            return Err(format!("line {line}: a face has {} corners", idx.len()));
+            return Err(Error::input(format!("line {line}: a face has {} corners", idx.len())));
         }
         // negative indices count back from the last vertex read before the face
         let face: Vec<usize> = idx
@@ -197,12 +200,14 @@ fn read_obj(bytes: &[u8]) -> std::result::Result<MeshData, String> {
             .map(|&i| {
                 let v = if i > 0 { i - 1 } else { before + i };
                 if i == 0 || v < 0 || v >= n {
-                    Err(format!("line {line}: vertex reference {i} is out of range (there are {n} vertices)"))
+                    Err(Error::input(format!(
+                        "line {line}: vertex reference {i} is out of range (there are {n} vertices)"
+                    )))
                 } else {
                     Ok(v as usize)
                 }
             })
-            .collect::<std::result::Result<_, _>>()?;
+            .collect::<Result<_, _>>()?;
         if face.len() > 3 {
             split += 1;
         }
@@ -214,72 +219,73 @@ fn read_obj(bytes: &[u8]) -> std::result::Result<MeshData, String> {
 
 /// OFF (ascii): the `OFF` keyword (optional), counts, one vertex per line (values after x y z,
 /// such as colours, ignored), one face per line (`k i1 … ik`, values after them ignored).
-fn read_off(bytes: &[u8]) -> std::result::Result<MeshData, String> {
-    let text = std::str::from_utf8(bytes).map_err(|_| "an OFF file must be text (binary OFF is not supported)")?;
+fn read_off(bytes: &[u8]) -> Result<MeshData> {
+    let text = std::str::from_utf8(bytes)
+        .map_err(|_| Error::input("an OFF file must be text (binary OFF is not supported)"))?;
     // non-empty lines with their numbers, comments removed
     let mut lines = text
         .lines()
         .enumerate()
         .map(|(l, line)| (l + 1, line.split('#').next().unwrap_or("").split_whitespace().collect::<Vec<&str>>()))
         .filter(|(_, t)| !t.is_empty());
-    let (mut l, mut first) = lines.next().ok_or("the file is empty")?;
+    let (mut l, mut first) = lines.next().ok_or_else(|| Error::input("the file is empty"))?;
     if first[0] != "OFF" && first[0].ends_with("OFF") {
-        return Err(format!(
+        return Err(Error::input(format!(
             "line {l}: `{}` variants (colours, normals, texture) are not supported; use plain OFF",
             first[0]
-        ));
+        )));
     }
     if first[0] == "OFF" {
         first.remove(0);
         if first.is_empty() {
-            (l, first) = lines.next().ok_or("the file ends before the counts")?;
+            (l, first) = lines.next().ok_or_else(|| Error::input("the file ends before the counts"))?;
         }
     }
-    let num = |t: &str, l: usize, what: &str| -> std::result::Result<f64, String> {
-        t.parse::<f64>().map_err(|_| format!("line {l}: `{t}` is not a number ({what})"))
+    let num = |t: &str, l: usize, what: &str| -> Result<f64> {
+        t.parse::<f64>().map_err(|_| Error::input(format!("line {l}: `{t}` is not a number ({what})")))
     };
-    let count = |t: &str, l: usize, what: &str| -> std::result::Result<usize, String> {
+    let count = |t: &str, l: usize, what: &str| -> Result<usize> {
         let v = num(t, l, what)?;
         if v >= 0.0 && v.fract() == 0.0 && v < 1e12 {
             Ok(v as usize)
         } else {
-            Err(format!("line {l}: {what} {v} is not a count"))
+            Err(Error::input(format!("line {l}: {what} {v} is not a count")))
         }
     };
     if first.len() < 2 {
-        return Err(format!("line {l}: expected the vertex, face and edge counts"));
+        return Err(Error::input(format!("line {l}: expected the vertex, face and edge counts")));
     }
     let nv = count(first[0], l, "vertex count")?;
     let nf = count(first[1], l, "face count")?;
     let mut data = MeshData::default();
     for _ in 0..nv {
-        let (l, t) = lines.next().ok_or("the file ends before all vertices are read")?;
+        let (l, t) = lines.next().ok_or_else(|| Error::input("the file ends before all vertices are read"))?;
         if t.len() < 3 {
-            return Err(format!("line {l}: a vertex needs 3 coordinates"));
+            return Err(Error::input(format!("line {l}: a vertex needs 3 coordinates")));
         }
         data.positions.push([num(t[0], l, "x")?, num(t[1], l, "y")?, num(t[2], l, "z")?]);
     }
     let mut split = 0;
     for f in 0..nf {
-        let (l, t) = lines.next().ok_or("the file ends before all faces are read")?;
+        let (l, t) = lines.next().ok_or_else(|| Error::input("the file ends before all faces are read"))?;
         let k = count(t[0], l, "corner count")?;
         if k < 3 {
-            return Err(format!("line {l}: face {f} has {k} corners"));
+            return Err(Error::input(format!("line {l}: face {f} has {k} corners")));
         }
         if t.len() < k + 1 {
-            return Err(format!("line {l}: face {f} lists {} of its {k} corners", t.len() - 1));
+            return Err(Error::input(format!("line {l}: face {f} lists {} of its {k} corners", t.len() - 1)));
         }
         let face: Vec<usize> = t[1..=k]
             .iter()
             .map(|x| {
                 let v = count(x, l, "vertex index")?;
                 if v >= nv {
-                    Err(format!("line {l}: face {f} refers to vertex {v} but there are {nv} vertices"))
+                    Err(Error::input(format!("line {l}: face {f} refers to vertex {v} but there are {nv} vertices")))
                 } else {
                     Ok(v)
                 }
             })
-            .collect::<std::result::Result<_, _>>()?;
+            .collect::<Result<_, _>>()?;
         if k > 3 {
             split += 1;
         }
@@ -289,11 +295,11 @@ fn read_off(bytes: &[u8]) -> std::result::Result<MeshData, String> {
     Ok(data)
 }
 
-fn read_ply(bytes: &[u8]) -> std::result::Result<MeshData, String> {
+fn read_ply(bytes: &[u8]) -> Result<MeshData> {
     use ply_rs_bw::ply::Property;
     let parser = ply_rs_bw::parser::Parser::<ply_rs_bw::ply::DefaultElement>::new();
     let mut reader = std::io::Cursor::new(bytes);
-    let ply = parser.read_ply(&mut reader).map_err(|e| format!("cannot parse the PLY file: {e}"))?;
+    let ply = parser.read_ply(&mut reader).map_err(|e| Error::input(format!("cannot parse the PLY file: {e}")))?;
     let scalar = |p: &Property| -> Option<f64> {
         Some(match *p {
             Property::Char(v) => v.into(),
@@ -318,22 +324,23 @@ fn read_ply(bytes: &[u8]) -> std::result::Result<MeshData, String> {
             _ => return None,
         })
     };
-    let vertices = ply.payload.get("vertex").ok_or("the PLY file has no `vertex` element")?;
-    let def = ply.header.elements.get("vertex").ok_or("the PLY header declares no `vertex` element")?;
+    let vertices = ply.payload.get("vertex").ok_or_else(|| Error::input("the PLY file has no `vertex` element"))?;
+    let def =
+        ply.header.elements.get("vertex").ok_or_else(|| Error::input("the PLY header declares no `vertex` element"))?;
     let names: Vec<String> = def.properties.keys().cloned().collect();
     for c in ["x", "y"] {
         if !names.iter().any(|n| n == c) {
-            return Err(format!("the vertex element has no `{c}` property"));
+            return Err(Error::input(format!("the vertex element has no `{c}` property")));
         }
     }
     let mut data = MeshData::default();
     let mut columns: Vec<(String, Vec<f64>)> =
         names.iter().filter(|n| !["x", "y", "z"].contains(&n.as_str())).map(|n| (n.clone(), Vec::new())).collect();
     for (i, v) in vertices.iter().enumerate() {
-        let get = |name: &str| -> std::result::Result<f64, String> {
+        let get = |name: &str| -> Result<f64> {
             match v.get(name) {
                 None => Ok(0.0),
-                Some(p) => scalar(p).ok_or_else(|| format!("vertex {i}: property `{name}` is a list")),
+                Some(p) => scalar(p).ok_or_else(|| Error::input(format!("vertex {i}: property `{name}` is a list"))),
             }
         };
         data.positions.push([get("x")?, get("y")?, get("z")?]);
@@ -351,19 +358,20 @@ fn read_ply(bytes: &[u8]) -> std::result::Result<MeshData, String> {
             data.arrays.push(PointArray { name, components: 1, values });
         }
     }
-    let faces = ply.payload.get("face").ok_or("the PLY file has no `face` element")?;
+    let faces = ply.payload.get("face").ok_or_else(|| Error::input("the PLY file has no `face` element"))?;
     let mut split = 0;
     for (f, face) in faces.iter().enumerate() {
         let idx = face
             .get("vertex_indices")
             .or_else(|| face.get("vertex_index"))
-            .ok_or_else(|| format!("face {f} has no `vertex_indices` list"))?;
-        let idx = list(idx).ok_or_else(|| format!("face {f}: `vertex_indices` is not an integer list"))?;
+            .ok_or_else(|| Error::input(format!("face {f} has no `vertex_indices` list")))?;
+        let idx =
+            list(idx).ok_or_else(|| Error::input(format!("face {f}: `vertex_indices` is not an integer list")))?;
         if idx.len() < 3 {
-            return Err(format!("face {f} has {} corners", idx.len()));
+            return Err(Error::input(format!("face {f} has {} corners", idx.len())));
         }
         if let Some(&bad) = idx.iter().find(|&&v| v < 0 || v as usize >= n) {
-            return Err(format!("face {f} refers to vertex {bad} but there are {n} vertices"));
+            return Err(Error::input(format!("face {f} refers to vertex {bad} but there are {n} vertices")));
         }
         if idx.len() > 3 {
             split += 1;
@@ -376,15 +384,19 @@ fn read_ply(bytes: &[u8]) -> std::result::Result<MeshData, String> {
 }
 
 /// Cells as (type code, corner list) from either vtkio encoding, checked for consistency.
-fn cells_of(numbers: vtkio::model::VertexNumbers, what: &str) -> std::result::Result<Vec<Vec<usize>>, String> {
+fn cells_of(numbers: vtkio::model::VertexNumbers, what: &str) -> Result<Vec<Vec<usize>>> {
     use vtkio::model::VertexNumbers;
     let mut out = Vec::new();
     match numbers {
         VertexNumbers::Legacy { num_cells, vertices } => {
             let mut at = 0usize;
             for c in 0..num_cells as usize {
-                let k = *vertices.get(at).ok_or_else(|| format!("{what}: the cell list ends at cell {c}"))? as usize;
-                let cell = vertices.get(at + 1..at + 1 + k).ok_or_else(|| format!("{what}: cell {c} is truncated"))?;
+                let k =
+                    *vertices.get(at).ok_or_else(|| Error::input(format!("{what}: the cell list ends at cell {c}")))?
+                        as usize;
+                let cell = vertices
+                    .get(at + 1..at + 1 + k)
+                    .ok_or_else(|| Error::input(format!("{what}: cell {c} is truncated")))?;
                 out.push(cell.iter().map(|&v| v as usize).collect());
                 at += 1 + k;
             }
@@ -397,7 +409,7 @@ fn cells_of(numbers: vtkio::model::VertexNumbers, what: &str) -> std::result::Re
                 let end = end as usize;
                 let cell = connectivity
                     .get(start..end)
-                    .ok_or_else(|| format!("{what}: offsets of cell {c} run outside the connectivity"))?;
+                    .ok_or_else(|| Error::input(format!("{what}: offsets of cell {c} run outside the connectivity")))?;
                 out.push(cell.iter().map(|&v| v as usize).collect());
                 start = end;
             }
@@ -406,16 +418,19 @@ fn cells_of(numbers: vtkio::model::VertexNumbers, what: &str) -> std::result::Re
     Ok(out)
 }
 
-fn point_arrays(attrs: Vec<vtkio::model::Attribute>, n: usize) -> std::result::Result<Vec<PointArray>, String> {
+fn point_arrays(attrs: Vec<vtkio::model::Attribute>, n: usize) -> Result<Vec<PointArray>> {
     use vtkio::model::{Attribute, ElementType};
     let mut arrays = Vec::new();
     for attr in attrs {
-        let mut push = |name: String, comps: usize, buf: &vtkio::IOBuffer| -> std::result::Result<(), String> {
-            let values = buf
-                .cast_into::<f64>()
-                .ok_or_else(|| format!("point array `{name}` has a data type that cannot be read as numbers"))?;
+        let mut push = |name: String, comps: usize, buf: &vtkio::IOBuffer| -> Result<()> {
+            let values = buf.cast_into::<f64>().ok_or_else(|| {
+                Error::input(format!("point array `{name}` has a data type that cannot be read as numbers"))
+            })?;
             if values.len() != n * comps {
-                return Err(format!("point array `{name}` holds {} values for {n} points × {comps}", values.len()));
+                return Err(Error::input(format!(
+                    "point array `{name}` holds {} values for {n} points × {comps}",
+                    values.len()
+                )));
             }
             arrays.push(PointArray { name, components: comps, values });
             Ok(())
@@ -436,33 +451,33 @@ fn point_arrays(attrs: Vec<vtkio::model::Attribute>, n: usize) -> std::result::R
     Ok(arrays)
 }
 
-fn read_vtk(bytes: &[u8], ext: &str) -> std::result::Result<MeshData, String> {
+fn read_vtk(bytes: &[u8], ext: &str) -> Result<MeshData> {
     use vtkio::model::{CellType, DataSet};
     let parsed = std::panic::catch_unwind(|| {
         if ext == "vtk" {
-            vtkio::Vtk::parse_legacy_be(bytes).map_err(|e| e.to_string())
+            vtkio::Vtk::parse_legacy_be(bytes)
         } else {
-            vtkio::Vtk::parse_xml(std::io::BufReader::new(bytes)).map_err(|e| e.to_string())
+            vtkio::Vtk::parse_xml(std::io::BufReader::new(bytes))
         }
     })
-    .map_err(|_| "the VTK reader failed on this file (malformed?)".to_string())?
+    .map_err(|_| Error::input("the VTK reader failed on this file (malformed?)"))?
     .map_err(|e| {
         let raw = ext != "vtk" && bytes.windows(14).any(|w| w == b"encoding=\"raw\"");
-        if raw {
+        Error::input(if raw {
             format!(
                 "cannot parse the VTK file ({e}): its appended data is raw (ParaView's default), which the \
                  reader does not support; save with `Data Mode: Ascii` or `Binary` (base64)"
             )
         } else {
             format!("cannot parse the VTK file ({e}): truncated or malformed")
-        }
+        })
     })?;
     let mut data = MeshData::default();
     let mut dropped = 0usize;
     let mut split = 0usize;
-    let mut surface = |cell: &[usize], data: &mut MeshData, what: &str| -> std::result::Result<(), String> {
+    let mut surface = |cell: &[usize], data: &mut MeshData, what: &str| -> Result<()> {
         if cell.len() < 3 {
-            return Err(format!("{what} has {} corners", cell.len()));
+            return Err(Error::input(format!("{what} has {} corners", cell.len())));
         }
         if cell.len() > 3 {
             split += 1;
@@ -476,7 +491,7 @@ fn read_vtk(bytes: &[u8], ext: &str) -> std::result::Result<MeshData, String> {
             data.positions = points_of(&piece.points)?;
             let cells = cells_of(piece.cells.cell_verts, "cells")?;
             if cells.len() != piece.cells.types.len() {
-                return Err(format!("{} cells but {} cell types", cells.len(), piece.cells.types.len()));
+                return Err(Error::input(format!("{} cells but {} cell types", cells.len(), piece.cells.types.len())));
             }
             for (c, (cell, ty)) in cells.iter().zip(&piece.cells.types).enumerate() {
                 match ty {
@@ -486,9 +501,9 @@ fn read_vtk(bytes: &[u8], ext: &str) -> std::result::Result<MeshData, String> {
                     CellType::TriangleStrip => strip(cell, &mut data.triangles),
                     CellType::Vertex | CellType::PolyVertex | CellType::Line | CellType::PolyLine => dropped += 1,
                     other => {
-                        return Err(format!(
+                        return Err(Error::input(format!(
                             "cell {c} is a {other:?} cell: only surface cells (triangles, quads, polygons, strips) are supported"
-                        ))
+                        )))
                     }
                 }
             }
@@ -512,7 +527,7 @@ fn read_vtk(bytes: &[u8], ext: &str) -> std::result::Result<MeshData, String> {
             }
             data.arrays = point_arrays(piece.data.point, data.positions.len())?;
         }
-        _ => return Err("the data set is neither an unstructured grid nor polydata".into()),
+        _ => return Err(Error::input("the data set is neither an unstructured grid nor polydata")),
     }
     polygon_note(split, &mut data.notes);
     if dropped > 0 {
@@ -522,21 +537,21 @@ fn read_vtk(bytes: &[u8], ext: &str) -> std::result::Result<MeshData, String> {
 }
 
 /// The one inline piece of a data set (several pieces or external ones are refused).
-fn only_piece<P>(pieces: Vec<vtkio::model::Piece<P>>) -> std::result::Result<P, String> {
+fn only_piece<P>(pieces: Vec<vtkio::model::Piece<P>>) -> Result<P> {
     if pieces.len() != 1 {
-        return Err(format!("{} pieces: only single-piece files are supported", pieces.len()));
+        return Err(Error::input(format!("{} pieces: only single-piece files are supported", pieces.len())));
     }
     match pieces.into_iter().next() {
         Some(vtkio::model::Piece::Inline(piece)) => Ok(*piece),
-        _ => Err("the file refers to external pieces".into()),
+        _ => Err(Error::input("the file refers to external pieces")),
     }
 }
 
 /// Point coordinates as triples.
-fn points_of(buf: &vtkio::IOBuffer) -> std::result::Result<Vec<[f64; 3]>, String> {
-    let p = buf.cast_into::<f64>().ok_or("the point coordinates are not numbers")?;
+fn points_of(buf: &vtkio::IOBuffer) -> Result<Vec<[f64; 3]>> {
+    let p = buf.cast_into::<f64>().ok_or_else(|| Error::input("the point coordinates are not numbers"))?;
     if p.len() % 3 != 0 {
-        return Err("the point coordinates are not triples".into());
+        return Err(Error::input("the point coordinates are not triples"));
     }
     Ok(p.chunks(3).map(|c| [c[0], c[1], c[2]]).collect())
 }
@@ -675,7 +690,7 @@ mod tests {
         assert_eq!((p.positions.clone(), p.triangles.clone()), (obj.positions.clone(), obj.triangles.clone()));
         assert_eq!(p.array("temp").unwrap().values, vec![1.5, 2.5, 3.5, 4.5]);
         assert_eq!(p.array("z").unwrap().values, vec![0.0, 0.0, 0.0, 0.5]);
-        assert!(p.array("pressure").unwrap_err().contains("temp, x, y, z"));
+        assert!(p.array("pressure").unwrap_err().to_string().contains("temp, x, y, z"));
     }
 
     #[test]

@@ -113,20 +113,20 @@ pub fn read_npz(path: &Path) -> Result<Vec<NpzArray>> {
 
 /// Decodes a whole `.npy` file held in memory: a 2D numeric or boolean array as
 /// `([ny, nx], values in C order)`.
-pub fn decode_npy(bytes: &[u8]) -> std::result::Result<([usize; 2], Vec<f64>), String> {
+pub fn decode_npy(bytes: &[u8]) -> Result<([usize; 2], Vec<f64>)> {
     use npyz::{DType, Order, TypeChar};
-    let npy = npyz::NpyFile::new(bytes).map_err(|e| format!("not a readable .npy array: {e}"))?;
+    let npy = npyz::NpyFile::new(bytes).map_err(|e| Error::input(format!("not a readable .npy array: {e}")))?;
     let shape = npy.shape().to_vec();
     if shape.len() != 2 {
-        return Err(format!("expected a 2D array (rows, columns), found shape {shape:?}"));
+        return Err(Error::input(format!("expected a 2D array (rows, columns), found shape {shape:?}")));
     }
     let (ny, nx) = (shape[0] as usize, shape[1] as usize);
     let order = npy.order();
     let dtype = npy.dtype();
     let DType::Plain(ts) = &dtype else {
-        return Err(format!("unsupported dtype {}", dtype.descr()));
+        return Err(Error::input(format!("unsupported dtype {}", dtype.descr())));
     };
-    let bad = |e: std::io::Error| format!("cannot read the data (truncated?): {e}");
+    let bad = |e: std::io::Error| Error::input(format!("cannot read the data (truncated?): {e}"));
     // the data must end where the file ends: trailing bytes mean a wrong header or a
     // concatenated file
     let data_start = match bytes.get(6) {
@@ -137,11 +137,11 @@ pub fn decode_npy(bytes: &[u8]) -> std::result::Result<([usize; 2], Vec<f64>), S
     let expected = ny.checked_mul(nx).and_then(|k| k.checked_mul(ts.size_field() as usize));
     if let (Some(start), Some(len)) = (data_start, expected) {
         if bytes.len() > start.saturating_add(len) {
-            return Err(format!(
+            return Err(Error::input(format!(
                 "{} bytes after the {len} bytes of data the header describes (shape ({ny}, {nx}), dtype {})",
                 bytes.len() - start - len,
                 dtype.descr()
-            ));
+            )));
         }
     }
     let values: Vec<f64> = match (ts.type_char(), ts.size_field()) {
@@ -156,10 +156,10 @@ pub fn decode_npy(bytes: &[u8]) -> std::result::Result<([usize; 2], Vec<f64>), S
         (TypeChar::Uint, 4) => npy.into_vec::<u32>().map_err(bad)?.into_iter().map(f64::from).collect(),
         (TypeChar::Uint, 8) => npy.into_vec::<u64>().map_err(bad)?.into_iter().map(|v| v as f64).collect(),
         (TypeChar::Bool, 1) => npy.into_vec::<bool>().map_err(bad)?.into_iter().map(|b| b as u8 as f64).collect(),
-        _ => return Err(format!("unsupported dtype {}", dtype.descr())),
+        _ => return Err(Error::input(format!("unsupported dtype {}", dtype.descr()))),
     };
     if Some(values.len()) != ny.checked_mul(nx) {
-        return Err(format!("{} values for shape ({ny}, {nx})", values.len()));
+        return Err(Error::input(format!("{} values for shape ({ny}, {nx})", values.len())));
     }
     let values = match order {
         Order::C => values,

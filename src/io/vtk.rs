@@ -114,9 +114,11 @@ pub fn read_image(path: &Path) -> Result<ImageData> {
     } else if head.starts_with(b"<") {
         read_xml(&bytes)
     } else {
-        Err("neither a VTK XML file (`<?xml ...` / `<VTKFile ...`) nor a legacy VTK file (`# vtk DataFile ...`)".into())
+        Err(Error::input(
+            "neither a VTK XML file (`<?xml ...` / `<VTKFile ...`) nor a legacy VTK file (`# vtk DataFile ...`)",
+        ))
     };
-    result.map_err(|m| input(path, m))
+    result.map_err(|e| e.in_file(path))
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -208,22 +210,23 @@ enum Format {
 #[derive(Debug)]
 struct ArrayDecl {
     name: String,
-    ty: std::result::Result<Scalar, String>,
+    /// None for a type that is not numeric (an error only if the array is read).
+    ty: Option<Scalar>,
+    /// The `type` attribute as written.
+    ty_text: String,
     components: usize,
     format: Format,
     text: Vec<u8>,
 }
 
-type Msg = String;
-
 /// Largest allocation made on the word of a file's header before the data is seen to exist.
 const CAPACITY: usize = 1 << 24;
 
-fn attrs(e: &quick_xml::events::BytesStart) -> std::result::Result<Vec<(String, String)>, Msg> {
+fn attrs(e: &quick_xml::events::BytesStart) -> Result<Vec<(String, String)>> {
     let tag = String::from_utf8_lossy(e.name().as_ref()).into_owned();
     e.attributes()
         .map(|a| {
-            let a = a.map_err(|err| format!("malformed attribute in <{tag}>: {err}"))?;
+            let a = a.map_err(|err| Error::input(format!("malformed attribute in <{tag}>: {err}")))?;
             let key = String::from_utf8_lossy(a.key.as_ref()).into_owned();
             let value = match a.unescape_value() {
                 Ok(v) => v.into_owned(),
@@ -238,16 +241,16 @@ fn get<'a>(attrs: &'a [(String, String)], key: &str) -> Option<&'a str> {
     attrs.iter().find(|(k, _)| k == key).map(|(_, v)| v.as_str())
 }
 
-fn parse_numbers<const N: usize, T: std::str::FromStr>(s: &str, what: &str) -> std::result::Result<[T; N], Msg> {
+fn parse_numbers<const N: usize, T: std::str::FromStr>(s: &str, what: &str) -> Result<[T; N]> {
     let parts: Vec<&str> = s.split_whitespace().collect();
     let parsed: Option<Vec<T>> = parts.iter().map(|p| p.parse::<T>().ok()).collect();
     match parsed {
         Some(v) if v.len() == N => Ok(v.try_into().unwrap_or_else(|_| unreachable!())),
-        _ => Err(format!("{what} must be {N} numbers, found `{s}`")),
+        _ => Err(Error::input(format!("{what} must be {N} numbers, found `{s}`"))),
     }
 }
 
-fn read_xml(bytes: &[u8]) -> std::result::Result<ImageData, Msg> {
+fn read_xml(bytes: &[u8]) -> Result<ImageData> {
     use quick_xml::events::Event;
     // Appended data may be raw binary, which is not XML: parse the markup up to and including
     // the <AppendedData ...> start tag only.
@@ -258,7 +261,7 @@ fn read_xml(bytes: &[u8]) -> std::result::Result<ImageData, Msg> {
                 .iter()
                 .position(|&b| b == b'>')
                 .map(|p| at + p + 1)
-                .ok_or_else(|| "truncated: the file ends inside the <AppendedData> tag".to_string())?;
+                .ok_or_else(|| Error::input("truncated: the file ends inside the <AppendedData> tag"))?;
             (&bytes[..close], Some(close))
         }
         None => (bytes, None),
@@ -273,8 +276,9 @@ fn read_xml(bytes: &[u8]) -> std::result::Result<ImageData, Msg> {
     let mut cell_names: Vec<String> = Vec::new();
     let mut appended_encoding: Option<String> = None;
     loop {
-        let event =
-            reader.read_event().map_err(|e| format!("malformed XML near byte {}: {e}", reader.error_position()))?;
+        let event = reader
+            .read_event()
+            .map_err(|e| Error::input(format!("malformed XML near byte {}: {e}", reader.error_position())))?;
         let (start, empty) = match &event {
             Event::Start(e) => (Some(e), false),
             Event::Empty(e) => (Some(e), true),
@@ -288,12 +292,16 @@ fn read_xml(bytes: &[u8]) -> std::result::Result<ImageData, Msg> {
                     match get(&a, "type") {
                         Some("ImageData") => {}
                         Some(t @ "PImageData") => {
-                            return Err(format!(
+                            return Err(Error::input(format!(
                                 "this is a parallel file ({t}) that only points to piece files: read the .vti pieces"
-                            ))
+                            )))
                         }
-                        Some(t) => return Err(format!("the data set is {t}; only ImageData (.vti) is supported")),
-                        None => return Err("the <VTKFile> element has no `type`".into()),
+                        Some(t) => {
+                            return Err(Error::input(format!(
+                                "the data set is {t}; only ImageData (.vti) is supported"
+                            )))
+                        }
+                        None => return Err(Error::input("the <VTKFile> element has no `type`")),
                     }
                     file_attrs = Some(a);
                 }
@@ -311,19 +319,14 @@ fn read_xml(bytes: &[u8]) -> std::result::Result<ImageData, Msg> {
                     match section {
                         "PointData" => {
                             let ty_text = get(&a, "type").unwrap_or("");
-                            let ty = Scalar::parse(ty_text).ok_or_else(|| {
-                                if ty_text.is_empty() {
-                                    format!("point array `{arr_name}` has no `type`")
-                                } else {
-                                    format!("point array `{arr_name}` has type {ty_text}, which is not numeric")
-                                }
-                            });
+                            let ty = Scalar::parse(ty_text);
+                            let ty_text = ty_text.to_string();
                             let components = match get(&a, "NumberOfComponents") {
                                 None => 1,
                                 Some(c) => c.trim().parse::<usize>().ok().filter(|&c| c > 0).ok_or_else(|| {
-                                    format!(
+                                    Error::input(format!(
                                         "point array `{arr_name}`: NumberOfComponents `{c}` is not a positive integer"
-                                    )
+                                    ))
                                 })?,
                             };
                             let format = match get(&a, "format").unwrap_or("ascii") {
@@ -332,12 +335,18 @@ fn read_xml(bytes: &[u8]) -> std::result::Result<ImageData, Msg> {
                                 "appended" => {
                                     let off = get(&a, "offset").unwrap_or("0");
                                     Format::Appended(off.trim().parse().map_err(|_| {
-                                        format!("point array `{arr_name}`: offset `{off}` is not an integer")
+                                        Error::input(format!(
+                                            "point array `{arr_name}`: offset `{off}` is not an integer"
+                                        ))
                                     })?)
                                 }
-                                f => return Err(format!("point array `{arr_name}` has unknown format `{f}`")),
+                                f => {
+                                    return Err(Error::input(format!(
+                                        "point array `{arr_name}` has unknown format `{f}`"
+                                    )))
+                                }
                             };
-                            let decl = ArrayDecl { name: arr_name, ty, components, format, text: Vec::new() };
+                            let decl = ArrayDecl { name: arr_name, ty, ty_text, components, format, text: Vec::new() };
                             if empty {
                                 point_arrays.push(decl);
                             } else {
@@ -378,60 +387,60 @@ fn read_xml(bytes: &[u8]) -> std::result::Result<ImageData, Msg> {
             },
             Event::Eof => {
                 if let Some(c) = current {
-                    return Err(format!("truncated: the file ends inside point array `{}`", c.name));
+                    return Err(Error::input(format!("truncated: the file ends inside point array `{}`", c.name)));
                 }
                 break;
             }
             _ => {}
         }
     }
-    let file_attrs = file_attrs.ok_or("no <VTKFile> element: not a VTK XML file")?;
-    let image_attrs = image_attrs.ok_or("no <ImageData> element (truncated file?)")?;
+    let file_attrs = file_attrs.ok_or_else(|| Error::input("no <VTKFile> element: not a VTK XML file"))?;
+    let image_attrs = image_attrs.ok_or_else(|| Error::input("no <ImageData> element (truncated file?)"))?;
     let enc = Encoding {
         big_endian: match get(&file_attrs, "byte_order").unwrap_or("LittleEndian") {
             "LittleEndian" => false,
             "BigEndian" => true,
-            o => return Err(format!("unknown byte_order `{o}`")),
+            o => return Err(Error::input(format!("unknown byte_order `{o}`"))),
         },
         header: match get(&file_attrs, "header_type").unwrap_or("UInt32") {
             "UInt32" => 4,
             "UInt64" => 8,
-            h => return Err(format!("unsupported header_type `{h}` (VTK writes UInt32 or UInt64)")),
+            h => return Err(Error::input(format!("unsupported header_type `{h}` (VTK writes UInt32 or UInt64)"))),
         },
         zlib: match get(&file_attrs, "compressor").map(str::trim).unwrap_or("") {
             "" => false,
             "vtkZLibDataCompressor" => true,
             c => {
-                return Err(format!(
+                return Err(Error::input(format!(
                     "data compressed with `{c}`, which is not supported: only vtkZLibDataCompressor or no compression \
                      (re-save it from ParaView with another compressor)"
-                ))
+                )))
             }
         },
     };
     if piece_extents.is_empty() {
-        return Err("the image has no <Piece> (truncated file?)".into());
+        return Err(Error::input("the image has no <Piece> (truncated file?)"));
     }
     if piece_extents.len() > 1 {
-        return Err(format!(
+        return Err(Error::input(format!(
             "the image is split into {} pieces; only single-piece files are supported",
             piece_extents.len()
-        ));
+        )));
     }
-    let whole = get(&image_attrs, "WholeExtent").ok_or("<ImageData> has no WholeExtent")?;
+    let whole = get(&image_attrs, "WholeExtent").ok_or_else(|| Error::input("<ImageData> has no WholeExtent"))?;
     let extent_text = piece_extents[0].clone().unwrap_or_else(|| whole.to_string());
     let ext: [i64; 6] = parse_numbers(&extent_text, "the extent")?;
     let count = |lo: i64, hi: i64| if hi >= lo { (hi - lo + 1) as usize } else { 0 };
     let (nx, ny, nz) = (count(ext[0], ext[1]), count(ext[2], ext[3]), count(ext[4], ext[5]));
     if nz > 1 {
-        return Err(format!(
+        return Err(Error::input(format!(
             "the extent `{extent_text}` has {nz} points along z: only 2D images (one point along z) are supported"
-        ));
+        )));
     }
     if nx < 2 || ny < 2 || nz < 1 {
-        return Err(format!(
+        return Err(Error::input(format!(
             "the extent `{extent_text}` gives {nx} × {ny} × {nz} points: a 2D image needs at least 2 × 2 points in the x-y plane"
-        ));
+        )));
     }
     let origin3: [f64; 3] = match get(&image_attrs, "Origin") {
         Some(o) => parse_numbers(o, "Origin")?,
@@ -445,20 +454,26 @@ fn read_xml(bytes: &[u8]) -> std::result::Result<ImageData, Msg> {
     let origin = [origin3[0] + ext[0] as f64 * spacing[0], origin3[1] + ext[2] as f64 * spacing[1]];
     if point_arrays.is_empty() && !cell_names.is_empty() {
         let names: Vec<&str> = cell_names.iter().map(String::as_str).collect();
-        return Err(format!(
+        return Err(Error::input(format!(
             "the file has cell data only ({}); point data is needed (ParaView: Cell Data to Point Data)",
             list_names(&names)
-        ));
+        )));
     }
-    let n = nx.checked_mul(ny).ok_or_else(|| format!("the extent `{extent_text}` is too large"))?;
+    let n = nx.checked_mul(ny).ok_or_else(|| Error::input(format!("the extent `{extent_text}` is too large")))?;
     let mut arrays = Vec::with_capacity(point_arrays.len());
     for decl in point_arrays {
-        let ty = decl.ty.clone()?;
+        let ty = decl.ty.ok_or_else(|| {
+            Error::input(if decl.ty_text.is_empty() {
+                format!("point array `{}` has no `type`", decl.name)
+            } else {
+                format!("point array `{}` has type {}, which is not numeric", decl.name, decl.ty_text)
+            })
+        })?;
         let what = format!("point array `{}`", decl.name);
         let expected = n
             .checked_mul(decl.components)
             .and_then(|c| c.checked_mul(ty.size()))
-            .ok_or_else(|| format!("{what} is too large"))?;
+            .ok_or_else(|| Error::input(format!("{what} is too large")))?;
         let values = match decl.format {
             Format::Ascii => parse_ascii(&decl.text, n * decl.components, &what)?,
             Format::Binary => {
@@ -467,24 +482,33 @@ fn read_xml(bytes: &[u8]) -> std::result::Result<ImageData, Msg> {
                 ty.decode(&raw, enc.big_endian)
             }
             Format::Appended(offset) => {
-                let start = appended.ok_or_else(|| format!("{what} is appended but the file has no <AppendedData>"))?;
+                let start = appended
+                    .ok_or_else(|| Error::input(format!("{what} is appended but the file has no <AppendedData>")))?;
                 let data = appended_start(bytes, start)?;
                 let raw = match appended_encoding.as_deref().unwrap_or("raw") {
                     "raw" => {
                         let rest = data.get(offset..).ok_or_else(|| {
-                            format!("truncated: {what} starts at offset {offset}, past the end of the appended data")
+                            Error::input(format!(
+                                "truncated: {what} starts at offset {offset}, past the end of the appended data"
+                            ))
                         })?;
                         let mut src = RawStream { data: rest, pos: 0 };
                         read_block(&mut src, enc, expected, ty.size(), n, decl.components, &what)?
                     }
                     "base64" => {
                         let rest = data.get(offset..).ok_or_else(|| {
-                            format!("truncated: {what} starts at offset {offset}, past the end of the appended data")
+                            Error::input(format!(
+                                "truncated: {what} starts at offset {offset}, past the end of the appended data"
+                            ))
                         })?;
                         let mut src = Base64Stream { text: rest, pos: 0, pending: Vec::new() };
                         read_block(&mut src, enc, expected, ty.size(), n, decl.components, &what)?
                     }
-                    e => return Err(format!("unknown AppendedData encoding `{e}` (expected raw or base64)")),
+                    e => {
+                        return Err(Error::input(format!(
+                            "unknown AppendedData encoding `{e}` (expected raw or base64)"
+                        )))
+                    }
                 };
                 ty.decode(&raw, enc.big_endian)
             }
@@ -492,7 +516,7 @@ fn read_xml(bytes: &[u8]) -> std::result::Result<ImageData, Msg> {
         arrays.push(PointArray { name: decl.name, components: decl.components, values });
     }
     if arrays.is_empty() {
-        return Err("the file has no point data arrays".into());
+        return Err(Error::input("the file has no point data arrays"));
     }
     Ok(ImageData { nx, ny, spacing, origin, arrays })
 }
@@ -502,25 +526,27 @@ fn find(hay: &[u8], needle: &[u8]) -> Option<usize> {
 }
 
 /// The appended data after the `_` marker that follows the `<AppendedData>` tag ending at `close`.
-fn appended_start(bytes: &[u8], close: usize) -> std::result::Result<&[u8], Msg> {
+fn appended_start(bytes: &[u8], close: usize) -> Result<&[u8]> {
     let rest = &bytes[close..];
     let skip = rest.iter().position(|b| !b.is_ascii_whitespace()).unwrap_or(rest.len());
     match rest.get(skip) {
         Some(b'_') => Ok(&rest[skip + 1..]),
-        Some(_) => Err("the appended data does not start with the `_` marker".into()),
-        None => Err("truncated: the file ends before the appended data".into()),
+        Some(_) => Err(Error::input("the appended data does not start with the `_` marker")),
+        None => Err(Error::input("truncated: the file ends before the appended data")),
     }
 }
 
-fn parse_ascii(text: &[u8], count: usize, what: &str) -> std::result::Result<Vec<f64>, Msg> {
-    let text = std::str::from_utf8(text).map_err(|_| format!("{what}: ascii data is not text"))?;
+fn parse_ascii(text: &[u8], count: usize, what: &str) -> Result<Vec<f64>> {
+    let text = std::str::from_utf8(text).map_err(|_| Error::input(format!("{what}: ascii data is not text")))?;
     let mut out = Vec::with_capacity(count.min(CAPACITY));
     for (i, tok) in text.split_ascii_whitespace().enumerate() {
-        let v = tok.parse::<f64>().map_err(|_| format!("{what}: value {} (`{tok}`) is not a number", i + 1))?;
+        let v = tok
+            .parse::<f64>()
+            .map_err(|_| Error::input(format!("{what}: value {} (`{tok}`) is not a number", i + 1)))?;
         out.push(v);
     }
     if out.len() != count {
-        return Err(format!("{what} holds {} values, the extent needs {count}", out.len()));
+        return Err(Error::input(format!("{what} holds {} values, the extent needs {count}", out.len())));
     }
     Ok(out)
 }
@@ -528,7 +554,7 @@ fn parse_ascii(text: &[u8], count: usize, what: &str) -> std::result::Result<Vec
 /// A source of decoded bytes: raw appended data or base64 text.
 trait ByteSource {
     /// Exactly `n` bytes, or an error saying the data ends early.
-    fn take(&mut self, n: usize) -> std::result::Result<Vec<u8>, Msg>;
+    fn take(&mut self, n: usize) -> Result<Vec<u8>>;
 }
 
 struct RawStream<'a> {
@@ -537,12 +563,11 @@ struct RawStream<'a> {
 }
 
 impl ByteSource for RawStream<'_> {
-    fn take(&mut self, n: usize) -> std::result::Result<Vec<u8>, Msg> {
-        let end = self
-            .pos
-            .checked_add(n)
-            .filter(|&e| e <= self.data.len())
-            .ok_or_else(|| format!("truncated: {n} bytes needed, {} left", self.data.len() - self.pos))?;
+    fn take(&mut self, n: usize) -> Result<Vec<u8>> {
+        let end =
+            self.pos.checked_add(n).filter(|&e| e <= self.data.len()).ok_or_else(|| {
+                Error::input(format!("truncated: {n} bytes needed, {} left", self.data.len() - self.pos))
+            })?;
         let out = self.data[self.pos..end].to_vec();
         self.pos = end;
         Ok(out)
@@ -570,13 +595,13 @@ fn b64_value(c: u8) -> Option<u8> {
 
 impl Base64Stream<'_> {
     /// Decodes the next group of 4 characters (skipping whitespace) into `pending`.
-    fn next_group(&mut self) -> std::result::Result<bool, Msg> {
+    fn next_group(&mut self) -> Result<bool> {
         let mut group = [0u8; 4];
         let mut k = 0;
         while k < 4 {
             match self.text.get(self.pos) {
                 None | Some(b'<') => {
-                    return if k == 0 { Ok(false) } else { Err("truncated base64 data".into()) };
+                    return if k == 0 { Ok(false) } else { Err(Error::input("truncated base64 data")) };
                 }
                 Some(c) if c.is_ascii_whitespace() => self.pos += 1,
                 Some(&c) => {
@@ -588,14 +613,14 @@ impl Base64Stream<'_> {
         }
         let pad = group.iter().rev().take_while(|&&c| c == b'=').count();
         if pad > 2 {
-            return Err("invalid base64 data (`===`)".into());
+            return Err(Error::input("invalid base64 data (`===`)"));
         }
         let mut v = 0u32;
         for (i, &c) in group.iter().enumerate() {
             let d = if i >= 4 - pad {
                 0
             } else {
-                b64_value(c).ok_or_else(|| format!("invalid base64 character `{}`", c.escape_ascii()))?
+                b64_value(c).ok_or_else(|| Error::input(format!("invalid base64 character `{}`", c.escape_ascii())))?
             };
             v = (v << 6) | u32::from(d);
         }
@@ -606,15 +631,15 @@ impl Base64Stream<'_> {
 }
 
 impl ByteSource for Base64Stream<'_> {
-    fn take(&mut self, n: usize) -> std::result::Result<Vec<u8>, Msg> {
+    fn take(&mut self, n: usize) -> Result<Vec<u8>> {
         // at most 3 bytes per 4 characters left: refuse absurd sizes before allocating
         let left = (self.text.len() - self.pos) / 4 * 3 + self.pending.len();
         if n > left {
-            return Err(format!("truncated: {n} bytes needed, at most {left} left"));
+            return Err(Error::input(format!("truncated: {n} bytes needed, at most {left} left")));
         }
         while self.pending.len() < n {
             if !self.next_group()? {
-                return Err(format!("truncated: {n} bytes needed, {} left", self.pending.len()));
+                return Err(Error::input(format!("truncated: {n} bytes needed, {} left", self.pending.len())));
             }
         }
         let rest = self.pending.split_off(n);
@@ -622,7 +647,7 @@ impl ByteSource for Base64Stream<'_> {
     }
 }
 
-fn header_word(src: &mut dyn ByteSource, enc: Encoding) -> std::result::Result<usize, Msg> {
+fn header_word(src: &mut dyn ByteSource, enc: Encoding) -> Result<usize> {
     let b = src.take(enc.header)?;
     let v = match (enc.header, enc.big_endian) {
         (4, false) => u64::from(u32::from_le_bytes(b[..4].try_into().expect("4 bytes"))),
@@ -630,7 +655,7 @@ fn header_word(src: &mut dyn ByteSource, enc: Encoding) -> std::result::Result<u
         (_, false) => u64::from_le_bytes(b[..8].try_into().expect("8 bytes")),
         (_, true) => u64::from_be_bytes(b[..8].try_into().expect("8 bytes")),
     };
-    usize::try_from(v).map_err(|_| format!("header value {v} is too large"))
+    usize::try_from(v).map_err(|_| Error::input(format!("header value {v} is too large")))
 }
 
 /// Reads one array's block (header then data, compressed or not) and checks it holds
@@ -643,53 +668,53 @@ fn read_block(
     tuples: usize,
     comps: usize,
     what: &str,
-) -> std::result::Result<Vec<u8>, Msg> {
-    let ctx = |m: Msg| format!("{what}: {m}");
+) -> Result<Vec<u8>> {
+    let ctx = |m: &dyn std::fmt::Display| Error::input(format!("{what}: {m}"));
     let size_err = |got: usize| {
-        format!(
+        Error::input(format!(
             "{what} holds {got} bytes ({} values), but {tuples} points × {comps} components need {expected} bytes",
             got / elem
-        )
+        ))
     };
     if !enc.zlib {
-        let nbytes = header_word(src, enc).map_err(ctx)?;
+        let nbytes = header_word(src, enc).map_err(|e| ctx(&e))?;
         if nbytes != expected {
             return Err(size_err(nbytes));
         }
-        return src.take(nbytes).map_err(ctx);
+        return src.take(nbytes).map_err(|e| ctx(&e));
     }
-    let blocks = header_word(src, enc).map_err(ctx)?;
-    let block_size = header_word(src, enc).map_err(ctx)?;
-    let last_size = header_word(src, enc).map_err(ctx)?;
+    let blocks = header_word(src, enc).map_err(|e| ctx(&e))?;
+    let block_size = header_word(src, enc).map_err(|e| ctx(&e))?;
+    let last_size = header_word(src, enc).map_err(|e| ctx(&e))?;
     if blocks == 0 {
         return if expected == 0 { Ok(Vec::new()) } else { Err(size_err(0)) };
     }
     if block_size == 0 || last_size > block_size {
-        return Err(ctx(format!("corrupt compression header (block size {block_size}, last block {last_size})")));
+        return Err(ctx(&format!("corrupt compression header (block size {block_size}, last block {last_size})")));
     }
     let last = if last_size == 0 { block_size } else { last_size };
     let total = (blocks - 1).checked_mul(block_size).and_then(|t| t.checked_add(last));
     if total != Some(expected) {
         return Err(match total {
             Some(t) => size_err(t),
-            None => ctx("corrupt compression header".into()),
+            None => ctx(&"corrupt compression header"),
         });
     }
     let mut sizes = Vec::with_capacity(blocks.min(CAPACITY));
     for _ in 0..blocks {
-        sizes.push(header_word(src, enc).map_err(ctx)?);
+        sizes.push(header_word(src, enc).map_err(|e| ctx(&e))?);
     }
     let mut out = Vec::with_capacity(expected.min(CAPACITY));
     for (i, &cs) in sizes.iter().enumerate() {
         let want = if i + 1 == blocks { last } else { block_size };
-        let compressed = src.take(cs).map_err(ctx)?;
+        let compressed = src.take(cs).map_err(|e| ctx(&e))?;
         let before = out.len();
         flate2::read::ZlibDecoder::new(&compressed[..])
             .take(want as u64 + 1)
             .read_to_end(&mut out)
-            .map_err(|e| ctx(format!("block {} of {blocks} does not decompress: {e}", i + 1)))?;
+            .map_err(|e| ctx(&format!("block {} of {blocks} does not decompress: {e}", i + 1)))?;
         if out.len() - before != want {
-            return Err(ctx(format!(
+            return Err(ctx(&format!(
                 "block {} of {blocks} decompresses to {} bytes instead of {want}",
                 i + 1,
                 out.len() - before
@@ -702,15 +727,15 @@ fn read_block(
 // ---------------------------------------------------------------------------------------------
 // Legacy reader
 
-fn read_legacy(bytes: &[u8]) -> std::result::Result<ImageData, Msg> {
+fn read_legacy(bytes: &[u8]) -> Result<ImageData> {
     use vtkio::model::{Attribute, DataSet, ElementType, Extent, Piece};
     let vtk = vtkio::Vtk::parse_legacy_be(bytes).map_err(|e| {
-        format!(
+        Error::input(format!(
             "cannot parse the legacy VTK file ({e}): it is truncated, malformed or uses a feature vtkio cannot read"
-        )
+        ))
     })?;
     let DataSet::ImageData { extent, origin, spacing, pieces, .. } = vtk.data else {
-        return Err("the legacy data set is not STRUCTURED_POINTS; only image data is supported".into());
+        return Err(Error::input("the legacy data set is not STRUCTURED_POINTS; only image data is supported"));
     };
     let dims = match extent {
         Extent::Dims(d) => d.map(|v| v as usize),
@@ -724,10 +749,12 @@ fn read_legacy(bytes: &[u8]) -> std::result::Result<ImageData, Msg> {
     };
     let [nx, ny, nz] = dims;
     if nz > 1 {
-        return Err(format!("DIMENSIONS {nx} {ny} {nz}: only 2D images (one point along z) are supported"));
+        return Err(Error::input(format!(
+            "DIMENSIONS {nx} {ny} {nz}: only 2D images (one point along z) are supported"
+        )));
     }
     if nx < 2 || ny < 2 || nz < 1 {
-        return Err(format!("DIMENSIONS {nx} {ny} {nz}: a 2D image needs at least 2 × 2 points"));
+        return Err(Error::input(format!("DIMENSIONS {nx} {ny} {nz}: a 2D image needs at least 2 × 2 points")));
     }
     // vtkio keeps origin and spacing as f32: read them again as f64 from the header text
     let (origin64, spacing64) = legacy_geometry(bytes);
@@ -738,22 +765,22 @@ fn read_legacy(bytes: &[u8]) -> std::result::Result<ImageData, Msg> {
     let mut cell_names = Vec::new();
     for piece in pieces {
         let Piece::Inline(piece) = piece else {
-            return Err("the legacy file refers to external pieces".into());
+            return Err(Error::input("the legacy file refers to external pieces"));
         };
         for attr in &piece.data.cell {
             cell_names.push(attr.name().to_string());
         }
         for attr in piece.data.point {
-            let mut push = |name: String, comps: usize, buf: &vtkio::IOBuffer| -> std::result::Result<(), Msg> {
-                let values = buf
-                    .cast_into::<f64>()
-                    .ok_or_else(|| format!("point array `{name}` has a data type that cannot be read as numbers"))?;
+            let mut push = |name: String, comps: usize, buf: &vtkio::IOBuffer| -> Result<()> {
+                let values = buf.cast_into::<f64>().ok_or_else(|| {
+                    Error::input(format!("point array `{name}` has a data type that cannot be read as numbers"))
+                })?;
                 if values.len() != n * comps {
-                    return Err(format!(
+                    return Err(Error::input(format!(
                         "point array `{name}` holds {} values, but {n} points × {comps} components need {}",
                         values.len(),
                         n * comps
-                    ));
+                    )));
                 }
                 arrays.push(PointArray { name, components: comps, values });
                 Ok(())
@@ -775,13 +802,13 @@ fn read_legacy(bytes: &[u8]) -> std::result::Result<ImageData, Msg> {
     }
     if arrays.is_empty() {
         if cell_names.is_empty() {
-            return Err("the file has no point data".into());
+            return Err(Error::input("the file has no point data"));
         }
         let names: Vec<&str> = cell_names.iter().map(String::as_str).collect();
-        return Err(format!(
+        return Err(Error::input(format!(
             "the file has cell data only ({}); point data is needed (ParaView: Cell Data to Point Data)",
             list_names(&names)
-        ));
+        )));
     }
     Ok(ImageData { nx, ny, spacing, origin, arrays })
 }

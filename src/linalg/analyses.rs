@@ -13,7 +13,7 @@ pub fn solve_spd(
     a: SparseColMatRef<'_, usize, f64>,
     b: &mut [f64],
     analyses: Option<&mut Analyses>,
-) -> Result<(), String> {
+) -> std::result::Result<(), crate::error::NumericalError> {
     match analyses {
         None => solve_spd_once(a, b),
         Some(analyses) => SpdSolver::new(a.symbolic(), analyses)?.solve(a, b),
@@ -57,7 +57,7 @@ impl Analyses {
     pub(crate) fn of(
         &mut self,
         pattern: SymbolicSparseColMatRef<'_, usize>,
-    ) -> Result<std::sync::Arc<Analysis>, String> {
+    ) -> std::result::Result<std::sync::Arc<Analysis>, crate::error::NumericalError> {
         if let Some(at) = self.kept.iter().position(|(q, _)| same_pattern(q.as_ref(), pattern)) {
             let entry = self.kept.remove(at);
             let analysis = entry.1.clone();
@@ -102,7 +102,10 @@ impl SpdSolver {
     ///
     /// # Errors
     /// A message if the analysis or the workspace allocation fails.
-    pub fn new(pattern: SymbolicSparseColMatRef<'_, usize>, analyses: &mut Analyses) -> Result<Self, String> {
+    pub fn new(
+        pattern: SymbolicSparseColMatRef<'_, usize>,
+        analyses: &mut Analyses,
+    ) -> std::result::Result<Self, crate::error::NumericalError> {
         let analysis = analyses.of(pattern)?;
         Ok(SpdSolver { f: SpdFactor::new(analysis)? })
     }
@@ -111,7 +114,11 @@ impl SpdSolver {
     ///
     /// # Errors
     /// A message if `a` is not positive definite.
-    pub fn solve(&mut self, a: SparseColMatRef<'_, usize, f64>, b: &mut [f64]) -> Result<(), String> {
+    pub fn solve(
+        &mut self,
+        a: SparseColMatRef<'_, usize, f64>,
+        b: &mut [f64],
+    ) -> std::result::Result<(), crate::error::NumericalError> {
         self.f.factor(a)?;
         self.f.solve_in_place(b);
         Ok(())

@@ -68,10 +68,15 @@ pub(crate) fn parallelism_for(s: &SymbolicCholesky<usize>) -> Par {
     }
 }
 
+pub use crate::error::NumericalError;
+
 /// Solves `A x = b` once for a symmetric positive definite `A` given by its upper triangle
 /// (`b` is overwritten by `x`), with AMD: for a single factorisation the nested-dissection
 /// ordering costs more than it saves. `Err` if `A` is not numerically positive definite.
-pub(crate) fn solve_spd_once(a: SparseColMatRef<'_, usize, f64>, b: &mut [f64]) -> Result<(), String> {
+pub(crate) fn solve_spd_once(
+    a: SparseColMatRef<'_, usize, f64>,
+    b: &mut [f64],
+) -> std::result::Result<(), NumericalError> {
     let n = a.ncols();
     let s = factorize_symbolic_cholesky(a.symbolic(), Side::Upper, SymmetricOrdering::Amd, Default::default())
         .map_err(|e| format!("symbolic Cholesky: {e:?}"))?;
@@ -138,7 +143,10 @@ const PARALLEL_MIN_FLOPS: f64 = 2e10;
 ///
 /// # Errors
 /// A message if faer's analysis fails.
-pub(crate) fn analyse(a: SymbolicSparseColMatRef<'_, usize>, split_allowed: bool) -> Result<Analysis, String> {
+pub(crate) fn analyse(
+    a: SymbolicSparseColMatRef<'_, usize>,
+    split_allowed: bool,
+) -> std::result::Result<Analysis, NumericalError> {
     let n = a.ncols();
     let single = |symbolic: SymbolicCholesky<usize>| {
         let par = parallelism_for(&symbolic);
@@ -146,12 +154,12 @@ pub(crate) fn analyse(a: SymbolicSparseColMatRef<'_, usize>, split_allowed: bool
     };
     let amd = || {
         factorize_symbolic_cholesky(a, Side::Upper, SymmetricOrdering::Amd, params(n))
-            .map_err(|e| format!("symbolic Cholesky: {e:?}"))
+            .map_err(|e| crate::error::NumericalError(format!("symbolic Cholesky: {e:?}")))
     };
     if n < ND_MIN_N {
         return Ok(single(amd()?));
     }
-    let nd = || -> Result<Result<two_way::Symbolic, SymbolicCholesky<usize>>, String> {
+    let nd = || -> Result<Result<two_way::Symbolic, SymbolicCholesky<usize>>, NumericalError> {
         // the dissection's own second thread only where the factorisation may use one
         let g = Graph::from_pattern(a);
         let (perm, top) = dissection(&g, ND_LEAF, split_allowed && n >= PARALLEL_DISSECTION_MIN);
@@ -162,7 +170,7 @@ pub(crate) fn analyse(a: SymbolicSparseColMatRef<'_, usize>, split_allowed: bool
         let p = PermRef::new_checked(&perm, &inv, n);
         factorize_symbolic_cholesky(a, Side::Upper, SymmetricOrdering::Custom(p), params(n))
             .map(Err)
-            .map_err(|e| format!("symbolic Cholesky: {e:?}"))
+            .map_err(|e| crate::error::NumericalError(format!("symbolic Cholesky: {e:?}")))
     };
     if n >= ND_ONLY_N {
         // AMD is compared only where there is no two-way split (a disconnected pattern, a
@@ -203,7 +211,9 @@ pub(crate) fn analyse(a: SymbolicSparseColMatRef<'_, usize>, split_allowed: bool
 ///
 /// # Errors
 /// A message if faer's analysis fails.
-pub(crate) fn analyse_simplicial(a: SymbolicSparseColMatRef<'_, usize>) -> Result<SymbolicCholesky<usize>, String> {
+pub(crate) fn analyse_simplicial(
+    a: SymbolicSparseColMatRef<'_, usize>,
+) -> std::result::Result<SymbolicCholesky<usize>, NumericalError> {
     let n = a.ncols();
     let params = |_| CholeskySymbolicParams {
         supernodal_flop_ratio_threshold: faer::sparse::linalg::SupernodalThreshold::FORCE_SIMPLICIAL,
@@ -229,7 +239,7 @@ enum Numeric {
 }
 
 impl Numeric {
-    fn new(analysis: &Analysis) -> Result<Numeric, String> {
+    fn new(analysis: &Analysis) -> std::result::Result<Numeric, NumericalError> {
         Ok(match analysis {
             Analysis::Single { symbolic, par } => Numeric::Single {
                 l: vec![0.0; symbolic.len_val()],
@@ -265,7 +275,7 @@ impl Workspace {
     ///
     /// # Errors
     /// A message if it cannot be allocated.
-    pub(crate) fn new(analysis: &Analysis) -> Result<Workspace, String> {
+    pub(crate) fn new(analysis: &Analysis) -> std::result::Result<Workspace, NumericalError> {
         let mut numeric = Numeric::new(analysis)?;
         numeric.touch();
         Ok(Workspace(numeric))
@@ -284,7 +294,7 @@ impl SpdFactor {
     ///
     /// # Errors
     /// A message if the workspace cannot be allocated.
-    pub fn new(analysis: std::sync::Arc<Analysis>) -> Result<SpdFactor, String> {
+    pub fn new(analysis: std::sync::Arc<Analysis>) -> std::result::Result<SpdFactor, NumericalError> {
         let numeric = Numeric::new(&analysis)?;
         Ok(SpdFactor { analysis, numeric })
     }
@@ -298,12 +308,12 @@ impl SpdFactor {
     ///
     /// # Errors
     /// A message if `a` is not numerically positive definite.
-    pub fn factor(&mut self, a: SparseColMatRef<'_, usize, f64>) -> Result<(), String> {
+    pub fn factor(&mut self, a: SparseColMatRef<'_, usize, f64>) -> std::result::Result<(), NumericalError> {
         match (&*self.analysis, &mut self.numeric) {
             (Analysis::Single { symbolic, par }, Numeric::Single { l, mem }) => symbolic
                 .factorize_numeric_llt(l, a, Side::Upper, Default::default(), *par, MemStack::new(mem), Spec::default())
                 .map(|_| ())
-                .map_err(|e| format!("{e:?}")),
+                .map_err(|e| NumericalError(format!("{e:?}"))),
             (Analysis::TwoWay(s), Numeric::TwoWay(t)) => t.factor(s, a.val()),
             _ => unreachable!("numeric storage made for its analysis"),
         }

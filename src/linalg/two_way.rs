@@ -181,7 +181,7 @@ impl TwoWay {
     ///
     /// # Errors
     /// A message if the workspace cannot be allocated.
-    pub fn new(s: &Symbolic) -> Result<TwoWay, String> {
+    pub fn new(s: &Symbolic) -> std::result::Result<TwoWay, crate::error::NumericalError> {
         let ls = s.sep.len();
         let oom = |_| "out of memory for the Cholesky workspace".to_string();
         let mut halves = Vec::with_capacity(2);
@@ -227,7 +227,7 @@ impl TwoWay {
     ///
     /// # Errors
     /// A message if `N` is not numerically positive definite.
-    pub fn factor(&mut self, s: &Symbolic, values: &[f64]) -> Result<(), String> {
+    pub fn factor(&mut self, s: &Symbolic, values: &[f64]) -> std::result::Result<(), crate::error::NumericalError> {
         let [n0, n1] = &mut self.halves;
         let [h0, h1] = &s.halves;
         let (sigma, gram) = (&mut self.sigma, &mut self.gram);
@@ -310,7 +310,12 @@ fn touch_mat(m: &mut Mat<f64>) {
 }
 
 /// Gathers a half's values, factorises it, extracts `T` and writes `T Tᵀ` to `gram`.
-fn factor_half(h: &Half, num: &mut HalfNumeric, values: &[f64], gram: &mut Mat<f64>) -> Result<(), String> {
+fn factor_half(
+    h: &Half,
+    num: &mut HalfNumeric,
+    values: &[f64],
+    gram: &mut Mat<f64>,
+) -> std::result::Result<(), crate::error::NumericalError> {
     for (v, &p) in num.values.iter_mut().zip(&h.src) {
         *v = values[p as usize];
     }

@@ -11,7 +11,10 @@ use faer::sparse::Triplet;
 ///
 /// # Errors
 /// A message if `K_FF` is not positive definite (a free part with no fixed vertex).
-pub fn dirichlet_solve(k: &Sparse, fixed: &[Option<f64>]) -> Result<Vec<f64>, String> {
+pub fn dirichlet_solve(
+    k: &Sparse,
+    fixed: &[Option<f64>],
+) -> std::result::Result<Vec<f64>, crate::error::NumericalError> {
     dirichlet_solve_with(k, fixed, None)
 }
 
@@ -24,7 +27,7 @@ pub fn dirichlet_solve_with(
     k: &Sparse,
     fixed: &[Option<f64>],
     analyses: Option<&mut Analyses>,
-) -> Result<Vec<f64>, String> {
+) -> std::result::Result<Vec<f64>, crate::error::NumericalError> {
     let n = k.nrows();
     assert_eq!(fixed.len(), n);
     let mut slot = vec![usize::MAX; n];
@@ -80,7 +83,10 @@ impl<'a> Dirichlet<'a> {
     ///
     /// # Errors
     /// A message if the analysis fails.
-    pub fn new(k: &'a Sparse, analyses: &mut crate::linalg::Analyses) -> Result<Self, String> {
+    pub fn new(
+        k: &'a Sparse,
+        analyses: &mut crate::linalg::Analyses,
+    ) -> std::result::Result<Self, crate::error::NumericalError> {
         let (upper, pattern) = Self::pattern(k);
         let solver = crate::linalg::SpdSolver::new(pattern.as_ref(), analyses)?;
         Ok(Dirichlet { k, upper, pattern, solver })
@@ -113,7 +119,7 @@ impl<'a> Dirichlet<'a> {
     ///
     /// # Errors
     /// A message if a free part touches no fixed vertex.
-    pub fn solve(&mut self, fixed: &[Option<f64>]) -> Result<Vec<f64>, String> {
+    pub fn solve(&mut self, fixed: &[Option<f64>]) -> std::result::Result<Vec<f64>, crate::error::NumericalError> {
         let n = self.k.nrows();
         let val = self.k.val();
         let mut rhs: Vec<f64> = fixed.iter().map(|f| f.unwrap_or(0.0)).collect();

@@ -139,7 +139,7 @@ pub(crate) fn smooth_on<D: Smoothable + Sync>(
         return Err(Error::input(format!("the field has {} values, the domain {n} vertices", h.len())));
     }
     if let Some(&v) = settings.energy.sharp.iter().find(|&&v| v >= n) {
-        return Err(Error::input(format!("--sharp vertex {v} is out of range (the input has {n} vertices)")));
+        return Err(Error::input(format!("sharp vertex {v} is out of range (the input has {n} vertices)")));
     }
     let mut seconds = StageSeconds::default();
 
@@ -149,7 +149,7 @@ pub(crate) fn smooth_on<D: Smoothable + Sync>(
     seconds.persistence = t.elapsed().as_secs_f64();
 
     let (ell, smooth_length_rule) = match settings.smooth_length {
-        Some(fraction) => (fraction * domain.diameter(), format!("--smooth-length {fraction} of the diameter")),
+        Some(fraction) => (fraction * domain.diameter(), format!("{fraction} of the diameter, as given")),
         None => default_smooth_length(domain, &kept),
     };
     let k = &ops.stiffness;

@@ -52,16 +52,16 @@ impl SmoothSettings {
     pub fn validate(&self) -> Result<()> {
         self.energy.validate()?;
         if !(self.data_weight.is_finite() && self.data_weight >= 0.0) {
-            return Err(Error::Usage(format!("--data-weight must be finite and ≥ 0, got {}", self.data_weight)));
+            return Err(Error::setting("data_weight", format!("must be finite and ≥ 0, got {}", self.data_weight)));
         }
         if let Some(w) = self.smooth_weight {
             if !(w.is_finite() && w > 0.0) {
-                return Err(Error::Usage(format!("--smooth-weight must be finite and > 0, got {w}")));
+                return Err(Error::setting("smooth_weight", format!("must be finite and > 0, got {w}")));
             }
         }
         if let Some(l) = self.smooth_length {
             if !(l.is_finite() && l > 0.0) {
-                return Err(Error::Usage(format!("--smooth-length must be finite and > 0, got {l}")));
+                return Err(Error::setting("smooth_length", format!("must be finite and > 0, got {l}")));
             }
         }
         Ok(())

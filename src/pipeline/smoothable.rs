@@ -100,7 +100,11 @@ impl Smoothable for Series {
 
 /// The harmonic representative: kept minima at the data's minimum, kept maxima at its
 /// maximum, harmonic elsewhere with `k` (non-negative weights: the maximum principle holds).
-fn harmonic_representative(h: &[f64], kept: &KeptSet, k: &Sparse) -> std::result::Result<Vec<f64>, String> {
+fn harmonic_representative(
+    h: &[f64],
+    kept: &KeptSet,
+    k: &Sparse,
+) -> std::result::Result<Vec<f64>, crate::error::NumericalError> {
     let (lo, hi) = crate::domain::value_range(h);
     let fixed: Vec<Option<f64>> = kept
         .roles

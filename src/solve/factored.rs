@@ -69,7 +69,7 @@ impl<'r> Normal<'r> {
         row_cols: &[[usize; 2]],
         row_len: &[u8],
         split: bool,
-    ) -> Result<Normal<'r>, String> {
+    ) -> std::result::Result<Normal<'r>, crate::error::NumericalError> {
         let pattern = Pattern::new(r, row_cols, row_len);
         let (cp, ri) = (pattern.symbolic.col_ptr(), pattern.symbolic.row_idx());
         let find = |i: usize, j: usize| {
@@ -131,7 +131,7 @@ impl<'r> Normal<'r> {
     }
 
     /// Factorises the last normal matrix in double-double (once refinement has stalled).
-    fn factor_exact(&mut self) -> Result<(), String> {
+    fn factor_exact(&mut self) -> std::result::Result<(), crate::error::NumericalError> {
         if self.exact.is_none() {
             let symbolic = linalg::analyse_simplicial(self.pattern.symbolic.as_ref())?;
             let mem = MemBuffer::try_new(StackReq::any_of(&[
@@ -206,7 +206,7 @@ impl Objective<fx128> for Normal<'_> {
 
     /// `F_FᵀF_F + diag(d) + Aᵀ diag(w) A` in double-double, and its rounding factorised in
     /// double (or in double-double once refinement has stalled).
-    fn factor(&mut self, rows: &Rows, w: &[fx128]) -> Result<(), String> {
+    fn factor(&mut self, rows: &Rows, w: &[fx128]) -> std::result::Result<(), crate::error::NumericalError> {
         self.vals.copy_from_slice(&self.base);
         for (k, &wk) in w.iter().enumerate() {
             let [p1, p2, p12] = self.pattern.pos_row[k];

@@ -49,7 +49,7 @@ impl Objective<f64> for Assembled<'_> {
     }
 
     /// With a growing diagonal shift if the matrix is not numerically positive definite.
-    fn factor(&mut self, rows: &Rows, w: &[f64]) -> Result<(), String> {
+    fn factor(&mut self, rows: &Rows, w: &[f64]) -> std::result::Result<(), crate::error::NumericalError> {
         let (normal, vals) = (&self.normal, &mut self.vals);
         let mut reg = 0.0;
         for attempt in 0..4 {
@@ -132,7 +132,7 @@ pub(super) fn solve(
     settings: &QpSettings,
     analyses: &mut ordering::Analyses,
     prepared: Option<Prepared>,
-) -> Result<Outcome, String> {
+) -> std::result::Result<Outcome, crate::error::NumericalError> {
     let spare = prepared.and_then(|p| p.keep_in(analyses));
     let rows = Rows::new(r)?;
     match &r.factor {
@@ -164,7 +164,7 @@ fn run<T: Real, O: Objective<T>>(
     objective: &mut O,
     hint: Option<&[f64]>,
     settings: &QpSettings,
-) -> Result<Outcome, String> {
+) -> std::result::Result<Outcome, crate::error::NumericalError> {
     let (n, m) = (r.n, r.m());
     let zero = T::of(0.0);
     let of = T::of;
@@ -264,7 +264,7 @@ fn run<T: Real, O: Objective<T>>(
         let dres = rd.iter().fold(0.0f64, |a, v| a.max(v.to_f64().abs())) / qnorm;
         last = (pres, dres, mu);
         if !(pres.is_finite() && dres.is_finite() && mu.is_finite()) {
-            return Err(format!("non-finite iterate at iteration {it}"));
+            return Err(crate::error::NumericalError(format!("non-finite iterate at iteration {it}")));
         }
         let xmax = x.iter().fold(0.0f64, |a, v| a.max(v.to_f64().abs()));
         let small_step = last_step <= STEP_TOLERANCE * (1.0 + xmax);
@@ -412,7 +412,7 @@ fn run<T: Real, O: Objective<T>>(
         }
         let alpha = (0.99 * alpha_max).min(1.0);
         if alpha < 1e-12 {
-            return Err(format!("step length {alpha:e} at iteration {it}"));
+            return Err(crate::error::NumericalError(format!("step length {alpha:e} at iteration {it}")));
         }
         let a = of(alpha);
         last_step = 0.0;
@@ -430,10 +430,10 @@ fn run<T: Real, O: Objective<T>>(
     if pres <= 1e3 * tol && (has_data || (dres <= 1e3 * tol && mu <= 1e3 * tol)) {
         return Ok(finish(&x, &z, SolveStatus::AlmostSolved, settings.max_iter, objective));
     }
-    Err(format!(
+    Err(crate::error::NumericalError(format!(
         "no convergence in {} iterations (primal {pres:.1e}, dual {dres:.1e}, gap {mu:.1e})",
         settings.max_iter
-    ))
+    )))
 }
 
 /// The normal matrix's pattern [`solve`] analyses for `r`.

@@ -89,7 +89,7 @@ impl Prepared {
         slot: &[usize],
         n: usize,
         split_allowed: bool,
-    ) -> Result<Prepared, String> {
+    ) -> std::result::Result<Prepared, crate::error::NumericalError> {
         let (cp, ri) = (p.col_ptr(), p.row_idx());
         let pairs = (0..p.ncols()).flat_map(|j| {
             ri[cp[j]..p.col_range(j).end].iter().filter_map(move |&i| {
@@ -174,14 +174,14 @@ pub(super) struct Rows {
 
 impl Rows {
     /// The rows of `r`; `Err` if one has more than two entries.
-    pub(super) fn new(r: &ReducedQp) -> Result<Rows, String> {
+    pub(super) fn new(r: &ReducedQp) -> std::result::Result<Rows, crate::error::NumericalError> {
         let m = r.m();
         let mut rows = Rows { cols: vec![[0; 2]; m], vals: vec![[0.0; 2]; m], len: vec![0; m] };
         for k in 0..r.a_row.len() {
             let row = r.a_row[k];
             let l = rows.len[row] as usize;
             if l >= 2 {
-                return Err(format!("row {row} has more than two entries"));
+                return Err(crate::error::NumericalError(format!("row {row} has more than two entries")));
             }
             rows.cols[row][l] = r.a_col[k];
             rows.vals[row][l] = r.a_val[k];
@@ -219,7 +219,7 @@ pub(super) trait Objective<T: Real> {
     /// `out = ∇φ(x)`.
     fn gradient(&mut self, x: &[T], out: &mut [T]);
     /// Factorises `P + Aᵀ diag(w) A`.
-    fn factor(&mut self, rows: &Rows, w: &[T]) -> Result<(), String>;
+    fn factor(&mut self, rows: &Rows, w: &[T]) -> std::result::Result<(), crate::error::NumericalError>;
     /// Overwrites `rhs` with the last factorised matrix's inverse times it.
     fn solve_in_place(&mut self, rhs: &mut [T]);
     /// The auxiliary variables `t = F x + g` (factored form), rounded.

@@ -99,13 +99,13 @@ pub fn solve_monotone_qp_with(
                 match super::ipm::solve(&reduced, hint.as_deref(), settings, analyses, None) {
                     Ok(out) => (out, Method::Structured),
                     Err(why) => {
-                        fallback = Some(why);
+                        fallback = Some(why.to_string());
                         (clarabel(&reduced)?, Method::Clarabel)
                     }
                 }
             }
             Err(why) => {
-                fallback = Some(why);
+                fallback = Some(why.to_string());
                 (clarabel(&reduced)?, Method::Clarabel)
             }
         },
@@ -128,7 +128,11 @@ pub fn solve_monotone_qp_with(
 ///
 /// # Errors
 /// A message if the analysis fails.
-pub fn prepare(p: &Sparse, fixed: &[Option<f64>], split_allowed: bool) -> std::result::Result<Prepared, String> {
+pub fn prepare(
+    p: &Sparse,
+    fixed: &[Option<f64>],
+    split_allowed: bool,
+) -> std::result::Result<Prepared, crate::error::NumericalError> {
     let mut slot = vec![usize::MAX; fixed.len()];
     let mut n = 0;
     for (i, f) in fixed.iter().enumerate() {

@@ -420,7 +420,7 @@ impl DiscreteGradient {
     /// # Errors
     /// A description of the pair that could not be cancelled (no critical edge at its merge
     /// vertex joins its basin to another one): never expected for persistence-chosen sets.
-    pub fn simplify(&mut self, pairs: &[super::Pair], keep: &[bool]) -> Result<usize, String> {
+    pub fn simplify(&mut self, pairs: &[super::Pair], keep: &[bool]) -> Result<usize, crate::error::ConstructionError> {
         let mut order: Vec<&super::Pair> = pairs.iter().filter(|p| p.partner.is_some() && !keep[p.extremum]).collect();
         order.sort_by(|a, b| {
             a.persistence
@@ -447,7 +447,7 @@ impl DiscreteGradient {
             let m = p.extremum as u32;
             let s = p.partner.expect("filtered") as u32;
             if self.vertex_pair[m as usize] != Pairing::Critical {
-                return Err(format!("vertex {m} is not critical any more"));
+                return Err(crate::error::ConstructionError::Unfit(format!("vertex {m} is not critical any more")));
             }
             let rs = self.rank[s as usize];
             let mut done = false;
@@ -471,10 +471,10 @@ impl DiscreteGradient {
                 break;
             }
             if !done {
-                return Err(format!(
+                return Err(crate::error::ConstructionError::Unfit(format!(
                     "no critical edge at vertex {s} joins the basin of extremum {m} to another one (persistence {})",
                     p.persistence
-                ));
+                )));
             }
         }
         Ok(cancelled)

@@ -41,7 +41,7 @@ impl MorseSmale {
     ///
     /// # Errors
     /// A description of a cancellation that failed (never expected for persistence sets).
-    pub fn new<D: Domain>(domain: &D, values: &[f64], kept: &KeptSet) -> Result<Self, String> {
+    pub fn new<D: Domain>(domain: &D, values: &[f64], kept: &KeptSet) -> Result<Self, crate::error::ConstructionError> {
         let t = std::time::Instant::now();
         let complex = std::sync::Arc::new(super::gradient::Complex::new(domain));
         let mut down = DiscreteGradient::on(complex.clone(), values, Direction::Descending);

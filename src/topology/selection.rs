@@ -201,7 +201,10 @@ pub fn select<D: Domain>(domain: &D, values: &[f64], selection: &Selection) -> R
         }
         Selection::Pairs(count) => {
             if domain.pairing_rule() != PairingRule::Path {
-                return Err(Error::Usage("--pairs applies to series; use --minima/--maxima".into()));
+                return Err(Error::setting(
+                    "pairs",
+                    "applies to series; on a surface keep a count of minima and maxima",
+                ));
             }
             let available = minima_pairs.iter().filter(|p| p.partner.is_some() && p.persistence > 0.0).count();
             if *count > available {
@@ -211,7 +214,7 @@ pub fn select<D: Domain>(domain: &D, values: &[f64], selection: &Selection) -> R
         }
         Selection::AllMaxima | Selection::AllMinima => {
             if domain.pairing_rule() == PairingRule::Path {
-                return Err(Error::Usage("--keep-all-maxima/--keep-all-minima apply to surfaces".into()));
+                return Err(Error::setting("all_extrema", "apply to surfaces"));
             }
             let maxima_pairs = superlevel_pairs(domain, values);
             let all = |pairs: &[Pair]| -> Kept {
@@ -228,7 +231,10 @@ pub fn select<D: Domain>(domain: &D, values: &[f64], selection: &Selection) -> R
         }
         Selection::Count { minima, maxima } => {
             if domain.pairing_rule() == PairingRule::Path {
-                return Err(Error::Usage("on a series a count means pairs: use --pairs N".into()));
+                return Err(Error::setting(
+                    "count",
+                    "on a series a count of minima and maxima is a count of pairs: keep pairs",
+                ));
             }
             let maxima_pairs = superlevel_pairs(domain, values);
             let (a, w1) = by_count(values, &minima_pairs, *minima, true);
@@ -416,30 +422,30 @@ fn check_explicit<D: Domain>(domain: &D, values: &[f64], minima: &[usize], maxim
             }))
             .collect();
         kept.sort_by_key(|k| k.index);
-        check_alternation(values, &kept).map_err(Error::infeasible)?;
+        check_alternation(values, &kept)?;
     }
     Ok(())
 }
 
 /// Along a series, kept minima and maxima must alternate and each minimum must lie strictly
 /// below its neighbouring kept maxima.
-fn check_alternation(values: &[f64], kept: &[KeptExtremum]) -> std::result::Result<(), String> {
+fn check_alternation(values: &[f64], kept: &[KeptExtremum]) -> Result<()> {
     for w in kept.windows(2) {
         let (a, b) = (&w[0], &w[1]);
         if a.role == b.role {
-            return Err(format!(
+            return Err(Error::infeasible(format!(
                 "kept {}s {} and {} are consecutive: minima and maxima must alternate along a series",
                 a.role.label(),
                 a.index,
                 b.index
-            ));
+            )));
         }
         let (mn, mx) = if a.role == Role::Min { (a, b) } else { (b, a) };
         if values[mn.index] >= values[mx.index] {
-            return Err(format!(
+            return Err(Error::infeasible(format!(
                 "kept minimum {} (value {}) is not strictly below the neighbouring kept maximum {} (value {})",
                 mn.index, values[mn.index], mx.index, values[mx.index]
-            ));
+            )));
         }
     }
     Ok(())

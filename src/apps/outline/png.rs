@@ -2,17 +2,17 @@
 //! pixel edges and simplified (see [`super::read_outline`] for the conventions).
 
 use super::shape::{signed_area2, Outline, TRACE_TOLERANCE};
+use crate::error::{Error, Result};
 
-type Msg = String;
 type Loops = Vec<Vec<[f64; 2]>>;
 
 /// Directions of boundary edges on the corner lattice (y up): +x, +y, −x, −y.
 const STEP: [[i64; 2]; 4] = [[1, 0], [0, 1], [-1, 0], [0, -1]];
 
 /// The mask, traced and simplified: the outer boundary first, then the holes.
-pub(super) fn read_png(bytes: &[u8]) -> Result<Loops, Msg> {
+pub(super) fn read_png(bytes: &[u8]) -> Result<Loops> {
     let img = image::load_from_memory_with_format(bytes, image::ImageFormat::Png)
-        .map_err(|e| format!("cannot read the PNG image: {e}"))?;
+        .map_err(|e| Error::input(format!("cannot read the PNG image: {e}")))?;
     let (w, h) = (img.width() as usize, img.height() as usize);
     let mut mask: Vec<bool> = Vec::new();
     if img.color().has_alpha() {
@@ -28,7 +28,7 @@ pub(super) fn read_png(bytes: &[u8]) -> Result<Loops, Msg> {
         mask = (0..w * h).map(|k| luma.get_pixel((k % w) as u32, (h - 1 - k / w) as u32).0[0] < 128).collect();
     }
     let region = largest_region(&mask, w, h).ok_or_else(|| {
-        "no pixel is inside the shape (inside: alpha ≥ 50 %, or without transparency a grey level < 50 %)".to_string()
+        Error::input("no pixel is inside the shape (inside: alpha ≥ 50 %, or without transparency a grey level < 50 %)")
     })?;
     let loops = trace(&region, w, h);
     Ok(simplify_valid(loops))

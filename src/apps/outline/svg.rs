@@ -1,9 +1,9 @@
 //! Outlines from SVG: shapes and paths as closed polygons (see [`super::read_outline`]).
 
 use super::shape::CURVE_SEGMENTS;
+use crate::error::{Error, Result};
 use quick_xml::events::{BytesStart, Event};
 
-type Msg = String;
 type Loops = Vec<Vec<[f64; 2]>>;
 
 /// An affine map `(x, y) ↦ (a x + c y + e, b x + d y + f)` as `[a, b, c, d, e, f]`.
@@ -31,7 +31,7 @@ fn apply(m: Affine, p: [f64; 2]) -> [f64; 2] {
 const HIDDEN: [&[u8]; 7] = [b"defs", b"clipPath", b"mask", b"symbol", b"pattern", b"marker", b"metadata"];
 
 /// Reads every shape of an SVG document as closed loops, in document order, y negated.
-pub(super) fn read_svg(bytes: &[u8]) -> Result<Loops, Msg> {
+pub(super) fn read_svg(bytes: &[u8]) -> Result<Loops> {
     let line_of = |pos: u64| bytes[..(pos as usize).min(bytes.len())].iter().filter(|&&b| b == b'\n').count() + 1;
     let mut reader = quick_xml::Reader::from_reader(bytes);
     // open elements: their transform, and whether they are hidden
@@ -42,7 +42,7 @@ pub(super) fn read_svg(bytes: &[u8]) -> Result<Loops, Msg> {
         let pos = reader.buffer_position();
         let event = reader
             .read_event()
-            .map_err(|e| format!("malformed XML near line {}: {e}", line_of(reader.error_position())))?;
+            .map_err(|e| Error::input(format!("malformed XML near line {}: {e}", line_of(reader.error_position()))))?;
         let (e, empty) = match &event {
             Event::Start(e) => (e, false),
             Event::Empty(e) => (e, true),
@@ -56,7 +56,9 @@ pub(super) fn read_svg(bytes: &[u8]) -> Result<Loops, Msg> {
             _ => continue,
         };
         let name = e.local_name().as_ref().to_vec();
-        let at = |m: &str| format!("line {}: <{}>: {m}", line_of(pos), String::from_utf8_lossy(&name));
+        let at = |m: &dyn std::fmt::Display| {
+            Error::input(format!("line {}: <{}>: {m}", line_of(pos), String::from_utf8_lossy(&name)))
+        };
         saw_svg |= name == b"svg";
         let (parent, hidden_above) = *stack.last().unwrap_or(&(IDENTITY, false));
         let attrs = attributes(e).map_err(|m| at(&m))?;
@@ -73,7 +75,7 @@ pub(super) fn read_svg(bytes: &[u8]) -> Result<Loops, Msg> {
         if hidden {
             continue;
         }
-        let number = |key: &str| -> Result<f64, Msg> {
+        let number = |key: &str| -> Result<f64> {
             match get(key) {
                 None => Ok(0.0),
                 Some(v) => length(v).ok_or_else(|| at(&format!("`{key}=\"{v}\"` is not a number in user units"))),
@@ -92,7 +94,7 @@ pub(super) fn read_svg(bytes: &[u8]) -> Result<Loops, Msg> {
             b"rect" => {
                 let (x, y, w, h) = (number("x")?, number("y")?, number("width")?, number("height")?);
                 if number("rx")? != 0.0 || number("ry")? != 0.0 {
-                    return Err(at("rounded rectangles (rx, ry) are not supported: convert the shape to a path"));
+                    return Err(at(&"rounded rectangles (rx, ry) are not supported: convert the shape to a path"));
                 }
                 shapes.push(vec![[x, y], [x + w, y], [x + w, y + h], [x, y + h]]);
             }
@@ -110,7 +112,7 @@ pub(super) fn read_svg(bytes: &[u8]) -> Result<Loops, Msg> {
                         .collect(),
                 );
             }
-            b"use" => return Err(at("<use> clones are not supported: unlink them (make them real paths) first")),
+            b"use" => return Err(at(&"<use> clones are not supported: unlink them (make them real paths) first")),
             _ => {}
         }
         for s in shapes {
@@ -121,18 +123,18 @@ pub(super) fn read_svg(bytes: &[u8]) -> Result<Loops, Msg> {
         }
     }
     if !saw_svg {
-        return Err("not an SVG document (no <svg> element)".into());
+        return Err(Error::input("not an SVG document (no <svg> element)"));
     }
     if loops.is_empty() {
-        return Err("no shape found (polygon, polyline, path, rect, circle or ellipse)".into());
+        return Err(Error::input("no shape found (polygon, polyline, path, rect, circle or ellipse)"));
     }
     Ok(loops)
 }
 
-fn attributes(e: &BytesStart) -> Result<Vec<(String, String)>, Msg> {
+fn attributes(e: &BytesStart) -> Result<Vec<(String, String)>> {
     e.attributes()
         .map(|a| {
-            let a = a.map_err(|err| format!("malformed attribute: {err}"))?;
+            let a = a.map_err(|err| Error::input(format!("malformed attribute: {err}")))?;
             let key = String::from_utf8_lossy(a.key.local_name().as_ref()).into_owned();
             let value = match a.unescape_value() {
                 Ok(v) => v.into_owned(),
@@ -222,11 +224,11 @@ impl Cursor<'_> {
     }
 }
 
-fn numbers(text: &str) -> Result<Vec<f64>, Msg> {
+fn numbers(text: &str) -> Result<Vec<f64>> {
     let mut c = Cursor { s: text.as_bytes(), i: 0 };
     let mut out = Vec::new();
     while !c.done() {
-        out.push(c.number().ok_or_else(|| format!("`{}` is not a number", rest(&c)))?);
+        out.push(c.number().ok_or_else(|| Error::input(format!("`{}` is not a number", rest(&c))))?);
     }
     Ok(out)
 }
@@ -237,7 +239,7 @@ fn rest(c: &Cursor) -> String {
 }
 
 /// Parses a `transform` list: matrix, translate, scale, rotate, skewX, skewY (or `none`).
-fn parse_transform(text: &str) -> Result<Affine, Msg> {
+fn parse_transform(text: &str) -> Result<Affine> {
     let t = text.trim();
     if t.is_empty() || t == "none" {
         return Ok(IDENTITY);
@@ -246,11 +248,13 @@ fn parse_transform(text: &str) -> Result<Affine, Msg> {
     let mut s = t;
     while !s.trim_start_matches(|c: char| c.is_whitespace() || c == ',').is_empty() {
         s = s.trim_start_matches(|c: char| c.is_whitespace() || c == ',');
-        let open = s.find('(').ok_or_else(|| format!("cannot handle transform `{text}`"))?;
-        let close = s.find(')').ok_or_else(|| format!("cannot handle transform `{text}` (no closing parenthesis)"))?;
+        let open = s.find('(').ok_or_else(|| Error::input(format!("cannot handle transform `{text}`")))?;
+        let close = s
+            .find(')')
+            .ok_or_else(|| Error::input(format!("cannot handle transform `{text}` (no closing parenthesis)")))?;
         let name = s[..open].trim();
-        let args = numbers(&s[open + 1..close]).map_err(|e| format!("transform `{text}`: {e}"))?;
-        let bad = || format!("cannot handle transform `{text}`: {name} with {} values", args.len());
+        let args = numbers(&s[open + 1..close]).map_err(|e| Error::input(format!("transform `{text}`: {e}")))?;
+        let bad = || Error::input(format!("cannot handle transform `{text}`: {name} with {} values", args.len()));
         let rad = |a: f64| a.to_radians();
         let step: Affine = match (name, args.as_slice()) {
             ("matrix", [a, b, c, d, e, f]) => [*a, *b, *c, *d, *e, *f],
@@ -270,7 +274,7 @@ fn parse_transform(text: &str) -> Result<Affine, Msg> {
             ("skewX", [a]) => [1.0, 0.0, rad(*a).tan(), 1.0, 0.0, 0.0],
             ("skewY", [a]) => [1.0, rad(*a).tan(), 0.0, 1.0, 0.0, 0.0],
             ("matrix" | "translate" | "scale" | "rotate" | "skewX" | "skewY", _) => return Err(bad()),
-            _ => return Err(format!("cannot handle transform `{text}` (unknown `{name}`)")),
+            _ => return Err(Error::input(format!("cannot handle transform `{text}` (unknown `{name}`)"))),
         };
         m = compose(m, step);
         s = &s[close + 1..];
@@ -343,7 +347,7 @@ fn arc(p0: [f64; 2], rx: f64, ry: f64, phi_deg: f64, large: bool, sweep: bool, p
 }
 
 /// The subpaths of a path's `d`, each a closed loop (open subpaths are closed as SVG fills them).
-fn path(d: &str) -> Result<Loops, Msg> {
+fn path(d: &str) -> Result<Loops> {
     let mut c = Cursor { s: d.as_bytes(), i: 0 };
     let mut loops: Loops = Vec::new();
     let mut current: Vec<[f64; 2]> = Vec::new();
@@ -358,18 +362,19 @@ fn path(d: &str) -> Result<Loops, Msg> {
             c.i += 1;
             command = Some(next);
         } else if command.is_none() {
-            return Err(format!("`d` must start with a moveto (M or m), found `{}`", rest(&c)));
+            return Err(Error::input(format!("`d` must start with a moveto (M or m), found `{}`", rest(&c))));
         }
         let cmd = command.unwrap_or(b'M');
         if !started && !matches!(cmd, b'M' | b'm') {
-            return Err(format!("`d` must start with a moveto (M or m), found `{}`", cmd as char));
+            return Err(Error::input(format!("`d` must start with a moveto (M or m), found `{}`", cmd as char)));
         }
         started = true;
         let relative = cmd.is_ascii_lowercase();
         let base = if relative { cur } else { [0.0, 0.0] };
-        let fail = |c: &Cursor| format!("`d`: command {} needs more numbers at `{}`", cmd as char, rest(c));
+        let fail =
+            |c: &Cursor| Error::input(format!("`d`: command {} needs more numbers at `{}`", cmd as char, rest(c)));
         let num = |c: &mut Cursor| c.number().ok_or_else(|| fail(c));
-        let point = |c: &mut Cursor| -> Result<[f64; 2], Msg> {
+        let point = |c: &mut Cursor| -> Result<[f64; 2]> {
             let x = num(c)?;
             let y = num(c)?;
             Ok([base[0] + x, base[1] + y])
@@ -400,7 +405,7 @@ fn path(d: &str) -> Result<Loops, Msg> {
                 // numbers after Z without a command are an error
                 command = None;
                 if !c.done() && !c.peek().is_some_and(|b| b.is_ascii_alphabetic()) {
-                    return Err(format!("`d`: numbers after Z need a command, at `{}`", rest(&c)));
+                    return Err(Error::input(format!("`d`: numbers after Z need a command, at `{}`", rest(&c))));
                 }
             }
             b'L' => {
@@ -446,7 +451,7 @@ fn path(d: &str) -> Result<Loops, Msg> {
                 arc(cur, rx, ry, phi, large, sweep, p, &mut current);
                 cur = p;
             }
-            other => return Err(format!("`d`: unknown command `{}`", other as char)),
+            other => return Err(Error::input(format!("`d`: unknown command `{}`", other as char))),
         }
         last_cubic = cubic_ctrl;
         last_quad = quad_ctrl;
@@ -499,9 +504,9 @@ mod tests {
         }
         // the smooth cubic reflects the control point (1, 1) about (1, 0): its midpoint is below
         assert!(l[CURVE_SEGMENTS + CURVE_SEGMENTS / 2][1] < 0.0);
-        assert!(path("M0 0 L1").unwrap_err().contains("needs more numbers"));
-        assert!(path("L0 0 1 1").unwrap_err().contains("moveto"));
-        assert!(path("M0 0 X1 1").unwrap_err().contains("unknown command"));
+        assert!(path("M0 0 L1").unwrap_err().to_string().contains("needs more numbers"));
+        assert!(path("L0 0 1 1").unwrap_err().to_string().contains("moveto"));
+        assert!(path("M0 0 X1 1").unwrap_err().to_string().contains("unknown command"));
     }
 
     #[test]
@@ -531,10 +536,10 @@ mod tests {
             (r#"<svg><g/></svg>"#, "no shape"),
             (r#"<html/>"#, "not an SVG"),
         ] {
-            let e = read_svg(text.as_bytes()).unwrap_err();
+            let e = read_svg(text.as_bytes()).unwrap_err().to_string();
             assert!(e.contains(needle), "{text}: {e}");
         }
-        let e = read_svg(b"<svg>\n<path d=\"M0 0 Lx\"/></svg>").unwrap_err();
+        let e = read_svg(b"<svg>\n<path d=\"M0 0 Lx\"/></svg>").unwrap_err().to_string();
         assert!(e.starts_with("line 2: <path>"), "{e}");
     }
 }

@@ -17,6 +17,8 @@ pub enum Error {
     Input {
         /// File the input came from, if any.
         path: Option<PathBuf>,
+        /// The first offending element, when the error has one (the message names it too).
+        at: Option<Location>,
         /// What is wrong, with the first offending rows or vertices.
         message: String,
     },
@@ -26,6 +28,8 @@ pub enum Error {
     Infeasible {
         /// File the input came from, if any.
         path: Option<PathBuf>,
+        /// The first vertex in conflict, when one is.
+        at: Option<Location>,
         /// Which extrema conflict.
         message: String,
     },
@@ -125,6 +129,22 @@ pub enum ConstructionError {
     Unfit(String),
 }
 
+/// Where in the input an error is: the element a program can point at (a viewer selecting the
+/// vertex, an editor jumping to the line).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "lowercase"))]
+pub enum Location {
+    /// A vertex (sample) of the domain, 0-based.
+    Vertex(usize),
+    /// A triangle (face) of a mesh, 0-based in file order.
+    Triangle(usize),
+    /// A line of a text file, 1-based.
+    Line(usize),
+    /// A byte offset in a file, 0-based.
+    Byte(u64),
+}
+
 /// What kind of failure an [`Error`] is: one kind per exit status of SPEC.md's "Exit status"
 /// (and the failures behind it), for callers that branch on it rather than on the message.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -167,7 +187,7 @@ fn prefix(path: &Option<PathBuf>) -> String {
 impl Error {
     /// An input error without a file (the caller attaches one with [`Error::in_file`]).
     pub fn input(message: impl Into<String>) -> Self {
-        Error::Input { path: None, message: message.into() }
+        Error::Input { path: None, at: None, message: message.into() }
     }
 
     /// A setting error ([`Error::Setting`]).
@@ -180,9 +200,26 @@ impl Error {
         Error::Internal { path: None, message: message.into() }
     }
 
+    /// Records where the error is (input and infeasibility errors; others are unchanged).
+    #[must_use]
+    pub fn at(mut self, location: Location) -> Self {
+        if let Error::Input { at, .. } | Error::Infeasible { at, .. } = &mut self {
+            *at = Some(location);
+        }
+        self
+    }
+
+    /// Where the error is, when it names an element.
+    pub fn location(&self) -> Option<Location> {
+        match self {
+            Error::Input { at, .. } | Error::Infeasible { at, .. } => *at,
+            _ => None,
+        }
+    }
+
     /// An infeasibility error without a file.
     pub fn infeasible(message: impl Into<String>) -> Self {
-        Error::Infeasible { path: None, message: message.into() }
+        Error::Infeasible { path: None, at: None, message: message.into() }
     }
 
     /// Attaches `file` to an error that does not name one yet.

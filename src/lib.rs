@@ -33,7 +33,7 @@ pub mod operators;
 pub mod topology;
 
 pub use domain::{Grid2d, Series, TriMesh};
-pub use error::{Error, ErrorKind, Result};
+pub use error::{Error, ErrorKind, Location, Result};
 pub use pipeline::{smooth, SmoothSettings, Smoothed};
 pub use smoother::{AnyDomain, AnySmoother, Smoother};
 pub use topology::Selection;

@@ -122,9 +122,11 @@ pub fn read_mesh_field(path: &Path, opts: &GridOptions) -> Result<MeshInput> {
                 if t.is_empty() || t.starts_with('#') {
                     continue;
                 }
-                let v: f64 = t
-                    .parse()
-                    .map_err(|_| Error::input(format!("line {}: `{t}` is not a number", l + 1)).in_file(file))?;
+                let v: f64 = t.parse().map_err(|_| {
+                    Error::input(format!("line {}: `{t}` is not a number", l + 1))
+                        .at(crate::error::Location::Line(l + 1))
+                        .in_file(file)
+                })?;
                 values.push(v);
             }
             if values.len() != n {

@@ -23,8 +23,11 @@
 
 use super::vec3::{cross, norm, sub};
 use super::{Domain, PairingRule};
-use crate::error::{Error, Result};
+use crate::error::Result;
 use std::collections::HashMap;
+
+mod connect;
+mod validate;
 
 /// A validated triangle mesh with its vertex adjacency.
 #[derive(Clone, Debug)]
@@ -43,22 +46,7 @@ pub struct TriMesh {
     orientable: bool,
 }
 
-/// At most this many offending elements are named in a message.
-const SHOW: usize = 5;
-
-fn list<T: std::fmt::Display>(items: &[T]) -> String {
-    let shown: Vec<String> = items.iter().take(SHOW).map(|x| x.to_string()).collect();
-    if items.len() > SHOW {
-        format!("{}, … ({} in all)", shown.join(", "), items.len())
-    } else {
-        shown.join(", ")
-    }
-}
-
-/// Area of a triangle given by its corner positions.
-pub fn triangle_area(a: [f64; 3], b: [f64; 3], c: [f64; 3]) -> f64 {
-    0.5 * norm(cross(sub(b, a), sub(c, a)))
-}
+pub use validate::triangle_area;
 
 impl TriMesh {
     /// Validates and builds a mesh (vertex indices 0-based). Messages name the first
@@ -71,306 +59,39 @@ impl TriMesh {
     /// whose triangles form more than one fan.
     pub fn new(positions: Vec<[f64; 3]>, mut triangles: Vec<[usize; 3]>) -> Result<TriMesh> {
         let n = positions.len();
-        if n == 0 || triangles.is_empty() {
-            return Err(Error::input(format!(
-                "the mesh has {n} vertices and {} triangles: it needs at least one triangle",
-                triangles.len()
-            )));
-        }
-        let bad: Vec<usize> = (0..n).filter(|&v| positions[v].iter().any(|x| !x.is_finite())).collect();
-        if !bad.is_empty() {
-            return Err(Error::input(format!("non-finite coordinates at vertices {}", list(&bad))));
-        }
-        let bad: Vec<usize> = (0..triangles.len()).filter(|&t| triangles[t].iter().any(|&v| v >= n)).collect();
-        if !bad.is_empty() {
-            return Err(Error::input(format!(
-                "triangles {} use a vertex index beyond the {n} vertices (e.g. triangle {} = {:?})",
-                list(&bad),
-                bad[0],
-                triangles[bad[0]]
-            )));
-        }
-        let bad: Vec<usize> = (0..triangles.len())
-            .filter(|&t| {
-                let [a, b, c] = triangles[t];
-                a == b || b == c || a == c
-            })
-            .collect();
-        if !bad.is_empty() {
-            return Err(Error::input(format!(
-                "triangles {} repeat a vertex (e.g. triangle {} = {:?})",
-                list(&bad),
-                bad[0],
-                triangles[bad[0]]
-            )));
-        }
-        // zero area relative to the mesh's scale (bounding-box diagonal)
-        let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
-        for p in &positions {
-            for k in 0..3 {
-                lo[k] = lo[k].min(p[k]);
-                hi[k] = hi[k].max(p[k]);
-            }
-        }
-        let diameter = norm(sub(hi, lo));
-        let bad: Vec<usize> = (0..triangles.len())
-            .filter(|&t| {
-                let [a, b, c] = triangles[t];
-                triangle_area(positions[a], positions[b], positions[c]) <= 1e-14 * diameter * diameter
-            })
-            .collect();
-        if !bad.is_empty() {
-            return Err(Error::input(format!(
-                "triangles {} have zero area (degenerate: collinear or coincident corners)",
-                list(&bad)
-            )));
-        }
-        let mut keyed: Vec<([usize; 3], usize)> = triangles
-            .iter()
-            .enumerate()
-            .map(|(t, tri)| {
-                let mut key = *tri;
-                key.sort_unstable();
-                (key, t)
-            })
-            .collect();
-        keyed.sort_unstable();
-        let mut dups: Vec<(usize, usize)> =
-            keyed.windows(2).filter(|w| w[0].0 == w[1].0).map(|w| (w[1].1, w[0].1)).collect();
-        dups.sort_unstable();
-        let dups: Vec<String> = dups.iter().map(|(t, first)| format!("{t} (= {first})")).collect();
-        drop(keyed);
-        if !dups.is_empty() {
-            return Err(Error::input(format!("duplicate triangles {}", list(&dups))));
-        }
-        let mut used = vec![false; n];
-        for tri in &triangles {
-            for &v in tri {
-                used[v] = true;
-            }
-        }
-        let bad: Vec<usize> = (0..n).filter(|&v| !used[v]).collect();
-        if !bad.is_empty() {
-            return Err(Error::input(format!("vertices {} are used by no triangle", list(&bad))));
-        }
-        let mut order: Vec<usize> = (0..n).collect();
-        order.sort_unstable_by(|&a, &b| positions[a].partial_cmp(&positions[b]).expect("finite"));
-        let dups: Vec<String> = order
-            .windows(2)
-            .filter(|w| positions[w[0]] == positions[w[1]])
-            .map(|w| format!("{} and {}", w[0].min(w[1]), w[0].max(w[1])))
-            .collect();
-        if !dups.is_empty() {
-            return Err(Error::input(format!(
-                "vertices at the same position: {} (a triangle soup? merge duplicate vertices first)",
-                list(&dups)
-            )));
-        }
-        // edges and their triangles, from the sorted half-edges (no hashing: this is the
-        // hot part of reading a large mesh)
-        let nt = triangles.len();
-        let mut half: Vec<(usize, usize, usize)> = Vec::with_capacity(3 * nt);
-        for (t, tri) in triangles.iter().enumerate() {
-            for k in 0..3 {
-                let (a, b) = (tri[k], tri[(k + 1) % 3]);
-                half.push((a.min(b), a.max(b), 3 * t + k));
-            }
-        }
-        // counting sort by the smaller vertex, then each short bucket: the order of sorting the
-        // triples, in linear time
-        let mut start = vec![0usize; n + 1];
-        for h in &half {
-            start[h.0 + 1] += 1;
-        }
-        for v in 0..n {
-            start[v + 1] += start[v];
-        }
-        let mut sorted = vec![(0usize, 0usize, 0usize); half.len()];
-        let mut fill = start.clone();
-        for &h in &half {
-            sorted[fill[h.0]] = h;
-            fill[h.0] += 1;
-        }
-        for v in 0..n {
-            sorted[start[v]..start[v + 1]].sort_unstable();
-        }
-        let half = sorted;
-        let mut edges: Vec<(usize, usize)> = Vec::with_capacity(3 * nt / 2 + 1);
-        let mut edge_tris: Vec<[usize; 2]> = Vec::with_capacity(3 * nt / 2 + 1);
-        // the edge of every corner's outgoing side (corner 3t + k: side k of triangle t)
-        let mut side_edge = vec![0usize; 3 * nt];
-        let mut bad: Vec<String> = Vec::new();
-        let mut i = 0;
-        while i < half.len() {
-            let (a, b, c) = half[i];
-            let mut j = i + 1;
-            while j < half.len() && (half[j].0, half[j].1) == (a, b) {
-                j += 1;
-            }
-            if j - i > 2 {
-                bad.push(format!("{a}–{b} ({} triangles)", j - i));
-            }
-            for h in &half[i..j] {
-                side_edge[h.2] = edges.len();
-            }
-            edges.push((a, b));
-            edge_tris.push([c / 3, if j - i >= 2 { half[i + 1].2 / 3 } else { usize::MAX }]);
-            i = j;
-        }
-        drop(half);
-        if !bad.is_empty() {
-            return Err(Error::input(format!("non-manifold edges (on more than two triangles): {}", list(&bad))));
-        }
-        // the edge {a, b} of triangle t (its sides as read: orientation repairs reorder corners)
-        let edge_of = |t: usize, a: usize, b: usize| -> usize {
-            let key = (a.min(b), a.max(b));
-            *side_edge[3 * t..3 * t + 3].iter().find(|&&e| edges[e] == key).expect("a side of the triangle")
-        };
-        // manifold vertices: the corners (vertex, triangle) at a vertex are joined across its
-        // interior edges; more than one group is more than one fan
-        let corner =
-            |tris: &[[usize; 3]], v: usize, t: usize| 3 * t + tris[t].iter().position(|&x| x == v).expect("corner");
-        let mut parent: Vec<usize> = (0..3 * nt).collect();
-        fn root(p: &mut [usize], mut x: usize) -> usize {
-            while p[x] != x {
-                p[x] = p[p[x]];
-                x = p[x];
-            }
-            x
-        }
-        for (e, &(a, b)) in edges.iter().enumerate() {
-            let [t1, t2] = edge_tris[e];
-            if t2 == usize::MAX {
-                continue;
-            }
-            for v in [a, b] {
-                let (r1, r2) =
-                    (root(&mut parent, corner(&triangles, v, t1)), root(&mut parent, corner(&triangles, v, t2)));
-                if r1 != r2 {
-                    parent[r1] = r2;
-                }
-            }
-        }
-        let mut fans = vec![0u32; n];
-        for c in 0..3 * nt {
-            if root(&mut parent, c) == c {
-                fans[triangles[c / 3][c % 3]] += 1;
-            }
-        }
-        drop(parent);
-        let bad: Vec<usize> = (0..n).filter(|&v| fans[v] > 1).collect();
-        if !bad.is_empty() {
-            return Err(Error::input(format!(
-                "non-manifold vertices {} (their triangles form more than one fan)",
-                list(&bad)
-            )));
-        }
-        // components of the triangle graph; consistent orientation by BFS
-        let mut tri_comp = vec![usize::MAX; nt];
-        let mut n_components = 0;
-        let mut flipped = 0usize;
-        let mut non_orientable = 0usize;
-        for seed in 0..nt {
-            if tri_comp[seed] != usize::MAX {
-                continue;
-            }
-            tri_comp[seed] = n_components;
-            let mut queue = std::collections::VecDeque::from([seed]);
-            while let Some(t) = queue.pop_front() {
-                let tri = triangles[t];
-                for k in 0..3 {
-                    let (a, b) = (tri[k], tri[(k + 1) % 3]);
-                    let [t1, t2] = edge_tris[edge_of(t, a, b)];
-                    let other = if t1 == t { t2 } else { t1 };
-                    if other == usize::MAX {
-                        continue;
-                    }
-                    // the neighbour agrees with t when it runs the shared edge b → a
-                    let o = triangles[other];
-                    let same = (0..3).any(|j| o[j] == a && o[(j + 1) % 3] == b);
-                    if tri_comp[other] == usize::MAX {
-                        tri_comp[other] = n_components;
-                        if same {
-                            triangles[other].swap(1, 2);
-                            flipped += 1;
-                        }
-                        queue.push_back(other);
-                    } else if same {
-                        non_orientable += 1;
-                    }
-                }
-            }
-            n_components += 1;
-        }
+        let diameter = validate::check_elements(&positions, &triangles)?;
+        let table = validate::edge_table(n, &triangles)?;
+        validate::check_fans(n, &triangles, &table)?;
+        let o = connect::orient(&mut triangles, &table);
         let mut repairs = Vec::new();
-        if flipped > 0 {
+        if o.flipped > 0 {
             repairs.push(format!(
-                "{flipped} triangles flipped to agree in orientation with their neighbours (inconsistent orientation)"
+                "{} triangles flipped to agree in orientation with their neighbours (inconsistent orientation)",
+                o.flipped
             ));
         }
-        if non_orientable > 0 {
+        if o.non_orientable > 0 {
             repairs.push("the surface is not orientable: orientation left inconsistent across some edges".into());
         }
         let mut components = vec![0usize; n];
         for (t, tri) in triangles.iter().enumerate() {
             for &v in tri {
-                components[v] = tri_comp[t];
+                components[v] = o.tri_comp[t];
             }
         }
-        // adjacency
-        let boundary: Vec<(usize, usize)> =
-            edges.iter().zip(&edge_tris).filter(|(_, t)| t[1] == usize::MAX).map(|(e, _)| *e).collect();
-        let n_edges = edges.len();
-        let mut start = vec![0usize; n + 1];
-        for &(a, b) in &edges {
-            start[a + 1] += 1;
-            start[b + 1] += 1;
-        }
-        for v in 0..n {
-            start[v + 1] += start[v];
-        }
-        let mut fill = start.clone();
-        let mut adj = vec![0usize; start[n]];
-        for &(a, b) in &edges {
-            adj[fill[a]] = b;
-            fill[a] += 1;
-            adj[fill[b]] = a;
-            fill[b] += 1;
-        }
-        for v in 0..n {
-            adj[start[v]..start[v + 1]].sort_unstable();
-        }
-        // boundary loops: components of the boundary edges (manifold vertices: each boundary
-        // vertex has exactly two boundary edges, so these are cycles)
-        let mut parent: Vec<usize> = (0..n).collect();
-        fn find(p: &mut [usize], mut x: usize) -> usize {
-            while p[x] != x {
-                p[x] = p[p[x]];
-                x = p[x];
-            }
-            x
-        }
-        for &(a, b) in &boundary {
-            let (ra, rb) = (find(&mut parent, a), find(&mut parent, b));
-            if ra != rb {
-                parent[ra] = rb;
-            }
-        }
-        let mut roots: Vec<usize> = boundary.iter().map(|&(a, _)| find(&mut parent, a)).collect();
-        roots.sort_unstable();
-        roots.dedup();
+        let (start, adj) = connect::adjacency(n, &table.edges);
         Ok(TriMesh {
             positions,
             triangles,
             start,
             adj,
-            n_edges,
-            boundary_loops: roots.len(),
+            n_edges: table.edges.len(),
+            boundary_loops: connect::boundary_loops(n, &table),
             components,
-            n_components,
+            n_components: o.n_components,
             diameter,
             repairs,
-            orientable: non_orientable == 0,
+            orientable: o.non_orientable == 0,
         })
     }
 
@@ -705,6 +426,24 @@ mod tests {
         let q = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [-1.0, 0.0, 0.0], [-1.0, -1.0, 0.0]];
         assert!(err(q, vec![[0, 1, 2], [0, 3, 4]]).contains("non-manifold vertices 0"));
         assert!(err(Vec::new(), Vec::new()).contains("at least one triangle"));
+    }
+
+    #[test]
+    fn a_refused_mesh_points_at_its_first_offending_element() {
+        use crate::error::Location;
+        let (p, t) = square();
+        let at = |p: Vec<[f64; 3]>, t: Vec<[usize; 3]>| TriMesh::new(p, t).unwrap_err().location();
+        let mut q = p.clone();
+        q[2][1] = f64::INFINITY;
+        assert_eq!(at(q, t.clone()), Some(Location::Vertex(2)));
+        assert_eq!(at(p.clone(), vec![[0, 1, 2], [0, 2, 9]]), Some(Location::Triangle(1)));
+        assert_eq!(at(p.clone(), vec![[0, 1, 2], [0, 2, 3], [2, 0, 1]]), Some(Location::Triangle(2)));
+        let mut q = p.clone();
+        q.push([5.0, 5.0, 0.0]);
+        assert_eq!(at(q, t.clone()), Some(Location::Vertex(4)));
+        let q = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [-1.0, 0.0, 0.0], [-1.0, -1.0, 0.0]];
+        assert_eq!(at(q, vec![[0, 1, 2], [0, 3, 4]]), Some(Location::Vertex(0)));
+        assert_eq!(at(Vec::new(), Vec::new()), None);
     }
 
     #[test]

@@ -169,10 +169,14 @@ fn read_obj(bytes: &[u8]) -> Result<MeshData> {
             Some("v") => {
                 let mut c = [0.0f64; 3];
                 for (k, slot) in c.iter_mut().enumerate() {
-                    let t = tokens
-                        .next()
-                        .ok_or_else(|| Error::input(format!("line {}: a vertex has {k} coordinates", l + 1)))?;
-                    *slot = t.parse().map_err(|_| Error::input(format!("line {}: `{t}` is not a number", l + 1)))?;
+                    let t = tokens.next().ok_or_else(|| {
+                        Error::input(format!("line {}: a vertex has {k} coordinates", l + 1))
+                            .at(crate::error::Location::Line(l + 1))
+                    })?;
+                    *slot = t.parse().map_err(|_| {
+                        Error::input(format!("line {}: `{t}` is not a number", l + 1))
+                            .at(crate::error::Location::Line(l + 1))
+                    })?;
                 }
                 data.positions.push(c);
             }
@@ -180,8 +184,10 @@ fn read_obj(bytes: &[u8]) -> Result<MeshData> {
                 let idx: Vec<i64> = tokens
                     .map(|t| {
                         let v = t.split('/').next().unwrap_or("");
-                        v.parse::<i64>()
-                            .map_err(|_| Error::input(format!("line {}: `{t}` is not a vertex reference", l + 1)))
+                        v.parse::<i64>().map_err(|_| {
+                            Error::input(format!("line {}: `{t}` is not a vertex reference", l + 1))
+                                .at(crate::error::Location::Line(l + 1))
+                        })
                     })
                     .collect::<Result<_, _>>()?;
                 faces.push((l + 1, idx, data.positions.len() as i64));
@@ -192,7 +198,8 @@ fn read_obj(bytes: &[u8]) -> Result<MeshData> {
     let n = data.positions.len() as i64;
     for (line, idx, before) in faces {
         if idx.len() < 3 {
-            return Err(Error::input(format!("line {line}: a face has {} corners", idx.len())));
+            return Err(Error::input(format!("line {line}: a face has {} corners", idx.len()))
+                .at(crate::error::Location::Line(line)));
         }
         // negative indices count back from the last vertex read before the face
         let face: Vec<usize> = idx
@@ -242,18 +249,21 @@ fn read_off(bytes: &[u8]) -> Result<MeshData> {
         }
     }
     let num = |t: &str, l: usize, what: &str| -> Result<f64> {
-        t.parse::<f64>().map_err(|_| Error::input(format!("line {l}: `{t}` is not a number ({what})")))
+        t.parse::<f64>().map_err(|_| {
+            Error::input(format!("line {l}: `{t}` is not a number ({what})")).at(crate::error::Location::Line(l))
+        })
     };
     let count = |t: &str, l: usize, what: &str| -> Result<usize> {
         let v = num(t, l, what)?;
         if v >= 0.0 && v.fract() == 0.0 && v < 1e12 {
             Ok(v as usize)
         } else {
-            Err(Error::input(format!("line {l}: {what} {v} is not a count")))
+            Err(Error::input(format!("line {l}: {what} {v} is not a count")).at(crate::error::Location::Line(l)))
         }
     };
     if first.len() < 2 {
-        return Err(Error::input(format!("line {l}: expected the vertex, face and edge counts")));
+        return Err(Error::input(format!("line {l}: expected the vertex, face and edge counts"))
+            .at(crate::error::Location::Line(l)));
     }
     let nv = count(first[0], l, "vertex count")?;
     let nf = count(first[1], l, "face count")?;
@@ -261,7 +271,9 @@ fn read_off(bytes: &[u8]) -> Result<MeshData> {
     for _ in 0..nv {
         let (l, t) = lines.next().ok_or_else(|| Error::input("the file ends before all vertices are read"))?;
         if t.len() < 3 {
-            return Err(Error::input(format!("line {l}: a vertex needs 3 coordinates")));
+            return Err(
+                Error::input(format!("line {l}: a vertex needs 3 coordinates")).at(crate::error::Location::Line(l))
+            );
         }
         data.positions.push([num(t[0], l, "x")?, num(t[1], l, "y")?, num(t[2], l, "z")?]);
     }
@@ -270,17 +282,19 @@ fn read_off(bytes: &[u8]) -> Result<MeshData> {
         let (l, t) = lines.next().ok_or_else(|| Error::input("the file ends before all faces are read"))?;
         let k = count(t[0], l, "corner count")?;
         if k < 3 {
-            return Err(Error::input(format!("line {l}: face {f} has {k} corners")));
+            return Err(Error::input(format!("line {l}: face {f} has {k} corners")).at(crate::error::Location::Line(l)));
         }
         if t.len() < k + 1 {
-            return Err(Error::input(format!("line {l}: face {f} lists {} of its {k} corners", t.len() - 1)));
+            return Err(Error::input(format!("line {l}: face {f} lists {} of its {k} corners", t.len() - 1))
+                .at(crate::error::Location::Line(l)));
         }
         let face: Vec<usize> = t[1..=k]
             .iter()
             .map(|x| {
                 let v = count(x, l, "vertex index")?;
                 if v >= nv {
-                    Err(Error::input(format!("line {l}: face {f} refers to vertex {v} but there are {nv} vertices")))
+                    Err(Error::input(format!("line {l}: face {f} refers to vertex {v} but there are {nv} vertices"))
+                        .at(crate::error::Location::Line(l)))
                 } else {
                     Ok(v)
                 }

@@ -176,12 +176,15 @@ pub fn read_series(path: &Path, options: &SeriesCsvOptions) -> Result<SeriesCsv>
         let v = parse_number(cell).ok_or_else(|| {
             if cell.trim().is_empty() {
                 err(format!("line {line}: missing value in column `{}`", names[value_col]))
+                    .at(crate::error::Location::Line(*line as usize))
             } else {
                 err(format!("line {line}: `{cell}` in column `{}` is not a number", names[value_col]))
+                    .at(crate::error::Location::Line(*line as usize))
             }
         })?;
         if !v.is_finite() {
-            return Err(err(format!("line {line}: value {v} in column `{}` is not finite", names[value_col])));
+            return Err(err(format!("line {line}: value {v} in column `{}` is not finite", names[value_col]))
+                .at(crate::error::Location::Line(*line as usize)));
         }
         values.push(v);
     }
@@ -302,16 +305,19 @@ pub fn read_series_output(path: &Path) -> Result<SeriesOutput> {
         let line = rec.position().map(|p| p.line()).unwrap_or(0);
         let num = |c: usize, name: &str| -> Result<f64> {
             let cell = rec.get(c).unwrap_or("");
-            cell.parse::<f64>().map_err(|_| err(format!("line {line}: `{cell}` in column `{name}` is not a number")))
+            cell.parse::<f64>().map_err(|_| {
+                err(format!("line {line}: `{cell}` in column `{name}` is not a number"))
+                    .at(crate::error::Location::Line(line as usize))
+            })
         };
         out.input.push(num(ci, "input")?);
         out.output.push(num(co, "output")?);
         out.u.push(num(cu, "u")?);
         let role = rec.get(cr).unwrap_or("");
-        out.roles.push(
-            Role::from_label(role)
-                .ok_or_else(|| err(format!("line {line}: unknown role `{role}` (min, max, fixed, end or empty)")))?,
-        );
+        out.roles.push(Role::from_label(role).ok_or_else(|| {
+            err(format!("line {line}: unknown role `{role}` (min, max, fixed, end or empty)"))
+                .at(crate::error::Location::Line(line as usize))
+        })?);
         out.x_text.push(cx.and_then(|c| rec.get(c)).unwrap_or("").to_string());
     }
     if out.input.len() < 2 {
@@ -372,6 +378,9 @@ mod tests {
             let msg = e.to_string();
             assert!(msg.contains(name) && msg.contains(needle), "{name}: {msg}");
             assert_eq!(e.exit_code(), 3);
+            if needle == "line 3" {
+                assert_eq!(e.location(), Some(crate::error::Location::Line(3)), "{name}");
+            }
         }
         let p = tmp("c.csv", "a\n1\n2\n");
         let e = read_series(&p, &SeriesCsvOptions { column: Some("zz".into()), ..Default::default() }).unwrap_err();

@@ -139,7 +139,8 @@ pub(crate) fn smooth_on<D: Smoothable + Sync>(
         return Err(Error::input(format!("the field has {} values, the domain {n} vertices", h.len())));
     }
     if let Some(&v) = settings.energy.sharp.iter().find(|&&v| v >= n) {
-        return Err(Error::input(format!("sharp vertex {v} is out of range (the input has {n} vertices)")));
+        return Err(Error::input(format!("sharp vertex {v} is out of range (the input has {n} vertices)"))
+            .at(crate::error::Location::Vertex(v)));
     }
     let mut seconds = StageSeconds::default();
 
@@ -216,9 +217,10 @@ pub(crate) fn smooth_on<D: Smoothable + Sync>(
                 {
                     excluded.push((rep.kind, e.to_string()));
                 }
-                Err(Error::Infeasible { path, message }) if settings.representative.is_some() => {
+                Err(Error::Infeasible { path, at, message }) if settings.representative.is_some() => {
                     return Err(Error::Infeasible {
                         path,
+                        at,
                         message: format!(
                             "the data cannot follow the {} representative: {message} (it was requested explicitly, so no other construction replaces it)",
                             rep.kind

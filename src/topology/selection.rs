@@ -159,7 +159,8 @@ pub fn select<D: Domain>(domain: &D, values: &[f64], selection: &Selection) -> R
     let n = domain.n_vertices();
     assert_eq!(values.len(), n, "one value per vertex");
     if let Some(i) = values.iter().position(|v| !v.is_finite()) {
-        return Err(Error::input(format!("value at vertex {i} is not finite ({})", values[i])));
+        return Err(Error::input(format!("value at vertex {i} is not finite ({})", values[i]))
+            .at(crate::error::Location::Vertex(i)));
     }
     let (lo, hi) = crate::domain::value_range(values);
     if lo == hi {
@@ -391,10 +392,11 @@ fn check_explicit<D: Domain>(domain: &D, values: &[f64], minima: &[usize], maxim
     let mut seen = vec![false; n];
     for (&v, is_min) in minima.iter().map(|v| (v, true)).chain(maxima.iter().map(|v| (v, false))) {
         if v >= n {
-            return Err(Error::infeasible(format!("vertex {v} is out of range (the input has {n} vertices)")));
+            return Err(Error::infeasible(format!("vertex {v} is out of range (the input has {n} vertices)"))
+                .at(crate::error::Location::Vertex(v)));
         }
         if seen[v] {
-            return Err(Error::infeasible(format!("vertex {v} is listed twice")));
+            return Err(Error::infeasible(format!("vertex {v} is listed twice")).at(crate::error::Location::Vertex(v)));
         }
         seen[v] = true;
         let ok = if is_min {

@@ -29,13 +29,54 @@ pub enum RepresentativeChoice {
     Flooded,
 }
 
+/// The construction a representative function came from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum RepresentativeKind {
+    /// Series: linear between consecutive kept extrema.
+    Linear,
+    /// Separatrices interpolated, harmonic elsewhere.
+    Separatrix,
+    /// Harmonic between the kept extrema.
+    Harmonic,
+    /// The data with the cancelled basins flooded.
+    Flooded,
+}
+
+impl RepresentativeKind {
+    /// The construction in one word, as reports name it.
+    pub fn name(self) -> &'static str {
+        match self {
+            RepresentativeKind::Linear => "linear",
+            RepresentativeKind::Separatrix => "separatrix",
+            RepresentativeKind::Harmonic => "harmonic",
+            RepresentativeKind::Flooded => "flooded",
+        }
+    }
+}
+
+impl std::fmt::Display for RepresentativeKind {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl From<RepresentativeChoice> for RepresentativeKind {
+    fn from(c: RepresentativeChoice) -> Self {
+        match c {
+            RepresentativeChoice::Separatrix => RepresentativeKind::Separatrix,
+            RepresentativeChoice::Harmonic => RepresentativeKind::Harmonic,
+            RepresentativeChoice::Flooded => RepresentativeKind::Flooded,
+        }
+    }
+}
+
 /// A representative function, the construction that produced it and the complex it used.
 #[derive(Clone, Debug)]
 pub struct Representative {
     /// Values per vertex.
     pub u: Vec<f64>,
-    /// Construction used: `linear`, `separatrix`, `harmonic` or `flooded`.
-    pub kind: &'static str,
+    /// Construction used.
+    pub kind: RepresentativeKind,
     /// Construction used, with its variant (one-sided saddles, released vertices).
     pub name: String,
     /// Why each construction tried before it was not used (automatic choice only).
@@ -72,7 +113,7 @@ pub trait Smoothable: Domain {
         kept: &KeptSet,
         choice: Option<RepresentativeChoice>,
         fill: &Sparse,
-        excluded: &[(&'static str, String)],
+        excluded: &[(RepresentativeKind, String)],
         analyses: &mut Analyses,
     ) -> Result<Representative>;
 }
@@ -90,11 +131,17 @@ impl Smoothable for Series {
         kept: &KeptSet,
         _: Option<RepresentativeChoice>,
         _: &Sparse,
-        _: &[(&'static str, String)],
+        _: &[(RepresentativeKind, String)],
         _: &mut Analyses,
     ) -> Result<Representative> {
         let u = series_representative(self, h, kept)?;
-        Ok(Representative { u, kind: "linear", name: "linear".into(), fallbacks: Vec::new(), complex: None })
+        Ok(Representative {
+            u,
+            kind: RepresentativeKind::Linear,
+            name: "linear".into(),
+            fallbacks: Vec::new(),
+            complex: None,
+        })
     }
 }
 
@@ -129,12 +176,12 @@ fn surface_representative<D: Domain>(
     kept: &KeptSet,
     choice: Option<RepresentativeChoice>,
     k: &Sparse,
-    excluded: &[(&'static str, String)],
+    excluded: &[(RepresentativeKind, String)],
     analyses: &mut Analyses,
 ) -> Result<Representative> {
     let analyses = std::cell::RefCell::new(analyses);
     let mut why: Vec<String> = excluded.iter().map(|(kind, e)| format!("{kind} representative: {e}")).collect();
-    let skip = |kind: &str| excluded.iter().any(|(x, _)| *x == kind);
+    let skip = |kind: RepresentativeKind| excluded.iter().any(|(x, _)| *x == kind);
     let complex = match MorseSmale::new(domain, h, kept) {
         Ok(ms) => Some(ms),
         Err(e) => {
@@ -201,28 +248,28 @@ fn surface_representative<D: Domain>(
         }
         u
     };
-    let order: &[&'static str] = match choice {
-        None => &["separatrix", "harmonic", "flooded"],
-        Some(RepresentativeChoice::Separatrix) => &["separatrix"],
-        Some(RepresentativeChoice::Harmonic) => &["harmonic"],
-        Some(RepresentativeChoice::Flooded) => &["flooded"],
+    use RepresentativeKind::{Flooded, Harmonic, Separatrix};
+    let automatic = [Separatrix, Harmonic, Flooded];
+    let order: Vec<RepresentativeKind> = match choice {
+        None => automatic.to_vec(),
+        Some(c) => vec![c.into()],
     };
     if choice.is_some() {
         // the complex is only for --complex when the user chose the construction
         why.clear();
     }
-    let build = |name: &str, why: &mut Vec<String>| match name {
-        "separatrix" => separatrix(why),
-        "harmonic" => harmonic(why),
+    let build = |kind: RepresentativeKind, why: &mut Vec<String>| match kind {
+        Separatrix => separatrix(why),
+        Harmonic => harmonic(why),
         _ => flooded(why),
     };
-    let named = |name: &str| {
-        let mut name = name.to_string();
-        if name == "separatrix" && one_sided_saddles.get() > 0 {
-            name = format!("separatrix with {} one-sided saddles", one_sided_saddles.get());
+    let named = |kind: RepresentativeKind| {
+        if kind != Separatrix {
+            return kind.name().to_string();
         }
-        if !name.starts_with("separatrix") {
-            return name;
+        let mut name = kind.name().to_string();
+        if one_sided_saddles.get() > 0 {
+            name = format!("separatrix with {} one-sided saddles", one_sided_saddles.get());
         }
         let r = repairs.get();
         let mut changes = Vec::new();
@@ -241,13 +288,13 @@ fn surface_representative<D: Domain>(
         }
         name
     };
-    for &kind in order {
+    for kind in order {
         if skip(kind) {
             continue;
         }
         if let Some(u) = build(kind, &mut why) {
             // --complex writes the separatrices u was built from
-            let complex = if kind == "separatrix" { merged_used.take().or(complex) } else { complex };
+            let complex = if kind == Separatrix { merged_used.take().or(complex) } else { complex };
             return Ok(Representative { u, kind, name: named(kind), fallbacks: why, complex });
         }
     }
@@ -282,7 +329,7 @@ impl Smoothable for TriMesh {
         kept: &KeptSet,
         choice: Option<RepresentativeChoice>,
         fill: &Sparse,
-        excluded: &[(&'static str, String)],
+        excluded: &[(RepresentativeKind, String)],
         analyses: &mut Analyses,
     ) -> Result<Representative> {
         surface_representative(self, h, kept, choice, fill, excluded, analyses)
@@ -302,7 +349,7 @@ impl Smoothable for Grid2d {
         kept: &KeptSet,
         choice: Option<RepresentativeChoice>,
         fill: &Sparse,
-        excluded: &[(&'static str, String)],
+        excluded: &[(RepresentativeKind, String)],
         analyses: &mut Analyses,
     ) -> Result<Representative> {
         surface_representative(self, h, kept, choice, fill, excluded, analyses)

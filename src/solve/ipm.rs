@@ -157,49 +157,25 @@ pub(super) fn solve(
     }
 }
 
-/// The interior-point iteration in arithmetic `T`.
-fn run<T: Real, O: Objective<T>>(
-    r: &ReducedQp,
-    rows: &Rows,
-    objective: &mut O,
-    hint: Option<&[f64]>,
-    settings: &QpSettings,
-) -> std::result::Result<Outcome, crate::error::NumericalError> {
-    let (n, m) = (r.n, r.m());
-    let zero = T::of(0.0);
-    let of = T::of;
-    let b: Vec<T> = r.b.iter().map(|&v| of(v)).collect();
-    let mut x: Vec<T> = match hint {
-        Some(h) => h.iter().map(|&v| of(v)).collect(),
-        None => vec![zero; n],
-    };
-    let finish = |x: &[T], z: &[T], status: SolveStatus, iterations: u32, objective: &O| Outcome {
-        x: x.iter().map(|v| v.to_f64()).collect(),
-        z: z.iter().map(|v| v.to_f64()).collect(),
-        y: objective.auxiliary(x),
-        status,
-        iterations,
-    };
-    if m == 0 {
-        objective.factor(rows, &[])?;
-        let mut rhs = vec![zero; n];
-        objective.gradient(&x, &mut rhs);
-        rhs.iter_mut().for_each(|v| *v = -*v);
-        objective.solve_in_place(&mut rhs);
-        for i in 0..n {
-            x[i] += rhs[i];
-        }
-        return Ok(finish(&x, &[], SolveStatus::Solved, 1, objective));
-    }
-    // starting point: slacks of x (shifted to be positive), multipliers below, then balanced
+/// The primal–dual iterate: `x`, the slacks `s = b − Ax` and the multipliers `z`.
+struct Iterate<T> {
+    x: Vec<T>,
+    s: Vec<T>,
+    z: Vec<T>,
+}
+
+/// The starting point from `x`: slacks of x (shifted to be positive), multipliers at the scale
+/// of the objective's gradient, which they must balance (each row of A has entries ±1): 3 ×
+/// mean |P x + q| (unit multipliers took about twice the iterations, docs/performance.md,
+/// "constants"), then both balanced.
+fn starting_point<T: Real, O: Objective<T>>(rows: &Rows, objective: &mut O, x: Vec<T>, b: &[T]) -> Iterate<T> {
+    let (n, m) = (x.len(), b.len());
+    let (zero, of) = (T::of(0.0), T::of);
     let mut s = vec![zero; m];
     rows.ax(&x, &mut s);
-    for (sk, bk) in s.iter_mut().zip(&b) {
+    for (sk, bk) in s.iter_mut().zip(b) {
         *sk = *bk - *sk;
     }
-    // multipliers at the scale of the objective's gradient at the start, which they must
-    // balance (each row of A has entries ±1): 3 × mean |P x + q|; unit multipliers took about
-    // twice the iterations (docs/performance.md, "constants")
     let mut g = vec![zero; n];
     objective.gradient(&x, &mut g);
     let gmean = g.iter().map(|a| a.to_f64().abs()).sum::<f64>() / n.max(1) as f64;
@@ -213,174 +189,373 @@ fn run<T: Real, O: Objective<T>>(
     let (ssum, zsum): (f64, f64) = (s.iter().map(|v| v.to_f64()).sum(), z.iter().map(|v| v.to_f64()).sum());
     s.iter_mut().for_each(|v| *v += of(0.5 * sz / zsum));
     z.iter_mut().for_each(|v| *v += of(0.5 * sz / ssum));
+    Iterate { x, s, z }
+}
 
+/// The residuals of an iterate: dual `rd = ∇φ + Aᵀz`, primal `rp = Ax + s − b`, the true
+/// slacks `b − Ax`, and their scaled norms.
+struct Residuals<T> {
+    rd: Vec<T>,
+    rp: Vec<T>,
+    slack: Vec<T>,
+    /// Mean complementarity `sᵀz / m`, in `T` and in double.
+    mu_t: T,
+    mu: f64,
+    /// Largest primal residual ÷ (1 + |b|∞), largest dual residual ÷ (1 + |q|∞).
+    pres: f64,
+    dres: f64,
+    /// Without a data term: the objective `φ(x) = ½ xᵀ(∇φ + q)` (up to the fixed part's constant).
+    phi: f64,
+}
+
+/// What the stopping test decided.
+enum Verdict {
+    /// Stop with this status, reporting the polished multipliers (with a data term) or `z`.
+    Stop(SolveStatus),
+    /// Go on; if the next factorisation fails, stop with this status (the point reached
+    /// already meets the targets except for the step: z/s beyond 10¹⁶ × the data diagonal
+    /// cancels in double precision once the gap is tiny), or fail when `None`.
+    Go(Option<SolveStatus>),
+}
+
+/// The gap bound's history: the best value and the iteration it was reached, for the stall test.
+struct Progress {
+    best_gap: f64,
+    best_at: u32,
+}
+
+/// The constants of the stopping tests.
+struct Targets<T> {
+    tol: f64,
+    /// Without a data term: the mean complementarity 10× below the feasibility tolerance (the
+    /// objective is flat along many directions; with the correctors μ ≤ tol was reached while
+    /// sᵀz was still 5× larger than without them).
+    tol_mu: f64,
+    gap_tolerance: f64,
+    d: Vec<T>,
+    q_free: Vec<T>,
+    d_sum: f64,
+}
+
+/// The interior-point iteration in arithmetic `T`.
+#[allow(clippy::needless_range_loop)] // parallel arrays indexed together
+fn run<T: Real, O: Objective<T>>(
+    r: &ReducedQp,
+    rows: &Rows,
+    objective: &mut O,
+    hint: Option<&[f64]>,
+    settings: &QpSettings,
+) -> std::result::Result<Outcome, crate::error::NumericalError> {
+    let (n, m) = (r.n, r.m());
+    let zero = T::of(0.0);
+    let of = T::of;
+    let b: Vec<T> = r.b.iter().map(|&v| of(v)).collect();
+    let x: Vec<T> = match hint {
+        Some(h) => h.iter().map(|&v| of(v)).collect(),
+        None => vec![zero; n],
+    };
+    let finish = |x: &[T], z: &[T], status: SolveStatus, iterations: u32, objective: &O| Outcome {
+        x: x.iter().map(|v| v.to_f64()).collect(),
+        z: z.iter().map(|v| v.to_f64()).collect(),
+        y: objective.auxiliary(x),
+        status,
+        iterations,
+    };
+    if m == 0 {
+        let mut x = x;
+        objective.factor(rows, &[])?;
+        let mut rhs = vec![zero; n];
+        objective.gradient(&x, &mut rhs);
+        rhs.iter_mut().for_each(|v| *v = -*v);
+        objective.solve_in_place(&mut rhs);
+        for i in 0..n {
+            x[i] += rhs[i];
+        }
+        return Ok(finish(&x, &[], SolveStatus::Solved, 1, objective));
+    }
+    let mut point = starting_point(rows, objective, x, &b);
     let bnorm = 1.0 + r.b.iter().fold(0.0f64, |a, v| a.max(v.abs()));
     let qnorm = 1.0 + r.q.iter().fold(0.0f64, |a, v| a.max(v.abs()));
-    let tol = settings.tolerance;
-    // without a data term: the mean complementarity 10× below the feasibility tolerance (the
-    // objective is flat along many directions; with the correctors μ ≤ tol was reached while
-    // sᵀz was still 5× larger than without them)
-    let tol_mu = 0.1 * tol;
-    let has_data = r.gap_bound;
-    let d: Vec<T> = r.d.iter().map(|&v| of(v)).collect();
-    let q_free: Vec<T> = r.q_free.iter().map(|&v| of(v)).collect();
-    let d_sum: f64 = r.d.iter().sum();
-    let (mut rd, mut rp, mut tmp_n, mut tmp_m) = (vec![zero; n], vec![zero; m], vec![zero; n], vec![zero; m]);
-    let (mut dx, mut ds, mut dz, mut rc) = (vec![zero; n], vec![zero; m], vec![zero; m], vec![zero; m]);
-    let (mut dx2, mut ds2, mut dz2, mut rc2) = (vec![zero; n], vec![zero; m], vec![zero; m], vec![zero; m]);
-    let mut slack = vec![zero; m];
-    let mut w = vec![zero; m];
-    let step = |v: &[T], d: &[T]| {
-        v.iter().zip(d).fold(1.0f64, |a, (&v, &d)| if d < zero { a.min((-v / d).to_f64()) } else { a })
+    let targets = Targets {
+        tol: settings.tolerance,
+        tol_mu: 0.1 * settings.tolerance,
+        gap_tolerance: settings.gap_tolerance,
+        d: r.d.iter().map(|&v| of(v)).collect(),
+        q_free: r.q_free.iter().map(|&v| of(v)).collect(),
+        d_sum: r.d.iter().sum(),
     };
+    let mut res = Residuals {
+        rd: vec![zero; n],
+        rp: vec![zero; m],
+        slack: vec![zero; m],
+        mu_t: zero,
+        mu: 0.0,
+        pres: 0.0,
+        dres: 0.0,
+        phi: 0.0,
+    };
+    let mut tmp_n = vec![zero; n];
+    let mut w = vec![zero; m];
+    let mut newton = Newton::new(n, m);
     let mut last = (f64::INFINITY, f64::INFINITY, f64::INFINITY);
     let mut last_step = f64::INFINITY;
-    let (mut best_gap, mut best_at) = (f64::INFINITY, 0u32);
-    // the outcome if the next factorisation fails: the point reached, when it already meets
-    // the targets except for the step (z/s beyond 10¹⁶ × the data diagonal cancels in double
-    // precision once the gap is tiny)
-    let mut fallback_status: Option<SolveStatus>;
+    let mut progress = Progress { best_gap: f64::INFINITY, best_at: 0 };
     for it in 0..settings.max_iter {
-        // residuals
-        objective.gradient(&x, &mut rd);
-        // φ(x) = ½ xᵀ(∇φ + q), the objective (up to the fixed part's constant)
-        let phi = if has_data {
-            0.0
-        } else {
-            0.5 * x.iter().zip(rd.iter().zip(&r.q)).map(|(x, (g, q))| (*x * (*g + of(*q))).to_f64()).sum::<f64>()
-        };
-        rows.atz(&z, &mut tmp_n);
-        for i in 0..n {
-            rd[i] += tmp_n[i];
-        }
-        rows.ax(&x, &mut slack);
-        for k in 0..m {
-            rp[k] = slack[k] + s[k] - b[k];
-            slack[k] = b[k] - slack[k];
-        }
-        let mu_t = s.iter().zip(&z).fold(zero, |a, (&s, &z)| a + s * z) / of(m as f64);
-        let mu = mu_t.to_f64();
-        let pres = rp.iter().fold(0.0f64, |a, v| a.max(v.to_f64().abs())) / bnorm;
-        let dres = rd.iter().fold(0.0f64, |a, v| a.max(v.to_f64().abs())) / qnorm;
-        last = (pres, dres, mu);
-        if !(pres.is_finite() && dres.is_finite() && mu.is_finite()) {
+        residuals(r, rows, objective, &point, &b, (bnorm, qnorm), &mut res, &mut tmp_n);
+        last = (res.pres, res.dres, res.mu);
+        if !(res.pres.is_finite() && res.dres.is_finite() && res.mu.is_finite()) {
             return Err(crate::error::NumericalError(format!("non-finite iterate at iteration {it}")));
         }
-        let xmax = x.iter().fold(0.0f64, |a, v| a.max(v.to_f64().abs()));
+        let xmax = point.x.iter().fold(0.0f64, |a, v| a.max(v.to_f64().abs()));
         let small_step = last_step <= STEP_TOLERANCE * (1.0 + xmax);
-        if has_data {
-            let comp = slack.iter().zip(&z).fold(zero, |a, (&s, &z)| a + max(s, zero) * z);
-            let stat = rd.iter().zip(&d).fold(zero, |a, (&g, &d)| a + g * g / d);
-            let gap = (comp + of(0.5) * stat).to_f64();
-            let data = (0..n).fold(zero, |a, i| {
-                let e = d[i] * x[i] + q_free[i];
-                a + e * e / d[i]
-            });
-            let data = (0.5 * data.to_f64()).max(1e-20 * d_sum);
-            // the multipliers polished for this point (coordinate descent on the bound): the
-            // interior z of rows far from active still carries complementarity the point no
-            // longer needs; about one iteration less on the benchmark grids
-            let mut polished = z.clone();
-            let gap = if pres <= tol {
-                let mut rho = rd.clone();
-                gap.min(polish_multipliers(rows, &slack, &d, &mut rho, &mut polished, POLISH_SWEEPS).to_f64())
-            } else {
-                gap
-            };
-            if pres <= tol && small_step && gap <= settings.gap_tolerance * data {
-                return Ok(finish(&x, &polished, SolveStatus::Solved, it, objective));
-            }
-            fallback_status = if pres > tol {
-                None
-            } else if gap <= settings.gap_tolerance * data {
-                Some(SolveStatus::Solved)
-            } else if gap <= 1e2 * settings.gap_tolerance * data {
-                Some(SolveStatus::AlmostSolved)
-            } else {
-                None
-            };
-            if gap < 0.5 * best_gap {
-                (best_gap, best_at) = (gap, it);
-            } else if pres <= tol && it >= best_at + STALL_ITERATIONS && gap <= 1e2 * settings.gap_tolerance * data {
-                // the bound has reached its rounding floor, within 100× the target
-                return Ok(finish(&x, &polished, SolveStatus::AlmostSolved, it, objective));
-            }
+        let (verdict, reported_z) = if r.gap_bound {
+            verdict_with_data(rows, &point, &res, &targets, small_step, it, &mut progress)
         } else {
-            // without a data term: the gap sᵀz + ½ ρᵀP⁻¹ρ against the energy ½ fᵀQf (P
-            // factorised once), or, where P cannot be solved alone, the mean complementarity
-            let energy = phi + r.constant;
-            // (one solve with P: only once the rows are met, where it can decide)
-            let gap = (pres <= tol)
-                .then(|| objective.energy_dual(&rd))
-                .flatten()
-                .map(|dual| slack.iter().zip(&z).map(|(s, z)| (max(*s, zero) * *z).to_f64()).sum::<f64>() + dual);
-            let target = settings.gap_tolerance * energy.abs().max(1e-300);
-            let converged = match gap {
-                Some(gap) => pres <= tol && small_step && gap <= target,
-                None => pres <= tol && dres <= tol && mu <= tol_mu,
-            };
-            if converged {
-                return Ok(finish(&x, &z, SolveStatus::Solved, it, objective));
+            (verdict_without_data(r, objective, &point, &res, &targets, small_step, it, &mut progress), None)
+        };
+        let fallback_status = match verdict {
+            Verdict::Stop(status) => {
+                return Ok(finish(&point.x, reported_z.as_deref().unwrap_or(&point.z), status, it, objective))
             }
-            // the rows met and the complementarity gone: the dual part ½ρᵀP⁻¹ρ of the bound
-            // can sit on the rounding floor of ρ amplified by P⁻¹ (k = 4: Ĝ ÷ energy ≈ 10⁻⁴
-            // with μ ≈ 10⁻²⁵), and the next factorisation can fail there; the point is kept
-            // rather than handed to another solver
-            let settled = pres <= tol && mu <= tol_mu;
-            fallback_status = settled.then_some(SolveStatus::AlmostSolved);
-            if let Some(gap) = gap {
-                if gap < 0.5 * best_gap {
-                    (best_gap, best_at) = (gap, it);
-                } else if settled && it >= best_at + STALL_ITERATIONS {
-                    return Ok(finish(&x, &z, SolveStatus::AlmostSolved, it, objective));
-                }
-            }
-        }
+            Verdict::Go(fallback) => fallback,
+        };
         for k in 0..m {
-            w[k] = z[k] / s[k];
+            w[k] = point.z[k] / point.s[k];
         }
         if let Err(e) = objective.factor(rows, &w) {
             return match fallback_status {
-                Some(status) => Ok(finish(&x, &z, status, it, objective)),
+                Some(status) => Ok(finish(&point.x, &point.z, status, it, objective)),
                 None => Err(e),
             };
         }
+        let alpha = newton.step(rows, objective, &point, &res, &w);
+        if alpha < 1e-12 {
+            return Err(crate::error::NumericalError(format!("step length {alpha:e} at iteration {it}")));
+        }
+        last_step = newton.advance(&mut point, alpha);
+    }
+    let (pres, dres, mu) = last;
+    let tol = targets.tol;
+    if pres <= 1e3 * tol && (r.gap_bound || (dres <= 1e3 * tol && mu <= 1e3 * tol)) {
+        return Ok(finish(&point.x, &point.z, SolveStatus::AlmostSolved, settings.max_iter, objective));
+    }
+    Err(crate::error::NumericalError(format!(
+        "no convergence in {} iterations (primal {pres:.1e}, dual {dres:.1e}, gap {mu:.1e})",
+        settings.max_iter
+    )))
+}
+
+/// Computes the residuals of `it` into `res`.
+#[allow(clippy::too_many_arguments, clippy::needless_range_loop)]
+fn residuals<T: Real, O: Objective<T>>(
+    r: &ReducedQp,
+    rows: &Rows,
+    objective: &mut O,
+    it: &Iterate<T>,
+    b: &[T],
+    (bnorm, qnorm): (f64, f64),
+    res: &mut Residuals<T>,
+    tmp_n: &mut [T],
+) {
+    let (n, m) = (it.x.len(), it.s.len());
+    let (zero, of) = (T::of(0.0), T::of);
+    let x = &it.x;
+    objective.gradient(x, &mut res.rd);
+    res.phi = if r.gap_bound {
+        0.0
+    } else {
+        0.5 * x.iter().zip(res.rd.iter().zip(&r.q)).map(|(x, (g, q))| (*x * (*g + of(*q))).to_f64()).sum::<f64>()
+    };
+    rows.atz(&it.z, tmp_n);
+    for i in 0..n {
+        res.rd[i] += tmp_n[i];
+    }
+    rows.ax(x, &mut res.slack);
+    for k in 0..m {
+        res.rp[k] = res.slack[k] + it.s[k] - b[k];
+        res.slack[k] = b[k] - res.slack[k];
+    }
+    res.mu_t = it.s.iter().zip(&it.z).fold(zero, |a, (&s, &z)| a + s * z) / of(m as f64);
+    res.mu = res.mu_t.to_f64();
+    res.pres = res.rp.iter().fold(0.0f64, |a, v| a.max(v.to_f64().abs())) / bnorm;
+    res.dres = res.rd.iter().fold(0.0f64, |a, v| a.max(v.to_f64().abs())) / qnorm;
+}
+
+/// The stopping test with a data term: the gap bound `Ĝ = Σ max(s, 0) z + ½ Σ ρ²/d` with the
+/// multipliers polished for the point (coordinate descent on the bound: the interior z of rows
+/// far from active still carries complementarity the point no longer needs; about one
+/// iteration less on the benchmark grids) against the data term. Returns the verdict and the
+/// polished multipliers, reported when it stops.
+fn verdict_with_data<T: Real>(
+    rows: &Rows,
+    it: &Iterate<T>,
+    res: &Residuals<T>,
+    t: &Targets<T>,
+    small_step: bool,
+    iteration: u32,
+    progress: &mut Progress,
+) -> (Verdict, Option<Vec<T>>) {
+    let (zero, of) = (T::of(0.0), T::of);
+    let (x, z, d) = (&it.x, &it.z, &t.d);
+    let pres = res.pres;
+    let comp = res.slack.iter().zip(z).fold(zero, |a, (&s, &z)| a + max(s, zero) * z);
+    let stat = res.rd.iter().zip(d).fold(zero, |a, (&g, &d)| a + g * g / d);
+    let gap = (comp + of(0.5) * stat).to_f64();
+    let data = (0..x.len()).fold(zero, |a, i| {
+        let e = d[i] * x[i] + t.q_free[i];
+        a + e * e / d[i]
+    });
+    let data = (0.5 * data.to_f64()).max(1e-20 * t.d_sum);
+    let mut polished = z.clone();
+    let gap = if pres <= t.tol {
+        let mut rho = res.rd.clone();
+        gap.min(polish_multipliers(rows, &res.slack, d, &mut rho, &mut polished, POLISH_SWEEPS).to_f64())
+    } else {
+        gap
+    };
+    let target = t.gap_tolerance * data;
+    if pres <= t.tol && small_step && gap <= target {
+        return (Verdict::Stop(SolveStatus::Solved), Some(polished));
+    }
+    let fallback = if pres > t.tol {
+        None
+    } else if gap <= target {
+        Some(SolveStatus::Solved)
+    } else if gap <= 1e2 * target {
+        Some(SolveStatus::AlmostSolved)
+    } else {
+        None
+    };
+    if gap < 0.5 * progress.best_gap {
+        (progress.best_gap, progress.best_at) = (gap, iteration);
+    } else if pres <= t.tol && iteration >= progress.best_at + STALL_ITERATIONS && gap <= 1e2 * target {
+        // the bound has reached its rounding floor, within 100× the target
+        return (Verdict::Stop(SolveStatus::AlmostSolved), Some(polished));
+    }
+    (Verdict::Go(fallback), None)
+}
+
+/// The stopping test without a data term: the gap `sᵀz + ½ ρᵀP⁻¹ρ` against the energy
+/// `½ fᵀQf` (P factorised once, and solved with only once the rows are met, where it can
+/// decide), or, where P cannot be solved alone, the mean complementarity.
+#[allow(clippy::too_many_arguments)]
+fn verdict_without_data<T: Real, O: Objective<T>>(
+    r: &ReducedQp,
+    objective: &mut O,
+    it: &Iterate<T>,
+    res: &Residuals<T>,
+    t: &Targets<T>,
+    small_step: bool,
+    iteration: u32,
+    progress: &mut Progress,
+) -> Verdict {
+    let zero = T::of(0.0);
+    let (pres, dres, mu) = (res.pres, res.dres, res.mu);
+    let energy = res.phi + r.constant;
+    let gap = (pres <= t.tol)
+        .then(|| objective.energy_dual(&res.rd))
+        .flatten()
+        .map(|dual| res.slack.iter().zip(&it.z).map(|(s, z)| (max(*s, zero) * *z).to_f64()).sum::<f64>() + dual);
+    let target = t.gap_tolerance * energy.abs().max(1e-300);
+    let converged = match gap {
+        Some(gap) => pres <= t.tol && small_step && gap <= target,
+        None => pres <= t.tol && dres <= t.tol && mu <= t.tol_mu,
+    };
+    if converged {
+        return Verdict::Stop(SolveStatus::Solved);
+    }
+    // the rows met and the complementarity gone: the dual part ½ρᵀP⁻¹ρ of the bound can sit on
+    // the rounding floor of ρ amplified by P⁻¹ (k = 4: Ĝ ÷ energy ≈ 10⁻⁴ with μ ≈ 10⁻²⁵), and the
+    // next factorisation can fail there; the point is kept rather than handed to another solver
+    let settled = pres <= t.tol && mu <= t.tol_mu;
+    if let Some(gap) = gap {
+        if gap < 0.5 * progress.best_gap {
+            (progress.best_gap, progress.best_at) = (gap, iteration);
+        } else if settled && iteration >= progress.best_at + STALL_ITERATIONS {
+            return Verdict::Stop(SolveStatus::AlmostSolved);
+        }
+    }
+    Verdict::Go(settled.then_some(SolveStatus::AlmostSolved))
+}
+
+/// The Newton step's storage: the direction `(dx, ds, dz)` for the complementarity target
+/// `rc`, and a second one for the centrality correctors.
+struct Newton<T> {
+    dx: Vec<T>,
+    ds: Vec<T>,
+    dz: Vec<T>,
+    rc: Vec<T>,
+    dx2: Vec<T>,
+    ds2: Vec<T>,
+    dz2: Vec<T>,
+    rc2: Vec<T>,
+    tmp_m: Vec<T>,
+}
+
+/// The largest step in `[0, 1]` along `d` that keeps `v` non-negative.
+fn max_step<T: Real>(v: &[T], d: &[T]) -> f64 {
+    let zero = T::of(0.0);
+    v.iter().zip(d).fold(1.0f64, |a, (&v, &d)| if d < zero { a.min((-v / d).to_f64()) } else { a })
+}
+
+impl<T: Real> Newton<T> {
+    fn new(n: usize, m: usize) -> Self {
+        let zero = T::of(0.0);
+        let (vn, vm) = (|| vec![zero; n], || vec![zero; m]);
+        Newton { dx: vn(), ds: vm(), dz: vm(), rc: vm(), dx2: vn(), ds2: vm(), dz2: vm(), rc2: vm(), tmp_m: vm() }
+    }
+
+    /// Mehrotra's predictor and corrector, then Gondzio's multiple centrality correctors (aim
+    /// at a longer step, push the complementarity products of that trial point back into
+    /// [0.1, 10] × σμ and keep the corrected direction if its step grows; one solve each, no
+    /// factorisation). Returns the step length; the direction is in `dx`, `ds`, `dz`.
+    #[allow(clippy::needless_range_loop)] // parallel arrays indexed together
+    fn step<O: Objective<T>>(
+        &mut self,
+        rows: &Rows,
+        objective: &mut O,
+        it: &Iterate<T>,
+        res: &Residuals<T>,
+        w: &[T],
+    ) -> f64 {
+        let (zero, of) = (T::of(0.0), T::of);
+        let (n, m) = (it.x.len(), it.s.len());
+        let (s, z) = (&it.s, &it.z);
+        let tmp_m = &mut self.tmp_m;
         // one Newton direction for complementarity target rc (s∘z − rc → 0)
         let mut direction = |rc: &[T], dx: &mut Vec<T>, ds: &mut Vec<T>, dz: &mut Vec<T>| {
             for k in 0..m {
-                tmp_m[k] = w[k] * rp[k] - rc[k] / s[k];
+                tmp_m[k] = w[k] * res.rp[k] - rc[k] / s[k];
             }
-            rows.atz(&tmp_m, dx);
+            rows.atz(tmp_m, dx);
             for i in 0..n {
-                dx[i] = -rd[i] - dx[i];
+                dx[i] = -res.rd[i] - dx[i];
             }
             objective.solve_in_place(dx);
             rows.ax(dx, ds);
             for k in 0..m {
                 let adx = ds[k];
-                dz[k] = w[k] * (adx + rp[k]) - rc[k] / s[k];
-                ds[k] = -rp[k] - adx;
+                dz[k] = w[k] * (adx + res.rp[k]) - rc[k] / s[k];
+                ds[k] = -res.rp[k] - adx;
             }
         };
         // predictor
         for k in 0..m {
-            rc[k] = s[k] * z[k];
+            self.rc[k] = s[k] * z[k];
         }
-        direction(&rc, &mut dx, &mut ds, &mut dz);
-        let alpha_aff = step(&s, &ds).min(step(&z, &dz)).min(1.0);
+        direction(&self.rc, &mut self.dx, &mut self.ds, &mut self.dz);
+        let alpha_aff = max_step(s, &self.ds).min(max_step(z, &self.dz)).min(1.0);
         let a_aff = of(alpha_aff);
-        let mu_aff = (0..m).fold(zero, |a, k| a + (s[k] + a_aff * ds[k]) * (z[k] + a_aff * dz[k])).to_f64() / m as f64;
-        let sigma = (mu_aff / mu).powi(3).min(1.0);
-        let sigma_mu = of(sigma) * mu_t;
+        let mu_aff =
+            (0..m).fold(zero, |a, k| a + (s[k] + a_aff * self.ds[k]) * (z[k] + a_aff * self.dz[k])).to_f64() / m as f64;
+        let sigma = (mu_aff / res.mu).powi(3).min(1.0);
+        let sigma_mu = of(sigma) * res.mu_t;
         // corrector
         for k in 0..m {
-            rc[k] = s[k] * z[k] + ds[k] * dz[k] - sigma_mu;
+            self.rc[k] = s[k] * z[k] + self.ds[k] * self.dz[k] - sigma_mu;
         }
-        direction(&rc, &mut dx, &mut ds, &mut dz);
-        let mut alpha_max = step(&s, &ds).min(step(&z, &dz));
-        // Gondzio's multiple centrality correctors: aim at a longer step, push the
-        // complementarity products of that trial point back into [0.1, 10] × σμ and keep the
-        // corrected direction if its step grows. One solve each, no factorisation.
+        direction(&self.rc, &mut self.dx, &mut self.ds, &mut self.dz);
+        let mut alpha_max = max_step(s, &self.ds).min(max_step(z, &self.dz));
         let (lo, hi) = (of(0.1) * sigma_mu, of(10.0) * sigma_mu);
         for _ in 0..CORRECTORS {
             if alpha_max >= 1.0 {
@@ -388,7 +563,7 @@ fn run<T: Real, O: Objective<T>>(
             }
             let trial = of((alpha_max + CORRECTOR_STEP).min(1.0));
             for k in 0..m {
-                let v = (s[k] + trial * ds[k]) * (z[k] + trial * dz[k]);
+                let v = (s[k] + trial * self.ds[k]) * (z[k] + trial * self.dz[k]);
                 let t = if v < lo {
                     lo - v
                 } else if v > hi {
@@ -396,44 +571,38 @@ fn run<T: Real, O: Objective<T>>(
                 } else {
                     zero
                 };
-                rc2[k] = rc[k] - t;
+                self.rc2[k] = self.rc[k] - t;
             }
-            direction(&rc2, &mut dx2, &mut ds2, &mut dz2);
-            let a2 = step(&s, &ds2).min(step(&z, &dz2));
+            direction(&self.rc2, &mut self.dx2, &mut self.ds2, &mut self.dz2);
+            let a2 = max_step(s, &self.ds2).min(max_step(z, &self.dz2));
             if a2 >= alpha_max + 0.1 * CORRECTOR_STEP {
-                std::mem::swap(&mut dx, &mut dx2);
-                std::mem::swap(&mut ds, &mut ds2);
-                std::mem::swap(&mut dz, &mut dz2);
-                std::mem::swap(&mut rc, &mut rc2);
+                std::mem::swap(&mut self.dx, &mut self.dx2);
+                std::mem::swap(&mut self.ds, &mut self.ds2);
+                std::mem::swap(&mut self.dz, &mut self.dz2);
+                std::mem::swap(&mut self.rc, &mut self.rc2);
                 alpha_max = a2;
             } else {
                 break;
             }
         }
-        let alpha = (0.99 * alpha_max).min(1.0);
-        if alpha < 1e-12 {
-            return Err(crate::error::NumericalError(format!("step length {alpha:e} at iteration {it}")));
-        }
-        let a = of(alpha);
-        last_step = 0.0;
-        for i in 0..n {
-            let dxi = a * dx[i];
+        (0.99 * alpha_max).min(1.0)
+    }
+
+    /// Moves `it` by `alpha` along the direction; returns the largest change of x.
+    fn advance(&self, it: &mut Iterate<T>, alpha: f64) -> f64 {
+        let a = T::of(alpha);
+        let mut last_step = 0.0f64;
+        for (xi, &dx) in it.x.iter_mut().zip(&self.dx) {
+            let dxi = a * dx;
             last_step = last_step.max(dxi.to_f64().abs());
-            x[i] += dxi;
+            *xi += dxi;
         }
-        for k in 0..m {
-            s[k] += a * ds[k];
-            z[k] += a * dz[k];
+        for k in 0..it.s.len() {
+            it.s[k] += a * self.ds[k];
+            it.z[k] += a * self.dz[k];
         }
+        last_step
     }
-    let (pres, dres, mu) = last;
-    if pres <= 1e3 * tol && (has_data || (dres <= 1e3 * tol && mu <= 1e3 * tol)) {
-        return Ok(finish(&x, &z, SolveStatus::AlmostSolved, settings.max_iter, objective));
-    }
-    Err(crate::error::NumericalError(format!(
-        "no convergence in {} iterations (primal {pres:.1e}, dual {dres:.1e}, gap {mu:.1e})",
-        settings.max_iter
-    )))
 }
 
 /// The normal matrix's pattern [`solve`] analyses for `r`.

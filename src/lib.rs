@@ -5,8 +5,18 @@
 //! (Jacobson, Weinkauf & Sorkine 2012, "Smooth Shape-Aware Functions with Controlled Extrema").
 //!
 //! Layers (arrow = "is used by"): `domain → {operators, topology} → representative →
-//! constraints → solve → verify → pipeline → cli`; `io` and `plot` see only `domain` and the
-//! pipeline's report.
+//! constraints → solve → verify → pipeline → smoother → cli`; `io` and `plot` see the domains
+//! and the results only.
+//!
+//! What a program needs is at the root: the domains ([`Grid2d`], [`Series`], [`TriMesh`],
+//! [`AnyDomain`]), the one-off [`smooth`] / [`smooth_any`] and the [`Smoother`] /
+//! [`AnySmoother`] for many fields on one domain, their settings ([`SmoothSettings`],
+//! [`Selection`], [`Energy`], [`EdgeSet`], [`QpSettings`], [`RepresentativeChoice`]), the
+//! results ([`Smoothed`], [`Report`], [`Role`]), the independent check ([`certify`],
+//! [`Certificate`]) and the errors ([`Error`], [`ErrorKind`], [`Location`]). The readers and
+//! writers are in [`io`] (`io::export` for any domain's results), the applications (weights,
+//! deformation, colour diffusion, geodesic distance) in `apps`; the linear algebra, the
+//! representative functions and the command-line tool are internal.
 //!
 //! A grid field smoothed with its pairs below 10 % of the range cancelled, certified:
 //!
@@ -32,22 +42,30 @@ pub mod error;
 pub mod operators;
 pub mod topology;
 
-pub use domain::{Grid2d, Series, TriMesh};
-pub use error::{Error, ErrorKind, Location, Result};
-pub use pipeline::{smooth, SmoothSettings, Smoothed};
-pub use smoother::{AnyDomain, AnySmoother, Smoother};
-pub use topology::Selection;
+pub use constraints::EdgeSet;
+pub use domain::{AnyDomain, Domain, Grid2d, Series, TriMesh};
+pub use error::{ConstructionError, Error, ErrorKind, Location, NumericalError, Result};
+pub use linalg::Analyses;
+pub use operators::Energy;
+pub use pipeline::{smooth, smooth_any, Report, RepresentativeChoice, SmoothSettings, Smoothed};
+pub use smoother::{AnySmoother, Smoother};
+pub use solve::{Formulation, Method, QpSettings};
+pub use topology::{Role, Selection};
+pub use verify::{certify, certify_any, Certificate};
+/// The command-line tool's commands (the binary's implementation, not a library interface).
 #[cfg(feature = "cli")]
+#[doc(hidden)]
 pub mod commands;
 pub mod constraints;
 pub mod derive;
-pub mod harmonic_order;
+#[cfg(feature = "serde")]
+pub(crate) mod harmonic_order;
 pub mod io;
-pub mod linalg;
+pub(crate) mod linalg;
 pub mod pipeline;
 #[cfg(feature = "plot")]
 pub mod plot;
-pub mod representative;
+pub(crate) mod representative;
 pub mod smoother;
 pub mod solve;
 pub mod verify;

@@ -96,7 +96,8 @@ pub struct WeightFunction {
     /// Free vertices fixed by the fill rule (SPEC.md).
     pub filled: usize,
     /// Levels of extended-precision refinement the representative needed (0: the plain
-    /// harmonic function was strictly regular; see [`crate::harmonic_order`]).
+    /// harmonic function was strictly regular at every free vertex; each level refines the
+    /// order where double precision tied neighbours).
     pub refinements: usize,
     /// The no-data certificate of `raw` (it must pass for `monotone`; reported for the others).
     pub certificate: Certificate,

@@ -53,7 +53,7 @@ impl TriMesh {
     /// offending vertices or triangles; the caller adds the file name.
     ///
     /// # Errors
-    /// [`Error::Input`] for: no triangle, a non-finite coordinate, an index out of range, a
+    /// [`crate::Error::Input`] for: no triangle, a non-finite coordinate, an index out of range, a
     /// triangle repeating a vertex, a zero-area triangle, a duplicate triangle, an unused
     /// vertex, two vertices at one position, an edge on more than two triangles, a vertex
     /// whose triangles form more than one fan.

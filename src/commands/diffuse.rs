@@ -4,7 +4,9 @@
 use super::input::read_trimesh;
 use super::sig6;
 use super::weights::stage_weights;
-use crate::apps::diffuse::{blend, linear_to_srgb8, outside_box, parse_colors, pixel_mesh, ColorAt, PixelMesh};
+use crate::apps::diffuse::{
+    blend, linear_to_srgb8, outside_box, parse_colors, pixel_mesh, ColorAt, ColorPoint, PixelMesh,
+};
 use crate::apps::handles::{resolve, Handle, HandleShape};
 use crate::apps::weights::{weights, WeightMethod, WeightSettings};
 use crate::domain::{Domain, TriMesh};
@@ -85,18 +87,7 @@ pub fn diffuse(args: &DiffuseArgs) -> Result<String> {
         ));
     }
     let (read, pm): (Option<TriMesh>, Option<PixelMesh>) = if image {
-        let img = image::ImageReader::open(&args.input)
-            .map_err(|source| Error::Io { path: args.input.clone(), source })?
-            .with_guessed_format()
-            .map_err(|source| Error::Io { path: args.input.clone(), source })?
-            .decode()
-            .map_err(|e| Error::input(format!("cannot decode the image: {e}")).in_file(&args.input))?;
-        let has_alpha = img.color().has_alpha();
-        let rgba = img.to_rgba8();
-        let (w, h) = (rgba.width() as usize, rgba.height() as usize);
-        let inside: Vec<bool> = rgba.pixels().map(|p| !has_alpha || p.0[3] >= 128).collect();
-        let pm = pixel_mesh(w, h, &inside).map_err(|e| e.in_file(&args.input))?;
-        (None, Some(pm))
+        (None, Some(read_pixel_mesh(&args.input)?))
     } else {
         crate::io::export::check_mesh_output(&args.output)?;
         (Some(read_trimesh(&args.input)?.0), None)
@@ -109,43 +100,7 @@ pub fn diffuse(args: &DiffuseArgs) -> Result<String> {
     if image && !args.output.extension().is_some_and(|e| e.eq_ignore_ascii_case("png")) {
         return Err(Error::Usage(format!("{}: the diffused image is written as PNG", args.output.display())));
     }
-    // colour points → handles
-    let mut handles = Vec::with_capacity(points.len());
-    for p in &points {
-        let shape = match (p.at, &pm) {
-            (ColorAt::Pixel([c, r]), Some(pm)) => {
-                if c >= pm.width || r >= pm.height {
-                    return Err(Error::input(format!(
-                        "point `{}`: pixel [{c}, {r}] is outside the {} × {} image",
-                        p.name, pm.width, pm.height
-                    ))
-                    .in_file(&args.colors));
-                }
-                let v = pm.vertex_of_pixel[r * pm.width + c].ok_or_else(|| {
-                    Error::input(format!(
-                        "point `{}`: pixel [{c}, {r}] is outside the image's shape (alpha < 128)",
-                        p.name
-                    ))
-                    .in_file(&args.colors)
-                })?;
-                HandleShape::Vertices(vec![v])
-            }
-            (ColorAt::Pixel(_), None) => {
-                return Err(Error::input(format!(
-                    "point `{}`: a mesh takes \"vertex\" or \"point\", not \"pixel\"",
-                    p.name
-                ))
-                .in_file(&args.colors))
-            }
-            (_, Some(_)) => {
-                return Err(Error::input(format!("point `{}`: an image takes \"pixel\": [column, row]", p.name))
-                    .in_file(&args.colors))
-            }
-            (ColorAt::Vertex(v), None) => HandleShape::Vertices(vec![v]),
-            (ColorAt::Point(q), None) => HandleShape::Point(q),
-        };
-        handles.push(Handle { name: p.name.clone(), shape });
-    }
+    let handles = color_handles(&points, pm.as_ref(), &args.colors)?;
     let sets = resolve(mesh, &handles).map_err(|e| e.in_file(&args.colors))?;
     let w = weights(mesh, &sets, &args.settings).map_err(|e| e.in_file(&args.input))?;
     let rgbs: Vec<[u8; 3]> = points.iter().map(|p| p.rgb).collect();
@@ -244,6 +199,64 @@ pub fn diffuse(args: &DiffuseArgs) -> Result<String> {
     );
     text += &format!("wrote {}\n", wrote.join(", "));
     Ok(text)
+}
+
+/// The image's pixels inside its shape (alpha ≥ 128, or every pixel without alpha) as a
+/// triangulated pixel mesh.
+fn read_pixel_mesh(path: &Path) -> Result<PixelMesh> {
+    let img = image::ImageReader::open(path)
+        .map_err(|source| Error::Io { path: path.to_path_buf(), source })?
+        .with_guessed_format()
+        .map_err(|source| Error::Io { path: path.to_path_buf(), source })?
+        .decode()
+        .map_err(|e| Error::input(format!("cannot decode the image: {e}")).in_file(path))?;
+    let has_alpha = img.color().has_alpha();
+    let rgba = img.to_rgba8();
+    let (w, h) = (rgba.width() as usize, rgba.height() as usize);
+    let inside: Vec<bool> = rgba.pixels().map(|p| !has_alpha || p.0[3] >= 128).collect();
+    pixel_mesh(w, h, &inside).map_err(|e| e.in_file(path))
+}
+
+/// The colour points as handles: a pixel of the image (inside its shape), or a vertex or a
+/// point of the mesh.
+fn color_handles(points: &[ColorPoint], pm: Option<&PixelMesh>, colors: &Path) -> Result<Vec<Handle>> {
+    let mut handles = Vec::with_capacity(points.len());
+    for p in points {
+        let shape = match (p.at, pm) {
+            (ColorAt::Pixel([c, r]), Some(pm)) => {
+                if c >= pm.width || r >= pm.height {
+                    return Err(Error::input(format!(
+                        "point `{}`: pixel [{c}, {r}] is outside the {} × {} image",
+                        p.name, pm.width, pm.height
+                    ))
+                    .in_file(colors));
+                }
+                let v = pm.vertex_of_pixel[r * pm.width + c].ok_or_else(|| {
+                    Error::input(format!(
+                        "point `{}`: pixel [{c}, {r}] is outside the image's shape (alpha < 128)",
+                        p.name
+                    ))
+                    .in_file(colors)
+                })?;
+                HandleShape::Vertices(vec![v])
+            }
+            (ColorAt::Pixel(_), None) => {
+                return Err(Error::input(format!(
+                    "point `{}`: a mesh takes \"vertex\" or \"point\", not \"pixel\"",
+                    p.name
+                ))
+                .in_file(colors))
+            }
+            (_, Some(_)) => {
+                return Err(Error::input(format!("point `{}`: an image takes \"pixel\": [column, row]", p.name))
+                    .in_file(colors))
+            }
+            (ColorAt::Vertex(v), None) => HandleShape::Vertices(vec![v]),
+            (ColorAt::Point(q), None) => HandleShape::Point(q),
+        };
+        handles.push(Handle { name: p.name.clone(), shape });
+    }
+    Ok(handles)
 }
 
 fn stage_png(path: &Path, img: &image::RgbaImage) -> Result<Staged> {

@@ -218,6 +218,23 @@ enum Verdict {
     Go(Option<SolveStatus>),
 }
 
+/// Where the stopping test is: the iterate, its residuals, whether the last step was small,
+/// the iteration.
+struct At<'a, T> {
+    it: &'a Iterate<T>,
+    res: &'a Residuals<T>,
+    small_step: bool,
+    iteration: u32,
+}
+
+impl<T> Clone for At<'_, T> {
+    fn clone(&self) -> Self {
+        *self
+    }
+}
+
+impl<T> Copy for At<'_, T> {}
+
 /// The gap bound's history: the best value and the iteration it was reached, for the stall test.
 struct Progress {
     best_gap: f64,
@@ -308,10 +325,11 @@ fn run<T: Real, O: Objective<T>>(
         }
         let xmax = point.x.iter().fold(0.0f64, |a, v| a.max(v.to_f64().abs()));
         let small_step = last_step <= STEP_TOLERANCE * (1.0 + xmax);
+        let at = At { it: &point, res: &res, small_step, iteration: it };
         let (verdict, reported_z) = if r.gap_bound {
-            verdict_with_data(rows, &point, &res, &targets, small_step, it, &mut progress)
+            verdict_with_data(rows, &at, &targets, &mut progress)
         } else {
-            (verdict_without_data(r, objective, &point, &res, &targets, small_step, it, &mut progress), None)
+            (verdict_without_data(r, objective, &at, &targets, &mut progress), None)
         };
         let fallback_status = match verdict {
             Verdict::Stop(status) => {
@@ -388,13 +406,11 @@ fn residuals<T: Real, O: Objective<T>>(
 /// polished multipliers, reported when it stops.
 fn verdict_with_data<T: Real>(
     rows: &Rows,
-    it: &Iterate<T>,
-    res: &Residuals<T>,
+    at: &At<'_, T>,
     t: &Targets<T>,
-    small_step: bool,
-    iteration: u32,
     progress: &mut Progress,
 ) -> (Verdict, Option<Vec<T>>) {
+    let At { it, res, small_step, iteration } = *at;
     let (zero, of) = (T::of(0.0), T::of);
     let (x, z, d) = (&it.x, &it.z, &t.d);
     let pres = res.pres;
@@ -438,17 +454,14 @@ fn verdict_with_data<T: Real>(
 /// The stopping test without a data term: the gap `sᵀz + ½ ρᵀP⁻¹ρ` against the energy
 /// `½ fᵀQf` (P factorised once, and solved with only once the rows are met, where it can
 /// decide), or, where P cannot be solved alone, the mean complementarity.
-#[allow(clippy::too_many_arguments)]
 fn verdict_without_data<T: Real, O: Objective<T>>(
     r: &ReducedQp,
     objective: &mut O,
-    it: &Iterate<T>,
-    res: &Residuals<T>,
+    at: &At<'_, T>,
     t: &Targets<T>,
-    small_step: bool,
-    iteration: u32,
     progress: &mut Progress,
 ) -> Verdict {
+    let At { it, res, small_step, iteration } = *at;
     let zero = T::of(0.0);
     let (pres, dres, mu) = (res.pres, res.dres, res.mu);
     let energy = res.phi + r.constant;

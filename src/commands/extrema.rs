@@ -6,8 +6,8 @@ use crate::domain::{AnyDomain, Domain};
 use crate::error::{Error, Result};
 use crate::io::series_csv::SeriesCsvOptions;
 use crate::plot::{plot_persistence_diagram, DiagramPoint};
-use crate::topology::{extrema_table, select, ExtremumKind, Role, Selection};
-use std::path::PathBuf;
+use crate::topology::{extrema_table, select, ExtremumKind, KeptSet, Role, Selection};
+use std::path::{Path, PathBuf};
 
 /// Options of `extrema`.
 #[derive(Clone, Debug)]
@@ -115,36 +115,56 @@ fn list<D: Domain>(args: &ExtremaArgs, field: &Field, domain: &D) -> Result<Stri
             .collect(),
     };
     if let Some(plot_path) = &args.plot {
-        let mut points = Vec::new();
-        // a series pairs each maximum with a minimum (one point per pair); on a grid the
-        // maxima have their own superlevel-set pairs, drawn below the diagonal
-        for r in &table {
-            match r.kind {
-                ExtremumKind::Min => {
-                    let death = r.partner.map(|p| h[p]).unwrap_or(f64::INFINITY);
-                    let kept = kept.roles[r.index] == Role::Min;
-                    points.push(DiagramPoint { birth: r.value, death, is_max: false, kept });
-                }
-                ExtremumKind::Max if surface => {
-                    let death = r.partner.map(|p| h[p]).unwrap_or(f64::NEG_INFINITY);
-                    let kept = kept.roles[r.index] == Role::Max;
-                    points.push(DiagramPoint { birth: r.value, death, is_max: true, kept });
-                }
-                _ => {}
-            }
-        }
-        let title = format!(
-            "{} — {} ({} points)",
-            path.file_name().unwrap_or_default().to_string_lossy(),
-            column,
-            points.len()
-        );
-        stage_plot(plot_path, |p| plot_persistence_diagram(p, &points, kept.threshold, &title, (900, 800)))?
-            .commit()?;
+        stage_diagram(plot_path, path, column, &table, h, &kept, surface)?.commit()?;
     }
     if args.json {
         return serde_json::to_string_pretty(&listing).map_err(|e| Error::input(e.to_string()));
     }
+    Ok(table_text(&listing, grid, mesh, surface, &kept))
+}
+
+/// The persistence diagram: one point per minimum (birth, death), and on surfaces one per
+/// maximum below the diagonal; kept points filled.
+fn stage_diagram(
+    plot_path: &Path,
+    path: &Path,
+    column: &str,
+    table: &[crate::topology::ExtremumInfo],
+    h: &[f64],
+    kept: &KeptSet,
+    surface: bool,
+) -> Result<crate::io::Staged> {
+    let mut points = Vec::new();
+    // a series pairs each maximum with a minimum (one point per pair); on a grid the
+    // maxima have their own superlevel-set pairs, drawn below the diagonal
+    for r in table {
+        match r.kind {
+            ExtremumKind::Min => {
+                let death = r.partner.map(|p| h[p]).unwrap_or(f64::INFINITY);
+                let kept = kept.roles[r.index] == Role::Min;
+                points.push(DiagramPoint { birth: r.value, death, is_max: false, kept });
+            }
+            ExtremumKind::Max if surface => {
+                let death = r.partner.map(|p| h[p]).unwrap_or(f64::NEG_INFINITY);
+                let kept = kept.roles[r.index] == Role::Max;
+                points.push(DiagramPoint { birth: r.value, death, is_max: true, kept });
+            }
+            _ => {}
+        }
+    }
+    let title =
+        format!("{} — {} ({} points)", path.file_name().unwrap_or_default().to_string_lossy(), column, points.len());
+    stage_plot(plot_path, |p| plot_persistence_diagram(p, &points, kept.threshold, &title, (900, 800)))
+}
+
+/// The table of extrema and its summary lines.
+fn table_text(
+    listing: &Listing,
+    grid: Option<[usize; 2]>,
+    mesh: Option<String>,
+    surface: bool,
+    kept: &KeptSet,
+) -> String {
     let mut out = String::new();
     out += &format!(
         "{:>8} {:>12} {:>9} {:>14} {:>14} {:>6} {:>4}\n",
@@ -207,5 +227,5 @@ fn list<D: Domain>(args: &ExtremaArgs, field: &Field, domain: &D) -> Result<Stri
             kept.maxima().len()
         );
     }
-    Ok(out)
+    out
 }

@@ -96,23 +96,7 @@ fn kind(s: &str) -> Kind {
 /// values that do not strictly increase, fewer than 2 samples.
 pub fn read_series(path: &Path, options: &SeriesCsvOptions) -> Result<SeriesCsv> {
     let err = |msg: String| Error::input(msg).in_file(path);
-    let bytes = std::fs::read(path).map_err(|source| Error::Io { path: path.to_path_buf(), source })?;
-    let text =
-        String::from_utf8(bytes).map_err(|e| err(format!("not UTF-8 text (byte {})", e.utf8_error().valid_up_to())))?;
-    let text = text.strip_prefix('\u{feff}').unwrap_or(&text);
-    let mut reader = csv::ReaderBuilder::new().has_headers(false).trim(csv::Trim::All).from_reader(text.as_bytes());
-    let mut rows: Vec<(u64, Vec<String>)> = Vec::new();
-    for rec in reader.records() {
-        let rec = rec.map_err(|e| err(format!("malformed CSV: {e}")))?;
-        let line = rec.position().map(|p| p.line()).unwrap_or(0);
-        if rec.iter().all(|c| c.is_empty()) {
-            continue;
-        }
-        rows.push((line, rec.iter().map(str::to_string).collect()));
-    }
-    if rows.is_empty() {
-        return Err(err("the file is empty".into()));
-    }
+    let rows = read_rows(path)?;
     let ncols = rows[0].1.len();
     // a header: a cell that is text where the next row holds a number or a date
     let has_header = rows.len() >= 2
@@ -156,7 +140,7 @@ pub fn read_series(path: &Path, options: &SeriesCsvOptions) -> Result<SeriesCsv>
     let value_col = match &options.column {
         Some(spec) => find(spec)?,
         None => (0..ncols).rev().find(|&c| kinds[c] == Kind::Number && Some(c) != explicit_x).ok_or_else(|| {
-            err(format!("no numeric column (columns: {}); choose one with --column", names.join(", ")))
+            err(format!("no numeric column (columns: {}); choose the value column by name or index", names.join(", ")))
         })?,
     };
     let x_col = match options.x_column.as_deref() {
@@ -170,70 +154,106 @@ pub fn read_series(path: &Path, options: &SeriesCsvOptions) -> Result<SeriesCsv>
     if x_col == Some(value_col) {
         return Err(err(format!("the x column and the value column are both `{}`", names[value_col])));
     }
-    let mut values = Vec::with_capacity(data.len());
-    for (line, r) in data {
-        let cell = &r[value_col];
-        let v = parse_number(cell).ok_or_else(|| {
-            if cell.trim().is_empty() {
-                err(format!("line {line}: missing value in column `{}`", names[value_col]))
-                    .at(crate::error::Location::Line(*line as usize))
-            } else {
-                err(format!("line {line}: `{cell}` in column `{}` is not a number", names[value_col]))
-                    .at(crate::error::Location::Line(*line as usize))
-            }
-        })?;
-        if !v.is_finite() {
-            return Err(err(format!("line {line}: value {v} in column `{}` is not finite", names[value_col]))
-                .at(crate::error::Location::Line(*line as usize)));
-        }
-        values.push(v);
-    }
+    let values = values_of(path, data, value_col, &names[value_col])?;
     let (x, x_text, x_source) = match x_col {
         None => (
             (0..values.len()).map(|i| i as f64).collect(),
             (0..values.len()).map(|i| i.to_string()).collect(),
             XSource::Index,
         ),
-        Some(c) => {
-            let dates = kinds[c] == Kind::Date;
-            let mut x = Vec::with_capacity(values.len());
-            let mut text = Vec::with_capacity(values.len());
-            for (line, r) in data {
-                let cell = r[c].trim();
-                let v = if dates { parse_date_days(cell) } else { parse_number(cell) }.filter(|v| v.is_finite());
-                let v = v.ok_or_else(|| {
-                    err(format!(
-                        "line {line}: `{cell}` in x column `{}` is not a {}",
-                        names[c],
-                        if dates { "date" } else { "finite number" }
-                    ))
-                })?;
-                x.push(v);
-                text.push(cell.to_string());
-            }
-            if let Some(i) = (1..x.len()).find(|&i| x[i] <= x[i - 1]) {
-                return Err(err(format!(
-                    "line {}: x column `{}` must strictly increase, but `{}` follows `{}`",
-                    data[i].0,
-                    names[c],
-                    text[i],
-                    text[i - 1]
-                )));
-            }
-            let source = if dates {
-                let first =
-                    NaiveDate::from_ymd_opt(1970, 1, 1).expect("valid") + chrono::Duration::days(x[0].floor() as i64);
-                XSource::Dates(names[c].clone(), first)
-            } else {
-                XSource::Numeric(names[c].clone())
-            };
-            (x, text, source)
-        }
+        Some(c) => x_of(path, data, &names[c], c, kinds[c] == Kind::Date)?,
     };
     if values.len() < 2 {
         return Err(err(format!("a series needs at least 2 samples, found {}", values.len())));
     }
     Ok(SeriesCsv { column: names[value_col].clone(), values, x, x_text, x_source })
+}
+
+/// One CSV row: its line in the file and its cells.
+type Row = (u64, Vec<String>);
+
+/// The non-empty rows of a CSV file (UTF-8, a byte-order mark dropped), with their lines.
+fn read_rows(path: &Path) -> Result<Vec<Row>> {
+    let err = |msg: String| Error::input(msg).in_file(path);
+    let bytes = std::fs::read(path).map_err(|source| Error::Io { path: path.to_path_buf(), source })?;
+    let text =
+        String::from_utf8(bytes).map_err(|e| err(format!("not UTF-8 text (byte {})", e.utf8_error().valid_up_to())))?;
+    let text = text.strip_prefix('\u{feff}').unwrap_or(&text);
+    let mut reader = csv::ReaderBuilder::new().has_headers(false).trim(csv::Trim::All).from_reader(text.as_bytes());
+    let mut rows: Vec<Row> = Vec::new();
+    for rec in reader.records() {
+        let rec = rec.map_err(|e| err(format!("malformed CSV: {e}")))?;
+        let line = rec.position().map(|p| p.line()).unwrap_or(0);
+        if rec.iter().all(|c| c.is_empty()) {
+            continue;
+        }
+        rows.push((line, rec.iter().map(str::to_string).collect()));
+    }
+    if rows.is_empty() {
+        return Err(err("the file is empty".into()));
+    }
+    Ok(rows)
+}
+
+/// The values of column `col` (named `name`): numbers, finite.
+fn values_of(path: &Path, data: &[Row], col: usize, name: &str) -> Result<Vec<f64>> {
+    let err = |msg: String| Error::input(msg).in_file(path);
+    let mut values = Vec::with_capacity(data.len());
+    for (line, r) in data {
+        let cell = &r[col];
+        let v = parse_number(cell).ok_or_else(|| {
+            if cell.trim().is_empty() {
+                err(format!("line {line}: missing value in column `{}`", name))
+                    .at(crate::error::Location::Line(*line as usize))
+            } else {
+                err(format!("line {line}: `{cell}` in column `{}` is not a number", name))
+                    .at(crate::error::Location::Line(*line as usize))
+            }
+        })?;
+        if !v.is_finite() {
+            return Err(err(format!("line {line}: value {v} in column `{}` is not finite", name))
+                .at(crate::error::Location::Line(*line as usize)));
+        }
+        values.push(v);
+    }
+    Ok(values)
+}
+
+/// The x axis from column `c` (named `name`): dates (days since 1970) or numbers, strictly
+/// increasing, with their text.
+fn x_of(path: &Path, data: &[Row], name: &str, c: usize, dates: bool) -> Result<(Vec<f64>, Vec<String>, XSource)> {
+    let err = |msg: String| Error::input(msg).in_file(path);
+    let mut x = Vec::with_capacity(data.len());
+    let mut text = Vec::with_capacity(data.len());
+    for (line, r) in data {
+        let cell = r[c].trim();
+        let v = if dates { parse_date_days(cell) } else { parse_number(cell) }.filter(|v| v.is_finite());
+        let v = v.ok_or_else(|| {
+            err(format!(
+                "line {line}: `{cell}` in x column `{}` is not a {}",
+                name,
+                if dates { "date" } else { "finite number" }
+            ))
+        })?;
+        x.push(v);
+        text.push(cell.to_string());
+    }
+    if let Some(i) = (1..x.len()).find(|&i| x[i] <= x[i - 1]) {
+        return Err(err(format!(
+            "line {}: x column `{}` must strictly increase, but `{}` follows `{}`",
+            data[i].0,
+            name,
+            text[i],
+            text[i - 1]
+        )));
+    }
+    let source = if dates {
+        let first = NaiveDate::from_ymd_opt(1970, 1, 1).expect("valid") + chrono::Duration::days(x[0].floor() as i64);
+        XSource::Dates(name.to_string(), first)
+    } else {
+        XSource::Numeric(name.to_string())
+    };
+    Ok((x, text, source))
 }
 
 /// The verifiable output of `smooth` on a series.

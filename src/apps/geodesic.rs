@@ -89,35 +89,10 @@ pub fn heat_geodesic_with(
     let p = mesh.positions();
     let tris = mesh.faces();
     let n = p.len();
-    if sources.is_empty() {
-        return Err(Error::input("no source vertex"));
-    }
-    if let Some(&s) = sources.iter().find(|&&s| s >= n) {
-        return Err(Error::input(format!("source vertex {s} is out of range (the mesh has {n} vertices)")));
-    }
-    let comps = mesh.components();
-    let mut reached = vec![false; mesh.n_components()];
-    for &s in sources {
-        reached[comps[s]] = true;
-    }
-    if let Some(c) = reached.iter().position(|r| !r) {
-        let v = comps.iter().position(|&x| x == c).unwrap_or(0);
-        return Err(Error::input(format!(
-            "component {c} (vertex {v}, …) has no source: its distance would be infinite"
-        )));
-    }
+    check_sources(mesh, sources)?;
     let k = cotan_stiffness(p, tris);
     let m = lumped_mass(p, tris);
-    let mut total = 0.0;
-    let mut count = 0usize;
-    for t in tris {
-        for e in 0..3 {
-            let d = sub(p[t[(e + 1) % 3]], p[t[e]]);
-            total += dot(d, d).sqrt();
-            count += 1;
-        }
-    }
-    let h = total / count as f64;
+    let h = mean_edge_length(p, tris);
     let time = h * h;
     let none = vec![false; n];
     let (pattern, heat_values) = upper(&k, time, &m, &none);
@@ -161,7 +136,71 @@ pub fn heat_geodesic_with(
 
     // X = −∇u/|∇u| per triangle, then its integrated divergence at the vertices
     let t = std::time::Instant::now();
-    let mut div = vec![0.0; n];
+    let div = unit_gradient_divergence(p, tris, &u);
+    seconds.field = t.elapsed().as_secs_f64();
+
+    // Poisson: L φ = ∇·X with L = −K, sources pinned at 0
+    let t = std::time::Instant::now();
+    let mut pinned = vec![false; n];
+    for &s in sources {
+        pinned[s] = true;
+    }
+    let (_, poisson_values) = upper(&k, 1.0, &vec![0.0; n], &pinned);
+    let mut phi: Vec<f64> = (0..n).map(|i| if pinned[i] { 0.0 } else { div[i] }).collect();
+    solver
+        .solve(faer::sparse::SparseColMatRef::new(pattern.as_ref(), &poisson_values), &mut phi)
+        .map_err(factor_failed)?;
+    seconds.poisson = t.elapsed().as_secs_f64();
+    // K φ = div gives −φ of L φ = div: distances grow away from the sources
+    for (i, v) in phi.iter_mut().enumerate() {
+        *v = if pinned[i] { 0.0 } else { -*v };
+    }
+    // the rows of pinned vertices' neighbours still hold their K entries to the pinned ones
+    // (values 0): nothing to correct
+    Ok((phi, seconds))
+}
+
+/// Every source a vertex, and every component with one (else its distance is infinite).
+fn check_sources(mesh: &TriMesh, sources: &[usize]) -> Result<()> {
+    let n = mesh.positions().len();
+    if sources.is_empty() {
+        return Err(Error::input("no source vertex"));
+    }
+    if let Some(&s) = sources.iter().find(|&&s| s >= n) {
+        return Err(Error::input(format!("source vertex {s} is out of range (the mesh has {n} vertices)")));
+    }
+    let comps = mesh.components();
+    let mut reached = vec![false; mesh.n_components()];
+    for &s in sources {
+        reached[comps[s]] = true;
+    }
+    if let Some(c) = reached.iter().position(|r| !r) {
+        let v = comps.iter().position(|&x| x == c).unwrap_or(0);
+        return Err(Error::input(format!(
+            "component {c} (vertex {v}, …) has no source: its distance would be infinite"
+        )));
+    }
+    Ok(())
+}
+
+/// The mean edge length (edges counted once per triangle side).
+fn mean_edge_length(p: &[[f64; 3]], tris: &[[usize; 3]]) -> f64 {
+    let mut total = 0.0;
+    let mut count = 0usize;
+    for t in tris {
+        for e in 0..3 {
+            let d = sub(p[t[(e + 1) % 3]], p[t[e]]);
+            total += dot(d, d).sqrt();
+            count += 1;
+        }
+    }
+    total / count as f64
+}
+
+/// The integrated divergence at the vertices of `X = −∇u/|∇u|`, per triangle (zero where the
+/// gradient vanishes).
+fn unit_gradient_divergence(p: &[[f64; 3]], tris: &[[usize; 3]], u: &[f64]) -> Vec<f64> {
+    let mut div = vec![0.0; p.len()];
     for tri in tris {
         let [a, b, c] = tri.map(|v| p[v]);
         let normal = cross(sub(b, a), sub(c, a));
@@ -193,27 +232,7 @@ pub fn heat_geodesic_with(
             div[i] += 0.5 * (cot_l * dot(e1, x) + cot_j * dot(e2, x));
         }
     }
-    seconds.field = t.elapsed().as_secs_f64();
-
-    // Poisson: L φ = ∇·X with L = −K, sources pinned at 0
-    let t = std::time::Instant::now();
-    let mut pinned = vec![false; n];
-    for &s in sources {
-        pinned[s] = true;
-    }
-    let (_, poisson_values) = upper(&k, 1.0, &vec![0.0; n], &pinned);
-    let mut phi: Vec<f64> = (0..n).map(|i| if pinned[i] { 0.0 } else { div[i] }).collect();
-    solver
-        .solve(faer::sparse::SparseColMatRef::new(pattern.as_ref(), &poisson_values), &mut phi)
-        .map_err(factor_failed)?;
-    seconds.poisson = t.elapsed().as_secs_f64();
-    // K φ = div gives −φ of L φ = div: distances grow away from the sources
-    for (i, v) in phi.iter_mut().enumerate() {
-        *v = if pinned[i] { 0.0 } else { -*v };
-    }
-    // the rows of pinned vertices' neighbours still hold their K entries to the pinned ones
-    // (values 0): nothing to correct
-    Ok((phi, seconds))
+    div
 }
 
 #[cfg(test)]

@@ -150,7 +150,6 @@ fn verify_weights(
     mesh: &crate::domain::TriMesh,
     data: &crate::io::mesh::MeshData,
 ) -> Result<String> {
-    use crate::verify::{certify_no_data, RegionKind};
     let n = mesh.n_vertices();
     let bad = |m: String| Error::input(m).in_file(&args.file);
     let take = |name: &str| -> Result<Vec<f64>> {
@@ -183,70 +182,19 @@ fn verify_weights(
             raw_sums[v] += raw[v];
         }
         pairs.push((name.clone(), raw.clone(), normalised.clone()));
-        let mut prescribed = vec![None; n];
-        for v in 0..n {
-            match Role::from_code(role[v]) {
-                Some(Role::Min | Role::Max | Role::Fixed) => prescribed[v] = Some(raw[v]),
-                Some(Role::Other) => {}
-                _ => return Err(bad(format!("role_{name}: {} at vertex {v} is not one of −1, 0, 1, 2", role[v]))),
-            }
-        }
-        structure.push((name.clone(), prescribed.clone(), role.clone()));
-        let vals: Vec<f64> = prescribed.iter().flatten().copied().collect();
-        if vals.is_empty() {
-            problems.push(format!("{name}: no prescribed vertex"));
-            continue;
-        }
-        let (lo, hi) = vals.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &x| (a.min(x), b.max(x)));
-        if lo != 0.0 || hi != 1.0 {
-            problems.push(format!("{name}: the prescribed values span [{lo}, {hi}]; a weight function is 1 on its handle and 0 on the others"));
-        }
-        for v in 0..n {
-            let r = role[v];
-            if (r == 1.0 && raw[v] != hi) || (r == -1.0 && raw[v] != lo) {
-                problems.push(format!("{name}: vertex {v} has role {r} but value {}", raw[v]));
-                break;
-            }
-        }
-        let kind = |x: f64| {
-            if x == hi {
-                RegionKind::Max
-            } else if x == lo {
-                RegionKind::Min
-            } else {
-                RegionKind::Exempt
-            }
-        };
-        let c = certify_no_data(mesh, &raw, &prescribed, kind);
-        if !c.passed {
-            problems.push(format!("weight_{name}_raw: {}", c.summary()));
-        }
-        let cu = certify_no_data(mesh, &u, &prescribed, kind);
-        if !cu.passed {
-            problems.push(format!("u_{name}: {}", cu.summary()));
-        }
-        lines.push(format!("{name}: {} minimum and {} maximum regions", c.strict_minima, c.strict_maxima));
+        let check = check_weight_function(mesh, name, &raw, &u, &role, &bad)?;
+        structure.push((name.clone(), check.prescribed, role));
+        problems.extend(check.problems);
+        lines.extend(check.line);
     }
     problems.extend(structure_problems(mesh, &structure));
     // a diffusion output: every colour inside the box of the colours at the handles
-    if let (Ok(r), Ok(g), Ok(b)) = (data.array("red"), data.array("green"), data.array("blue")) {
-        let rgb = [r.values, g.values, b.values];
-        let mut lo = [f64::INFINITY; 3];
-        let mut hi = [f64::NEG_INFINITY; 3];
-        for (_, prescribed, _) in &structure {
-            for v in (0..n).filter(|&v| prescribed[v] == Some(1.0)) {
-                for ch in 0..3 {
-                    lo[ch] = lo[ch].min(rgb[ch][v]);
-                    hi[ch] = hi[ch].max(rgb[ch][v]);
-                }
-            }
+    match colours_outside(data, &structure, n) {
+        Some(0) => lines.push("colours inside the handles' box".into()),
+        Some(outside) => {
+            problems.push(format!("{outside} vertices have colours outside the box of the colours at the handles"))
         }
-        let outside = (0..n).filter(|&v| (0..3).any(|ch| !(rgb[ch][v] >= lo[ch] && rgb[ch][v] <= hi[ch]))).count();
-        if outside > 0 {
-            problems.push(format!("{outside} vertices have colours outside the box of the colours at the handles"));
-        } else {
-            lines.push("colours inside the handles' box".into());
-        }
+        None => {}
     }
     if let Some(v) = (0..n).find(|&v| (sums[v] - 1.0).abs().is_nan() || (sums[v] - 1.0).abs() > 1e-9) {
         problems.push(format!("the normalised weights sum to {} at vertex {v}, not 1", sums[v]));
@@ -272,6 +220,95 @@ fn verify_weights(
         names.len(),
         lines.join("; ")
     ))
+}
+
+/// What [`check_weight_function`] found.
+struct FunctionCheck {
+    /// The prescribed values (roles −1, 1, 2).
+    prescribed: Vec<Option<f64>>,
+    problems: Vec<String>,
+    /// The summary line (none when nothing is prescribed).
+    line: Option<String>,
+}
+
+/// One function of a weights file: its prescribed values (roles −1, 1, 2) in `raw` span
+/// exactly [0, 1], roles ±1 sit at the extreme values, and `raw` and `u` pass the no-data
+/// certificate. Returns the prescribed values, the problems and the summary line.
+fn check_weight_function(
+    mesh: &crate::domain::TriMesh,
+    name: &str,
+    raw: &[f64],
+    u: &[f64],
+    role: &[f64],
+    bad: &dyn Fn(String) -> Error,
+) -> Result<FunctionCheck> {
+    use crate::verify::{certify_no_data, RegionKind};
+    let n = raw.len();
+    let mut problems = Vec::new();
+    let mut prescribed = vec![None; n];
+    for v in 0..n {
+        match Role::from_code(role[v]) {
+            Some(Role::Min | Role::Max | Role::Fixed) => prescribed[v] = Some(raw[v]),
+            Some(Role::Other) => {}
+            _ => return Err(bad(format!("role_{name}: {} at vertex {v} is not one of −1, 0, 1, 2", role[v]))),
+        }
+    }
+    let vals: Vec<f64> = prescribed.iter().flatten().copied().collect();
+    if vals.is_empty() {
+        return Ok(FunctionCheck { prescribed, problems: vec![format!("{name}: no prescribed vertex")], line: None });
+    }
+    let (lo, hi) = vals.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &x| (a.min(x), b.max(x)));
+    if lo != 0.0 || hi != 1.0 {
+        problems.push(format!(
+            "{name}: the prescribed values span [{lo}, {hi}]; a weight function is 1 on its handle and 0 on the others"
+        ));
+    }
+    for v in 0..n {
+        let r = role[v];
+        if (r == 1.0 && raw[v] != hi) || (r == -1.0 && raw[v] != lo) {
+            problems.push(format!("{name}: vertex {v} has role {r} but value {}", raw[v]));
+            break;
+        }
+    }
+    let kind = |x: f64| {
+        if x == hi {
+            RegionKind::Max
+        } else if x == lo {
+            RegionKind::Min
+        } else {
+            RegionKind::Exempt
+        }
+    };
+    let c = certify_no_data(mesh, raw, &prescribed, kind);
+    if !c.passed {
+        problems.push(format!("weight_{name}_raw: {}", c.summary()));
+    }
+    let cu = certify_no_data(mesh, u, &prescribed, kind);
+    if !cu.passed {
+        problems.push(format!("u_{name}: {}", cu.summary()));
+    }
+    let line = format!("{name}: {} minimum and {} maximum regions", c.strict_minima, c.strict_maxima);
+    Ok(FunctionCheck { prescribed, problems, line: Some(line) })
+}
+
+/// A diffusion output's vertices whose colour lies outside the per-channel box of the colours
+/// at the handles (`None`: the file has no colours).
+fn colours_outside(data: &crate::io::mesh::MeshData, structure: &[FixedSet], n: usize) -> Option<usize> {
+    let (Ok(r), Ok(g), Ok(b)) = (data.array("red"), data.array("green"), data.array("blue")) else {
+        return None;
+    };
+    let rgb = [r.values, g.values, b.values];
+    let mut lo = [f64::INFINITY; 3];
+    let mut hi = [f64::NEG_INFINITY; 3];
+    for (_, prescribed, _) in structure {
+        for v in (0..n).filter(|&v| prescribed[v] == Some(1.0)) {
+            for ch in 0..3 {
+                lo[ch] = lo[ch].min(rgb[ch][v]);
+                hi[ch] = hi[ch].max(rgb[ch][v]);
+            }
+        }
+    }
+    Some((0..n).filter(|&v| (0..3).any(|ch| !(rgb[ch][v] >= lo[ch] && rgb[ch][v] <= hi[ch]))).count())
 }
 
 /// What a weights file's fixed sets must look like beyond each function's certificate, so that

@@ -157,21 +157,7 @@ impl KeptSet {
 ///   maximum, no minimum or no maximum).
 pub fn select<D: Domain>(domain: &D, values: &[f64], selection: &Selection) -> Result<KeptSet> {
     let n = domain.n_vertices();
-    assert_eq!(values.len(), n, "one value per vertex");
-    if let Some(i) = values.iter().position(|v| !v.is_finite()) {
-        return Err(Error::input(format!("value at vertex {i} is not finite ({})", values[i]))
-            .at(crate::error::Location::Vertex(i)));
-    }
-    let (lo, hi) = crate::domain::value_range(values);
-    if lo == hi {
-        return Err(Error::input(format!("the field is constant ({lo}): it has no extrema to keep")));
-    }
-    if let Some((v, size)) = constant_component(domain, values) {
-        return Err(Error::input(format!(
-            "the connected component of vertex {v} ({size} vertices) is constant ({}): it has no extrema to keep",
-            values[v]
-        )));
-    }
+    let (lo, hi) = check_field(domain, values)?;
     let mut warnings = Vec::new();
     let mut threshold = None;
     let minima_pairs = sublevel_pairs(domain, values);
@@ -245,26 +231,7 @@ pub fn select<D: Domain>(domain: &D, values: &[f64], selection: &Selection) -> R
         }
     };
 
-    let mut roles = vec![Role::Other; n];
-    let mut kept = Vec::new();
-    for &(v, p) in &kept_min {
-        roles[v] = Role::Min;
-        kept.push(KeptExtremum {
-            index: v,
-            role: Role::Min,
-            value: values[v],
-            persistence: p.filter(|x| x.is_finite()),
-        });
-    }
-    for &(v, p) in &kept_max {
-        roles[v] = Role::Max;
-        kept.push(KeptExtremum {
-            index: v,
-            role: Role::Max,
-            value: values[v],
-            persistence: p.filter(|x| x.is_finite()),
-        });
-    }
+    let (mut roles, mut kept) = roles_of(n, values, &kept_min, &kept_max);
     kept.sort_by_key(|k| k.index);
     if domain.pairing_rule() == PairingRule::Path {
         for end in [0, n - 1] {
@@ -279,6 +246,55 @@ pub fn select<D: Domain>(domain: &D, values: &[f64], selection: &Selection) -> R
         }
     }
     Ok(KeptSet { roles, kept, threshold, warnings })
+}
+
+/// Checks that `values` can have extrema to keep: one finite value per vertex, and no
+/// connected component (nor the whole field) constant. Returns the value range.
+fn check_field<D: Domain>(domain: &D, values: &[f64]) -> Result<(f64, f64)> {
+    let n = domain.n_vertices();
+    if values.len() != n {
+        return Err(Error::input(format!("the field has {} values, the domain {n} vertices", values.len())));
+    }
+    if let Some(i) = values.iter().position(|v| !v.is_finite()) {
+        return Err(Error::input(format!("value at vertex {i} is not finite ({})", values[i]))
+            .at(crate::error::Location::Vertex(i)));
+    }
+    let (lo, hi) = crate::domain::value_range(values);
+    if lo == hi {
+        return Err(Error::input(format!("the field is constant ({lo}): it has no extrema to keep")));
+    }
+    if let Some((v, size)) = constant_component(domain, values) {
+        return Err(Error::input(format!(
+            "the connected component of vertex {v} ({size} vertices) is constant ({}): it has no extrema to keep",
+            values[v]
+        )));
+    }
+    Ok((lo, hi))
+}
+
+/// The roles and the kept extrema (minima first, then maxima, with their finite persistence).
+fn roles_of(n: usize, values: &[f64], kept_min: &Kept, kept_max: &Kept) -> (Vec<Role>, Vec<KeptExtremum>) {
+    let mut roles = vec![Role::Other; n];
+    let mut kept = Vec::new();
+    for &(v, p) in kept_min {
+        roles[v] = Role::Min;
+        kept.push(KeptExtremum {
+            index: v,
+            role: Role::Min,
+            value: values[v],
+            persistence: p.filter(|x| x.is_finite()),
+        });
+    }
+    for &(v, p) in kept_max {
+        roles[v] = Role::Max;
+        kept.push(KeptExtremum {
+            index: v,
+            role: Role::Max,
+            value: values[v],
+            persistence: p.filter(|x| x.is_finite()),
+        });
+    }
+    (roles, kept)
 }
 
 /// A connected component on which the field is constant: its first vertex and its size.
@@ -456,6 +472,13 @@ fn check_alternation(values: &[f64], kept: &[KeptExtremum]) -> Result<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_field_of_the_wrong_length_is_an_input_error_not_a_panic() {
+        let e = select(&crate::domain::Series::uniform(5), &[0.0, 1.0, 0.0], &Selection::Relative(0.1)).unwrap_err();
+        assert_eq!(e.kind(), crate::error::ErrorKind::Input);
+        assert!(e.to_string().contains("3 values, the domain 5 vertices"), "{e}");
+    }
     use crate::domain::Series;
 
     fn kept(values: &[f64], sel: Selection) -> (Vec<usize>, Vec<usize>) {

@@ -81,7 +81,53 @@ pub fn optimality_with(
     let rows = constraint_rows(qp);
     assert_eq!(z.len(), rows.len());
     let free: Vec<bool> = qp.fixed.iter().map(Option::is_none).collect();
-    // ρ over all entries (only the free ones count)
+    let (mut rho, auxiliary_residual) = gradient(qp, f, y);
+    let (complementarity, min_slack) = rows_into(qp, &rows, f, z, &mut rho);
+    let mut stationarity = dd(0.0);
+    let mut data = dd(0.0);
+    let mut bounded = true;
+    for j in 0..n {
+        let d = qp.data.map_or(0.0, |d| d[j]);
+        if d > 0.0 {
+            // ½ d (f − c)² = ½ (d f + q)² / d
+            let e = product(d, f[j]) + dd(qp.q[j]);
+            data += e * e / dd(d);
+        }
+        if free[j] {
+            if d > 0.0 {
+                stationarity += rho[j] * rho[j] / dd(d);
+            } else {
+                bounded = false;
+            }
+        }
+    }
+    let complementarity = round(complementarity);
+    let mut stationarity = round(stationarity);
+    let by_solve = !bounded;
+    if by_solve {
+        // no data term: ½ ρᵀP⁻¹ρ by one solve with P on the free entries
+        stationarity = solve_with_p(qp, &free, &rho, analyses).unwrap_or(f64::INFINITY);
+    }
+    let gap = complementarity + 0.5 * stationarity + 0.5 * auxiliary_residual * auxiliary_residual;
+    let energy = half_energy(qp.p, f);
+    let min_slack = if rows.is_empty() { 0.0 } else { min_slack };
+    Optimality {
+        gap,
+        by_solve,
+        energy,
+        data: 0.5 * round(data),
+        min_slack,
+        complementarity,
+        dual_residual: stationarity.sqrt(),
+        auxiliary_residual,
+        distance: (gap.is_finite() && min_slack >= 0.0).then(|| (2.0 * gap.max(0.0)).sqrt()),
+    }
+}
+
+/// The objective's gradient at `f` in double-double, `ρ = P f + q` (or, factored, `D f + q +
+/// Fᵀ y` with the auxiliary residual `|F f − y|`), over all entries (only the free ones count).
+fn gradient(qp: &MonotoneQp<'_>, f: &[f64], y: Option<&[f64]>) -> (Vec<fx128>, f64) {
+    let n = qp.q.len();
     let mut rho = vec![dd(0.0); n];
     let mut auxiliary_residual = 0.0;
     match (y, qp.factor) {
@@ -120,6 +166,12 @@ pub fn optimality_with(
             }
         }
     }
+    (rho, auxiliary_residual)
+}
+
+/// Adds `Aᵀz` into `ρ`; returns the complementarity `Σ s z` and the smallest slack
+/// `s = b − A f` (z clipped at 0).
+fn rows_into(qp: &MonotoneQp<'_>, rows: &[Row], f: &[f64], z: &[f64], rho: &mut [fx128]) -> (fx128, f64) {
     let mut complementarity = dd(0.0);
     let mut min_slack = f64::INFINITY;
     for (row, &zk) in rows.iter().zip(z) {
@@ -143,54 +195,19 @@ pub fn optimality_with(
         min_slack = min_slack.min(round(s));
         complementarity += s * dd(zk);
     }
-    let mut stationarity = dd(0.0);
-    let mut data = dd(0.0);
-    let mut bounded = true;
-    for j in 0..n {
-        let d = qp.data.map_or(0.0, |d| d[j]);
-        if d > 0.0 {
-            // ½ d (f − c)² = ½ (d f + q)² / d
-            let e = product(d, f[j]) + dd(qp.q[j]);
-            data += e * e / dd(d);
-        }
-        if free[j] {
-            if d > 0.0 {
-                stationarity += rho[j] * rho[j] / dd(d);
-            } else {
-                bounded = false;
-            }
+    (complementarity, min_slack)
+}
+
+/// `½ fᵀ P f` in double-double (P holds both triangles).
+fn half_energy(p: &crate::operators::Sparse, f: &[f64]) -> f64 {
+    let (cp, ri, v) = (p.symbolic().col_ptr(), p.symbolic().row_idx(), p.val());
+    let mut e = dd(0.0);
+    for j in 0..f.len() {
+        for p in cp[j]..cp[j + 1] {
+            e += product(v[p], f[ri[p]]) * dd(f[j]);
         }
     }
-    let complementarity = round(complementarity);
-    let mut stationarity = round(stationarity);
-    let by_solve = !bounded;
-    if by_solve {
-        // no data term: ½ ρᵀP⁻¹ρ by one solve with P on the free entries
-        stationarity = solve_with_p(qp, &free, &rho, analyses).unwrap_or(f64::INFINITY);
-    }
-    let gap = complementarity + 0.5 * stationarity + 0.5 * auxiliary_residual * auxiliary_residual;
-    let energy = {
-        let (cp, ri, v) = (qp.p.symbolic().col_ptr(), qp.p.symbolic().row_idx(), qp.p.val());
-        let mut e = dd(0.0);
-        for j in 0..n {
-            for p in cp[j]..cp[j + 1] {
-                e += product(v[p], f[ri[p]]) * dd(f[j]);
-            }
-        }
-        0.5 * round(e)
-    };
-    let min_slack = if rows.is_empty() { 0.0 } else { min_slack };
-    Optimality {
-        gap,
-        by_solve,
-        energy,
-        data: 0.5 * round(data),
-        min_slack,
-        complementarity,
-        dual_residual: stationarity.sqrt(),
-        auxiliary_residual,
-        distance: (gap.is_finite() && min_slack >= 0.0).then(|| (2.0 * gap.max(0.0)).sqrt()),
-    }
+    0.5 * round(e)
 }
 
 /// `ρ_Fᵀ P_FF⁻¹ ρ_F` for the free entries (`None` if `P_FF` is not numerically positive

@@ -140,99 +140,135 @@ pub fn ordered_harmonic<D: Domain>(
             )));
         }
         levels += 1;
-        // the region: irregular and flat vertices grown by one ring of free vertices
-        let mut in_region = vec![false; n];
-        let mut front: Vec<usize> = bad.iter().chain(&flat).copied().collect();
-        for &v in &front {
-            in_region[v] = true;
-        }
-        for _ in 0..1 {
-            let mut next = Vec::new();
-            for &v in &front {
-                for w in domain.neighbors(v) {
-                    if !in_region[w] && fixed[w].is_none() {
-                        in_region[w] = true;
-                        next.push(w);
-                    }
-                }
-            }
-            front = next;
-        }
+        let in_region = region(domain, fixed, bad.iter().chain(&flat).copied().collect());
         // each connected part of the region separately
-        let mut seen = vec![false; n];
-        for s in 0..n {
-            if !in_region[s] || seen[s] {
-                continue;
-            }
-            let mut part = vec![s];
-            seen[s] = true;
-            let mut i = 0;
-            while i < part.len() {
-                let v = part[i];
-                i += 1;
-                for w in domain.neighbors(v) {
-                    if in_region[w] && !seen[w] {
-                        seen[w] = true;
-                        part.push(w);
-                    }
-                }
-            }
-            let mut boundary: Vec<usize> =
-                part.iter().flat_map(|&v| domain.neighbors(v)).filter(|&w| !in_region[w]).collect();
-            boundary.sort_unstable();
-            boundary.dedup();
-            if boundary.is_empty() {
-                return Err(ConstructionError::Unfit(format!(
-                    "vertex {s} lies in a part of the domain that touches no handle"
-                )));
-            }
-            let base = phi[boundary[0]].clone();
-            let data: Vec<f64> = boundary.iter().map(|&b| approx_difference(&phi[b], &base)).collect();
-            if data.iter().all(|&d| d == 0.0) {
-                return Err(ConstructionError::Unfit(format!(
-                    "the harmonic order is exactly flat around vertex {s} (all {} boundary values equal)",
-                    boundary.len()
-                )));
-            }
-            // local Dirichlet problem on part ∪ boundary
-            let mut slot = vec![usize::MAX; n];
-            let mut local: Vec<usize> = part.clone();
-            local.extend_from_slice(&boundary);
-            for (j, &v) in local.iter().enumerate() {
-                slot[v] = j;
-            }
-            let (cp, ri, val) = (k.symbolic().col_ptr(), k.symbolic().row_idx(), k.val());
-            let mut t = Vec::new();
-            for &v in &local {
-                for p in cp[v]..cp[v + 1] {
-                    let r = ri[p];
-                    if slot[r] != usize::MAX {
-                        t.push(Triplet::new(slot[r], slot[v], val[p]));
-                    }
-                }
-            }
-            let m = local.len();
-            let sub =
-                Sparse::try_new_from_triplets(m, m, &t).map_err(|e| crate::error::NumericalError(format!("{e:?}")))?;
-            let mut lf: Vec<Option<f64>> = vec![None; m];
-            for (j, &d) in data.iter().enumerate() {
-                lf[part.len() + j] = Some(d);
-            }
-            let x = dirichlet_solve(&sub, &lf)?;
-            let part_scale = data.iter().fold(0.0f64, |a, d| a.max(d.abs()));
-            for (j, &v) in part.iter().enumerate() {
-                phi[v] = grow(&base, x[j]);
-                scale[v] = part_scale;
-            }
+        for part in parts(domain, &in_region) {
+            refine_part(domain, k, &part, &in_region, &mut phi, &mut scale)?;
         }
     }
     if levels == 0 {
         return Ok((u, 0));
     }
+    let ranked = relabel(u, &phi, fixed);
+    Ok((ranked, levels))
+}
+
+/// The refinement region: the vertices `front` grown by one ring of free vertices.
+fn region<D: Domain>(domain: &D, fixed: &[Option<f64>], mut front: Vec<usize>) -> Vec<bool> {
+    let n = domain.n_vertices();
+    let mut in_region = vec![false; n];
+    for &v in &front {
+        in_region[v] = true;
+    }
+    for _ in 0..1 {
+        let mut next = Vec::new();
+        for &v in &front {
+            for w in domain.neighbors(v) {
+                if !in_region[w] && fixed[w].is_none() {
+                    in_region[w] = true;
+                    next.push(w);
+                }
+            }
+        }
+        front = next;
+    }
+    in_region
+}
+
+/// The connected parts of a region, each in breadth-first order from its smallest vertex.
+fn parts<D: Domain>(domain: &D, in_region: &[bool]) -> Vec<Vec<usize>> {
+    let n = domain.n_vertices();
+    let mut seen = vec![false; n];
+    let mut out = Vec::new();
+    for s in 0..n {
+        if !in_region[s] || seen[s] {
+            continue;
+        }
+        let mut part = vec![s];
+        seen[s] = true;
+        let mut i = 0;
+        while i < part.len() {
+            let v = part[i];
+            i += 1;
+            for w in domain.neighbors(v) {
+                if in_region[w] && !seen[w] {
+                    seen[w] = true;
+                    part.push(w);
+                }
+            }
+        }
+        out.push(part);
+    }
+    out
+}
+
+/// Solves the local Dirichlet problem on `part` ∪ its boundary with the boundary's values
+/// relative to the first of them, and extends the part's values by one level.
+fn refine_part<D: Domain>(
+    domain: &D,
+    k: &Sparse,
+    part: &[usize],
+    in_region: &[bool],
+    phi: &mut [Vec<f64>],
+    scale: &mut [f64],
+) -> Result<(), ConstructionError> {
+    let n = domain.n_vertices();
+    let mut boundary: Vec<usize> = part.iter().flat_map(|&v| domain.neighbors(v)).filter(|&w| !in_region[w]).collect();
+    boundary.sort_unstable();
+    boundary.dedup();
+    if boundary.is_empty() {
+        return Err(ConstructionError::Unfit(format!(
+            "vertex {} lies in a part of the domain that touches no handle",
+            part[0]
+        )));
+    }
+    let base = phi[boundary[0]].clone();
+    let data: Vec<f64> = boundary.iter().map(|&b| approx_difference(&phi[b], &base)).collect();
+    if data.iter().all(|&d| d == 0.0) {
+        return Err(ConstructionError::Unfit(format!(
+            "the harmonic order is exactly flat around vertex {} (all {} boundary values equal)",
+            part[0],
+            boundary.len()
+        )));
+    }
+    // local Dirichlet problem on part ∪ boundary
+    let mut slot = vec![usize::MAX; n];
+    let mut local: Vec<usize> = part.to_vec();
+    local.extend_from_slice(&boundary);
+    for (j, &v) in local.iter().enumerate() {
+        slot[v] = j;
+    }
+    let (cp, ri, val) = (k.symbolic().col_ptr(), k.symbolic().row_idx(), k.val());
+    let mut t = Vec::new();
+    for &v in &local {
+        for p in cp[v]..cp[v + 1] {
+            let r = ri[p];
+            if slot[r] != usize::MAX {
+                t.push(Triplet::new(slot[r], slot[v], val[p]));
+            }
+        }
+    }
+    let m = local.len();
+    let sub = Sparse::try_new_from_triplets(m, m, &t).map_err(|e| crate::error::NumericalError(format!("{e:?}")))?;
+    let mut lf: Vec<Option<f64>> = vec![None; m];
+    for (j, &d) in data.iter().enumerate() {
+        lf[part.len() + j] = Some(d);
+    }
+    let x = dirichlet_solve(&sub, &lf)?;
+    let part_scale = data.iter().fold(0.0f64, |a, d| a.max(d.abs()));
+    for (j, &v) in part.iter().enumerate() {
+        phi[v] = grow(&base, x[j]);
+        scale[v] = part_scale;
+    }
+    Ok(())
+}
+
+/// Ranks of the refined order: fixed vertices keep their values, each run of free vertices
+/// between two fixed ones in the order is spread evenly between their values.
+fn relabel(u: Vec<f64>, phi: &[Vec<f64>], fixed: &[Option<f64>]) -> Vec<f64> {
+    let n = u.len();
     let mut order: Vec<usize> = (0..n).collect();
     order.sort_by(|&a, &b| compare(&phi[a], &phi[b]).then(a.cmp(&b)));
-    // relabel: fixed vertices keep their values, each run of free vertices between two fixed
-    // ones in the order is spread evenly between their values
     let mut ranked = u;
     let mut i = 0;
     while i < n {
@@ -257,7 +293,7 @@ pub fn ordered_harmonic<D: Domain>(
             ranked[order[start + j]] = a + (b - a) * (j + 1) as f64 / (run + 1) as f64;
         }
     }
-    Ok((ranked, levels))
+    ranked
 }
 
 #[cfg(test)]

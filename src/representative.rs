@@ -182,45 +182,7 @@ pub fn separatrix_representative<D: crate::domain::Domain>(
     analyses: &mut crate::linalg::Analyses,
 ) -> std::result::Result<(Vec<f64>, Repairs), ConstructionError> {
     let n = h.len();
-    let mut down = vec![f64::INFINITY; n];
-    let mut up = vec![f64::NEG_INFINITY; n];
-    let dist = |a: usize, b: usize| {
-        let (p, q) = (domain.point(a), domain.point(b));
-        ((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2) + (p[2] - q[2]).powi(2)).sqrt()
-    };
-    let paint = |sep: &crate::topology::morse_smale::Separatrix, target: &mut Vec<f64>, lower: bool| {
-        let p = &sep.path;
-        let total: f64 = p.windows(2).map(|w| dist(w[0], w[1])).sum();
-        let (hs, he) = (h[sep.saddle], h[*p.last().expect("non-empty")]);
-        let mut run = 0.0;
-        for (i, &v) in p.iter().enumerate() {
-            if i > 0 {
-                run += dist(p[i - 1], v);
-            }
-            let t = if total > 0.0 { run / total } else { 1.0 };
-            let value = hs + (he - hs) * t;
-            target[v] = if lower { target[v].min(value) } else { target[v].max(value) };
-        }
-    };
-    for s in &ms.descending {
-        paint(s, &mut down, true);
-    }
-    for s in &ms.ascending {
-        paint(s, &mut up, false);
-    }
-    let prescribed: Vec<Option<f64>> = (0..n)
-        .map(|v| {
-            if kept.roles[v].is_fixed() || ms.saddles.binary_search(&v).is_ok() {
-                Some(h[v])
-            } else {
-                match (down[v].is_finite(), up[v].is_finite()) {
-                    (true, false) => Some(down[v]),
-                    (false, true) => Some(up[v]),
-                    _ => None,
-                }
-            }
-        })
-        .collect();
+    let prescribed = interpolated_separatrices(domain, h, kept, ms);
     // Where the interpolated separatrices contradict each other (a separatrix vertex or a
     // saddle ends up below or above all its neighbours, or a free vertex between them is
     // flat), release the separatrices through those vertices (and through their prescribed
@@ -246,14 +208,7 @@ pub fn separatrix_representative<D: crate::domain::Domain>(
     for _ in 0..MAX_RELEASE_ROUNDS {
         let fixed: Vec<Option<f64>> = (0..n).map(|v| if released[v] { None } else { prescribed[v] }).collect();
         let u = dirichlet.solve(&fixed)?;
-        let bad: Vec<usize> = (0..n)
-            .filter(|&v| match kept.roles[v] {
-                Role::Other => !is_regular(domain, &u, v),
-                Role::Min => domain.neighbors(v).any(|w| u[w] <= u[v]),
-                Role::Max => domain.neighbors(v).any(|w| u[w] >= u[v]),
-                _ => false,
-            })
-            .collect();
+        let bad = failing(domain, kept, &u);
         let repairs = Repairs { released: count, moved: moved.len(), pinned: pinned.len() };
         if bad.is_empty() {
             return Ok((u, repairs));
@@ -329,6 +284,71 @@ pub fn separatrix_representative<D: crate::domain::Domain>(
     Err(ConstructionError::Unfit(format!(
         "separatrix vertices still contradict each other after {MAX_RELEASE_ROUNDS} rounds of releasing them"
     )))
+}
+
+/// The separatrices' values: each vertex of a descending (ascending) separatrix linearly
+/// interpolated by arc length between its saddle and its extremum, the smallest (largest)
+/// where several meet, kept extrema and saddles at their values; `None` elsewhere and where
+/// a descending and an ascending separatrix meet.
+fn interpolated_separatrices<D: crate::domain::Domain>(
+    domain: &D,
+    h: &[f64],
+    kept: &KeptSet,
+    ms: &crate::topology::morse_smale::MorseSmale,
+) -> Vec<Option<f64>> {
+    let n = h.len();
+    let mut down = vec![f64::INFINITY; n];
+    let mut up = vec![f64::NEG_INFINITY; n];
+    let dist = |a: usize, b: usize| {
+        let (p, q) = (domain.point(a), domain.point(b));
+        ((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2) + (p[2] - q[2]).powi(2)).sqrt()
+    };
+    let paint = |sep: &crate::topology::morse_smale::Separatrix, target: &mut Vec<f64>, lower: bool| {
+        let p = &sep.path;
+        let total: f64 = p.windows(2).map(|w| dist(w[0], w[1])).sum();
+        let (hs, he) = (h[sep.saddle], h[*p.last().expect("non-empty")]);
+        let mut run = 0.0;
+        for (i, &v) in p.iter().enumerate() {
+            if i > 0 {
+                run += dist(p[i - 1], v);
+            }
+            let t = if total > 0.0 { run / total } else { 1.0 };
+            let value = hs + (he - hs) * t;
+            target[v] = if lower { target[v].min(value) } else { target[v].max(value) };
+        }
+    };
+    for s in &ms.descending {
+        paint(s, &mut down, true);
+    }
+    for s in &ms.ascending {
+        paint(s, &mut up, false);
+    }
+    (0..n)
+        .map(|v| {
+            if kept.roles[v].is_fixed() || ms.saddles.binary_search(&v).is_ok() {
+                Some(h[v])
+            } else {
+                match (down[v].is_finite(), up[v].is_finite()) {
+                    (true, false) => Some(down[v]),
+                    (false, true) => Some(up[v]),
+                    _ => None,
+                }
+            }
+        })
+        .collect()
+}
+
+/// The vertices where `u` fails the representative's order: a free vertex that is not
+/// regular, a kept extremum that is not strict.
+fn failing<D: crate::domain::Domain>(domain: &D, kept: &KeptSet, u: &[f64]) -> Vec<usize> {
+    (0..u.len())
+        .filter(|&v| match kept.roles[v] {
+            Role::Other => !is_regular(domain, u, v),
+            Role::Min => domain.neighbors(v).any(|w| u[w] <= u[v]),
+            Role::Max => domain.neighbors(v).any(|w| u[w] >= u[v]),
+            _ => false,
+        })
+        .collect()
 }
 
 /// What [`separatrix_representative`] changed in the paper's construction.

@@ -165,6 +165,30 @@ fn harmonic_representative(
     dirichlet_solve(k, &fixed)
 }
 
+/// The separatrix representative's name with its variant: the one-sided saddles it used and
+/// what its repairs changed.
+fn separatrix_name(one_sided_saddles: usize, r: Repairs) -> String {
+    let mut name = "separatrix".to_string();
+    if one_sided_saddles > 0 {
+        name = format!("separatrix with {one_sided_saddles} one-sided saddles");
+    }
+    let mut changes = Vec::new();
+    if r.released > 0 {
+        changes.push(format!("{} contradicting separatrix vertices released to the harmonic fill", r.released));
+    }
+    let plural = |n: usize, one: &str, many: &str| format!("{n} {}", if n == 1 { one } else { many });
+    if r.moved > 0 {
+        changes.push(format!("{} moved outward", plural(r.moved, "kept value", "kept values")));
+    }
+    if r.pinned > 0 {
+        changes.push(format!("{} pinned beside them", plural(r.pinned, "free vertex", "free vertices")));
+    }
+    if !changes.is_empty() {
+        name = format!("{name} ({})", changes.join(", "));
+    }
+    name
+}
+
 /// The representative on a triangulated surface (the complex is built either way, for
 /// `--complex`). A construction the user chose is built or refused (its check failing is an
 /// error naming the vertices); the automatic choice tries the separatrix one, then the
@@ -263,30 +287,9 @@ fn surface_representative<D: Domain>(
         Harmonic => harmonic(why),
         _ => flooded(why),
     };
-    let named = |kind: RepresentativeKind| {
-        if kind != Separatrix {
-            return kind.name().to_string();
-        }
-        let mut name = kind.name().to_string();
-        if one_sided_saddles.get() > 0 {
-            name = format!("separatrix with {} one-sided saddles", one_sided_saddles.get());
-        }
-        let r = repairs.get();
-        let mut changes = Vec::new();
-        if r.released > 0 {
-            changes.push(format!("{} contradicting separatrix vertices released to the harmonic fill", r.released));
-        }
-        let plural = |n: usize, one: &str, many: &str| format!("{n} {}", if n == 1 { one } else { many });
-        if r.moved > 0 {
-            changes.push(format!("{} moved outward", plural(r.moved, "kept value", "kept values")));
-        }
-        if r.pinned > 0 {
-            changes.push(format!("{} pinned beside them", plural(r.pinned, "free vertex", "free vertices")));
-        }
-        if !changes.is_empty() {
-            name = format!("{name} ({})", changes.join(", "));
-        }
-        name
+    let named = |kind: RepresentativeKind| match kind {
+        Separatrix => separatrix_name(one_sided_saddles.get(), repairs.get()),
+        _ => kind.name().to_string(),
     };
     for kind in order {
         if skip(kind) {

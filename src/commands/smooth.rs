@@ -132,6 +132,20 @@ pub fn smooth(args: &SmoothArgs) -> Result<String> {
         s.commit()?;
     }
 
+    Ok(summary(args, &field, &result, filled, hidden, [read_seconds, write_seconds, start.elapsed().as_secs_f64()]))
+}
+
+/// What `smooth` prints: warnings and notes, the input, the kept set, the certificate, fit and
+/// solver, the seconds (`[read, write, total]`) and the files written.
+fn summary(
+    args: &SmoothArgs,
+    field: &Field,
+    result: &Smoothed,
+    filled: usize,
+    hidden: usize,
+    seconds: [f64; 3],
+) -> String {
+    let [read_seconds, write_seconds, total_seconds] = seconds;
     let r = &result.report;
     let mut text = String::new();
     for w in &r.warnings {
@@ -140,7 +154,7 @@ pub fn smooth(args: &SmoothArgs) -> Result<String> {
     for n in &field.notes {
         text += &format!("note: {n}\n");
     }
-    text += &input_line(&field, r, filled);
+    text += &input_line(field, r, filled);
     let kmin = r.kept.iter().filter(|k| k.role == Role::Min).count();
     text += &format!(
         "kept {kmin} minima and {} maxima{}; representative: {}\n",
@@ -149,7 +163,7 @@ pub fn smooth(args: &SmoothArgs) -> Result<String> {
         r.representative
     );
     text += &fit_and_solver_lines(r);
-    text += &seconds_line(&field.domain, read_seconds, &r.seconds, write_seconds, start.elapsed().as_secs_f64());
+    text += &seconds_line(&field.domain, read_seconds, &r.seconds, write_seconds, total_seconds);
     if hidden > 0 {
         text += &format!("plot: {hidden} kept extrema face away from the camera (try --view)\n");
     }
@@ -158,7 +172,7 @@ pub fn smooth(args: &SmoothArgs) -> Result<String> {
         wrote.push(p.display().to_string());
     }
     text += &format!("wrote {}\n", wrote.join(", "));
-    Ok(text)
+    text
 }
 
 fn facts(field: &Field) -> DomainFacts<'_> {

@@ -109,47 +109,9 @@ pub fn diffuse(args: &DiffuseArgs) -> Result<String> {
     let outside = outside_box(&rgbs, &colours);
     let names: Vec<String> = points.iter().map(|p| p.name.clone()).collect();
 
-    let mut staged: Vec<Staged> = Vec::new();
-    let mut wrote = vec![args.output.display().to_string()];
-    match &pm {
-        Some(pm) => {
-            let mut img = image::RgbaImage::new(pm.width as u32, pm.height as u32);
-            for (v, c) in colours.iter().enumerate() {
-                let p = pm.pixel_of_vertex[v];
-                img.put_pixel((p % pm.width) as u32, (p / pm.width) as u32, image::Rgba([c[0], c[1], c[2], 255]));
-            }
-            staged.push(stage_png(&args.output, &img)?);
-            let wpath = weights_path.clone();
-            staged.push(stage_weights(&wpath, mesh, &names, &w)?);
-            wrote.push(wpath.display().to_string());
-            if let Some(path) = &args.plot {
-                staged.push(stage_png(path, &enlarged(&img, pm, &sets, &rgbs))?);
-                wrote.push(path.display().to_string());
-            }
-        }
-        None => {
-            let chan = |k: usize| -> Vec<f64> { colours.iter().map(|c| f64::from(c[k])).collect() };
-            let (r, g, b) = (chan(0), chan(1), chan(2));
-            let mut owned: Vec<(String, Vec<f64>)> = vec![("red".into(), r), ("green".into(), g), ("blue".into(), b)];
-            for (h, f) in w.functions.iter().enumerate() {
-                owned.push((format!("weight_{}", names[h]), w.normalised[h].clone()));
-                owned.push((format!("weight_{}_raw", names[h]), f.raw.clone()));
-                owned.push((format!("u_{}", names[h]), f.u.clone()));
-                owned.push((format!("role_{}", names[h]), super::weights::weight_roles(mesh, &f.prescribed)));
-            }
-            let arrays: Vec<(&str, &[f64])> = owned.iter().map(|(n, v)| (n.as_str(), v.as_slice())).collect();
-            staged.push(crate::io::export::stage_mesh(&args.output, mesh, &arrays)?);
-            if let Some(path) = &args.plot {
-                let name = |p: &Path| p.file_name().unwrap_or_default().to_string_lossy().to_string();
-                let title = format!("{} coloured by {}", name(&args.input), name(&args.colors));
-                let view = if mesh.is_planar() { MeshView { azimuth: 0.0, elevation: 90.0 } } else { args.view };
-                staged.push(super::stage_plot(path, |p| {
-                    plot_mesh_colours(p, mesh.positions(), mesh.faces(), &colours, &title, view)
-                })?);
-                wrote.push(path.display().to_string());
-            }
-        }
-    }
+    let diffused =
+        Diffused { mesh, pm: pm.as_ref(), weights: &w, names: &names, colours: &colours, sets: &sets, rgbs: &rgbs };
+    let (mut staged, mut wrote) = stage_diffused(args, &diffused, &weights_path)?;
     if let Some(path) = &args.report {
         let report = DiffuseReport {
             input_file: args.input.display().to_string(),
@@ -257,6 +219,65 @@ fn color_handles(points: &[ColorPoint], pm: Option<&PixelMesh>, colors: &Path) -
         handles.push(Handle { name: p.name.clone(), shape });
     }
     Ok(handles)
+}
+
+/// A diffusion's result, for its outputs.
+struct Diffused<'a> {
+    mesh: &'a TriMesh,
+    pm: Option<&'a PixelMesh>,
+    weights: &'a crate::apps::weights::Weights,
+    names: &'a [String],
+    colours: &'a [[u8; 3]],
+    sets: &'a [Vec<usize>],
+    rgbs: &'a [[u8; 3]],
+}
+
+/// Stages the outputs: for an image the PNG, the weights mesh and the enlarged picture; for a
+/// mesh the mesh with red, green, blue and the weights, and its picture. Returns them with
+/// the names written.
+fn stage_diffused(args: &DiffuseArgs, d: &Diffused, weights_path: &Path) -> Result<(Vec<Staged>, Vec<String>)> {
+    let mut staged: Vec<Staged> = Vec::new();
+    let mut wrote = vec![args.output.display().to_string()];
+    match d.pm {
+        Some(pm) => {
+            let mut img = image::RgbaImage::new(pm.width as u32, pm.height as u32);
+            for (v, c) in d.colours.iter().enumerate() {
+                let p = pm.pixel_of_vertex[v];
+                img.put_pixel((p % pm.width) as u32, (p / pm.width) as u32, image::Rgba([c[0], c[1], c[2], 255]));
+            }
+            staged.push(stage_png(&args.output, &img)?);
+            let wpath = weights_path.to_path_buf();
+            staged.push(stage_weights(&wpath, d.mesh, d.names, d.weights)?);
+            wrote.push(wpath.display().to_string());
+            if let Some(path) = &args.plot {
+                staged.push(stage_png(path, &enlarged(&img, pm, d.sets, d.rgbs))?);
+                wrote.push(path.display().to_string());
+            }
+        }
+        None => {
+            let chan = |k: usize| -> Vec<f64> { d.colours.iter().map(|c| f64::from(c[k])).collect() };
+            let (r, g, b) = (chan(0), chan(1), chan(2));
+            let mut owned: Vec<(String, Vec<f64>)> = vec![("red".into(), r), ("green".into(), g), ("blue".into(), b)];
+            for (h, f) in d.weights.functions.iter().enumerate() {
+                owned.push((format!("weight_{}", d.names[h]), d.weights.normalised[h].clone()));
+                owned.push((format!("weight_{}_raw", d.names[h]), f.raw.clone()));
+                owned.push((format!("u_{}", d.names[h]), f.u.clone()));
+                owned.push((format!("role_{}", d.names[h]), super::weights::weight_roles(d.mesh, &f.prescribed)));
+            }
+            let arrays: Vec<(&str, &[f64])> = owned.iter().map(|(n, v)| (n.as_str(), v.as_slice())).collect();
+            staged.push(crate::io::export::stage_mesh(&args.output, d.mesh, &arrays)?);
+            if let Some(path) = &args.plot {
+                let name = |p: &Path| p.file_name().unwrap_or_default().to_string_lossy().to_string();
+                let title = format!("{} coloured by {}", name(&args.input), name(&args.colors));
+                let view = if d.mesh.is_planar() { MeshView { azimuth: 0.0, elevation: 90.0 } } else { args.view };
+                staged.push(super::stage_plot(path, |p| {
+                    plot_mesh_colours(p, d.mesh.positions(), d.mesh.faces(), d.colours, &title, view)
+                })?);
+                wrote.push(path.display().to_string());
+            }
+        }
+    }
+    Ok((staged, wrote))
 }
 
 fn stage_png(path: &Path, img: &image::RgbaImage) -> Result<Staged> {

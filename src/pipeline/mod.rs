@@ -29,7 +29,7 @@ pub use settings::{
     default_smooth_length, SmoothSettings, SMOOTH_LENGTH_EDGES, SMOOTH_LENGTH_FRACTION, SMOOTH_LENGTH_KEPT_SPACING,
 };
 pub use smoothable::{Representative, RepresentativeChoice, RepresentativeKind, Smoothable};
-use stages::{build_operators, order_representative, output_of, Ordered, Problem, Run};
+use stages::{build_operators, order_representative, output_of, Operators, Ordered, Problem, Run};
 use std::time::Instant;
 
 /// A certified result.
@@ -172,22 +172,7 @@ pub(crate) fn smooth_on<D: Smoothable + Sync>(
     }
 
     let t = Instant::now();
-    let scale = problem.scale;
-    let hint: Vec<f64> = ordered.u.iter().map(|&v| scale.unit(v)).collect();
-    let unit_bounds: Vec<Bound> = ordered.bounds.iter().map(|b| Bound { value: scale.unit(b.value), ..*b }).collect();
-    let qp = MonotoneQp {
-        p: &operators.p,
-        q: &operators.q,
-        fixed: &problem.fixed,
-        edges: &ordered.edges,
-        margin: ordered.eps,
-        bounds: &unit_bounds,
-        data: Some(&operators.data_diag),
-        hint: Some(&hint),
-        factor: operators.factor.as_ref(),
-        condition: operators.condition,
-    };
-    let sol = solve_monotone_qp_with(&qp, &settings.qp, analyses, prepared)?;
+    let sol = solve_qp(&problem, &ordered, &operators, settings, analyses, prepared)?;
     seconds.solve = t.elapsed().as_secs_f64();
 
     let t = Instant::now();
@@ -225,6 +210,33 @@ pub(crate) fn smooth_on<D: Smoothable + Sync>(
     let report = run.report(seconds, certificate);
     let Ordered { u, complex, .. } = ordered;
     Ok(Smoothed { output: f, u, roles: kept.roles, report, complex })
+}
+
+/// The QP in units of the input's range, started from the representative.
+fn solve_qp(
+    problem: &Problem,
+    ordered: &Ordered,
+    operators: &Operators,
+    settings: &SmoothSettings,
+    analyses: &mut Analyses,
+    prepared: Option<crate::solve::Prepared>,
+) -> Result<crate::solve::QpSolution> {
+    let scale = problem.scale;
+    let hint: Vec<f64> = ordered.u.iter().map(|&v| scale.unit(v)).collect();
+    let unit_bounds: Vec<Bound> = ordered.bounds.iter().map(|b| Bound { value: scale.unit(b.value), ..*b }).collect();
+    let qp = MonotoneQp {
+        p: &operators.p,
+        q: &operators.q,
+        fixed: &problem.fixed,
+        edges: &ordered.edges,
+        margin: ordered.eps,
+        bounds: &unit_bounds,
+        data: Some(&operators.data_diag),
+        hint: Some(&hint),
+        factor: operators.factor.as_ref(),
+        condition: operators.condition,
+    };
+    solve_monotone_qp_with(&qp, &settings.qp, analyses, prepared)
 }
 
 /// Two adjacent fixed vertices of different roles must differ in value (SPEC.md).

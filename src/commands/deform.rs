@@ -108,48 +108,8 @@ pub fn deform(args: &DeformArgs) -> Result<String> {
         skin_named(mesh.positions(), &w, &transforms, &names, args.skinning).map_err(|e| e.in_file(&args.weights))?;
     let posed_mesh = TriMesh::new(posed.clone(), mesh.faces().to_vec());
     let mut staged: Vec<Staged> = vec![stage_geometry(&args.output, &posed, mesh.faces())?];
-    // the most moved handle colours the picture
-    let moved = transforms
-        .iter()
-        .enumerate()
-        .map(|(h, t)| {
-            let d: f64 = (0..3)
-                .flat_map(|r| (0..4).map(move |c| (r, c)))
-                .map(|(r, c)| {
-                    let id = if r == c { 1.0 } else { 0.0 };
-                    (t.0[r][c] - id).powi(2)
-                })
-                .sum();
-            (h, d)
-        })
-        .max_by(|a, b| a.1.total_cmp(&b.1))
-        .map_or(0, |x| x.0);
     if let Some(path) = &args.plot {
-        // rest and posed meshes side by side in one scene
-        let (lo, hi) = bounds(mesh.positions());
-        let shift = 1.25 * (hi[0] - lo[0]).max(hi[1] - lo[1]);
-        let (pl, _) = bounds(&posed);
-        let dx = shift + lo[0] - pl[0];
-        let mut positions = mesh.positions().to_vec();
-        positions.extend(posed.iter().map(|p| [p[0] + dx, p[1], p[2]]));
-        let nv = mesh.positions().len();
-        let mut tris = mesh.faces().to_vec();
-        tris.extend(mesh.faces().iter().map(|t| t.map(|v| v + nv)));
-        let mut values = w[moved].clone();
-        values.extend_from_slice(&w[moved]);
-        let panel = [GridPanel {
-            title: format!("rest | posed ({:?}), coloured by weight_{}", args.skinning, names[moved]),
-            values: &values,
-        }];
-        let title = format!(
-            "{} posed by {}",
-            args.input.file_name().unwrap_or_default().to_string_lossy(),
-            args.transforms.display()
-        );
-        staged.push(super::stage_plot(path, |p| {
-            plot_mesh_fields(p, &positions, &tris, &panel, &[], &title, args.view, false)?;
-            Ok(())
-        })?);
+        staged.push(stage_picture(path, args, &mesh, &posed, &w, &transforms, &names)?);
     }
     for s in staged {
         s.commit()?;
@@ -177,6 +137,60 @@ pub fn deform(args: &DeformArgs) -> Result<String> {
     );
     text += &super::wrote_line([Some(&args.output), args.plot.as_ref()]);
     Ok(text)
+}
+
+/// The picture: rest and posed meshes side by side in one scene, coloured by the weight of
+/// the most moved handle.
+fn stage_picture(
+    path: &std::path::Path,
+    args: &DeformArgs,
+    mesh: &TriMesh,
+    posed: &[[f64; 3]],
+    w: &[Vec<f64>],
+    transforms: &[Transform],
+    names: &[&str],
+) -> Result<Staged> {
+    // the most moved handle colours the picture
+    let moved = transforms
+        .iter()
+        .enumerate()
+        .map(|(h, t)| {
+            let d: f64 = (0..3)
+                .flat_map(|r| (0..4).map(move |c| (r, c)))
+                .map(|(r, c)| {
+                    let id = if r == c { 1.0 } else { 0.0 };
+                    (t.0[r][c] - id).powi(2)
+                })
+                .sum();
+            (h, d)
+        })
+        .max_by(|a, b| a.1.total_cmp(&b.1))
+        .map_or(0, |x| x.0);
+    // rest and posed meshes side by side in one scene
+    let (lo, hi) = bounds(mesh.positions());
+    let shift = 1.25 * (hi[0] - lo[0]).max(hi[1] - lo[1]);
+    let (pl, _) = bounds(posed);
+    let dx = shift + lo[0] - pl[0];
+    let mut positions = mesh.positions().to_vec();
+    positions.extend(posed.iter().map(|p| [p[0] + dx, p[1], p[2]]));
+    let nv = mesh.positions().len();
+    let mut tris = mesh.faces().to_vec();
+    tris.extend(mesh.faces().iter().map(|t| t.map(|v| v + nv)));
+    let mut values = w[moved].clone();
+    values.extend_from_slice(&w[moved]);
+    let panel = [GridPanel {
+        title: format!("rest | posed ({:?}), coloured by weight_{}", args.skinning, names[moved]),
+        values: &values,
+    }];
+    let title = format!(
+        "{} posed by {}",
+        args.input.file_name().unwrap_or_default().to_string_lossy(),
+        args.transforms.display()
+    );
+    super::stage_plot(path, |p| {
+        plot_mesh_fields(p, &positions, &tris, &panel, &[], &title, args.view, false)?;
+        Ok(())
+    })
 }
 
 /// Stages a mesh without arrays in the format its extension names.

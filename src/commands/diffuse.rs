@@ -258,12 +258,7 @@ fn stage_diffused(args: &DiffuseArgs, d: &Diffused, weights_path: &Path) -> Resu
             let chan = |k: usize| -> Vec<f64> { d.colours.iter().map(|c| f64::from(c[k])).collect() };
             let (r, g, b) = (chan(0), chan(1), chan(2));
             let mut owned: Vec<(String, Vec<f64>)> = vec![("red".into(), r), ("green".into(), g), ("blue".into(), b)];
-            for (h, f) in d.weights.functions.iter().enumerate() {
-                owned.push((format!("weight_{}", d.names[h]), d.weights.normalised[h].clone()));
-                owned.push((format!("weight_{}_raw", d.names[h]), f.raw.clone()));
-                owned.push((format!("u_{}", d.names[h]), f.u.clone()));
-                owned.push((format!("role_{}", d.names[h]), super::weights::weight_roles(d.mesh, &f.prescribed)));
-            }
+            owned.extend(super::weights::weight_arrays(d.mesh, d.names, d.weights));
             let arrays: Vec<(&str, &[f64])> = owned.iter().map(|(n, v)| (n.as_str(), v.as_slice())).collect();
             staged.push(crate::io::export::stage_mesh(&args.output, d.mesh, &arrays)?);
             if let Some(path) = &args.plot {

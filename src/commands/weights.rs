@@ -108,6 +108,14 @@ pub fn weight_roles<D: crate::domain::Domain>(domain: &D, prescribed: &[Option<f
 /// Stages a weights file: per handle `weight_<name>`, `weight_<name>_raw`, `u_<name>`,
 /// `role_<name>` (SPEC.md formats).
 pub fn stage_weights(path: &Path, mesh: &TriMesh, names: &[String], w: &Weights) -> Result<Staged> {
+    let owned = weight_arrays(mesh, names, w);
+    let arrays: Vec<(&str, &[f64])> = owned.iter().map(|(n, v)| (n.as_str(), v.as_slice())).collect();
+    crate::io::export::stage_mesh(path, mesh, &arrays)
+}
+
+/// The arrays of a weights file per handle (SPEC.md formats): `weight_<name>` (normalised),
+/// `weight_<name>_raw`, `u_<name>`, `role_<name>`.
+pub fn weight_arrays(mesh: &TriMesh, names: &[String], w: &Weights) -> Vec<(String, Vec<f64>)> {
     let mut owned: Vec<(String, Vec<f64>)> = Vec::new();
     for (h, f) in w.functions.iter().enumerate() {
         let name = &names[h];
@@ -116,8 +124,7 @@ pub fn stage_weights(path: &Path, mesh: &TriMesh, names: &[String], w: &Weights)
         owned.push((format!("u_{name}"), f.u.clone()));
         owned.push((format!("role_{name}"), weight_roles(mesh, &f.prescribed)));
     }
-    let arrays: Vec<(&str, &[f64])> = owned.iter().map(|(n, v)| (n.as_str(), v.as_slice())).collect();
-    crate::io::export::stage_mesh(path, mesh, &arrays)
+    owned
 }
 
 /// Runs `weights`.

@@ -131,7 +131,6 @@ pub(super) fn parse_numbers<const N: usize, T: std::str::FromStr>(s: &str, what:
 }
 
 pub(super) fn read_xml(bytes: &[u8]) -> Result<ImageData> {
-    use quick_xml::events::Event;
     // Appended data may be raw binary, which is not XML: parse the markup up to and including
     // the <AppendedData ...> start tag only.
     let appended_tag = find(bytes, b"<AppendedData");
@@ -146,6 +145,73 @@ pub(super) fn read_xml(bytes: &[u8]) -> Result<ImageData> {
         }
         None => (bytes, None),
     };
+    let Markup { file_attrs, image_attrs, piece_extents, point_arrays, cell_names, appended_encoding } =
+        scan_markup(markup)?;
+    let file_attrs = file_attrs.ok_or_else(|| Error::input("no <VTKFile> element: not a VTK XML file"))?;
+    let image_attrs = image_attrs.ok_or_else(|| Error::input("no <ImageData> element (truncated file?)"))?;
+    let enc = encoding_of(&file_attrs)?;
+    let Geometry { nx, ny, spacing, origin, extent_text } = geometry(&image_attrs, &piece_extents)?;
+    if point_arrays.is_empty() && !cell_names.is_empty() {
+        let names: Vec<&str> = cell_names.iter().map(String::as_str).collect();
+        return Err(Error::input(format!(
+            "the file has cell data only ({}); point data is needed (ParaView: Cell Data to Point Data)",
+            list_names(&names)
+        )));
+    }
+    let n = nx.checked_mul(ny).ok_or_else(|| Error::input(format!("the extent `{extent_text}` is too large")))?;
+    let appended = Appended { bytes, start: appended, encoding: appended_encoding.as_deref() };
+    let mut arrays = Vec::with_capacity(point_arrays.len());
+    for decl in point_arrays {
+        arrays.push(decode_array(decl, n, enc, &appended)?);
+    }
+    if arrays.is_empty() {
+        return Err(Error::input("the file has no point data arrays"));
+    }
+    Ok(ImageData { nx, ny, spacing, origin, arrays })
+}
+
+/// A point array's declaration from its `<DataArray>` attributes.
+fn array_decl(a: &[(String, String)], arr_name: String) -> Result<ArrayDecl> {
+    let ty_text = get(a, "type").unwrap_or("");
+    let ty = Scalar::parse(ty_text);
+    let ty_text = ty_text.to_string();
+    let components = match get(a, "NumberOfComponents") {
+        None => 1,
+        Some(c) => c.trim().parse::<usize>().ok().filter(|&c| c > 0).ok_or_else(|| {
+            Error::input(format!("point array `{arr_name}`: NumberOfComponents `{c}` is not a positive integer"))
+        })?,
+    };
+    let format = match get(a, "format").unwrap_or("ascii") {
+        "ascii" => Format::Ascii,
+        "binary" => Format::Binary,
+        "appended" => {
+            let off = get(a, "offset").unwrap_or("0");
+            Format::Appended(
+                off.trim()
+                    .parse()
+                    .map_err(|_| Error::input(format!("point array `{arr_name}`: offset `{off}` is not an integer")))?,
+            )
+        }
+        f => return Err(Error::input(format!("point array `{arr_name}` has unknown format `{f}`"))),
+    };
+    Ok(ArrayDecl { name: arr_name, ty, ty_text, components, format, text: Vec::new() })
+}
+
+/// What the markup declares: the `<VTKFile>` and `<ImageData>` attributes, each piece's
+/// extent, the point arrays (with their inline text) and the cell arrays' names, and the
+/// encoding of the appended data.
+struct Markup {
+    file_attrs: Option<Vec<(String, String)>>,
+    image_attrs: Option<Vec<(String, String)>>,
+    piece_extents: Vec<Option<String>>,
+    point_arrays: Vec<ArrayDecl>,
+    cell_names: Vec<String>,
+    appended_encoding: Option<String>,
+}
+
+/// Reads the markup (up to the `<AppendedData>` start tag).
+fn scan_markup(markup: &[u8]) -> Result<Markup> {
+    use quick_xml::events::Event;
     let mut reader = quick_xml::Reader::from_reader(markup);
     let mut file_attrs: Option<Vec<(String, String)>> = None;
     let mut image_attrs: Option<Vec<(String, String)>> = None;
@@ -198,35 +264,7 @@ pub(super) fn read_xml(bytes: &[u8]) -> Result<ImageData> {
                     let arr_name = get(&a, "Name").unwrap_or("").to_string();
                     match section {
                         "PointData" => {
-                            let ty_text = get(&a, "type").unwrap_or("");
-                            let ty = Scalar::parse(ty_text);
-                            let ty_text = ty_text.to_string();
-                            let components = match get(&a, "NumberOfComponents") {
-                                None => 1,
-                                Some(c) => c.trim().parse::<usize>().ok().filter(|&c| c > 0).ok_or_else(|| {
-                                    Error::input(format!(
-                                        "point array `{arr_name}`: NumberOfComponents `{c}` is not a positive integer"
-                                    ))
-                                })?,
-                            };
-                            let format = match get(&a, "format").unwrap_or("ascii") {
-                                "ascii" => Format::Ascii,
-                                "binary" => Format::Binary,
-                                "appended" => {
-                                    let off = get(&a, "offset").unwrap_or("0");
-                                    Format::Appended(off.trim().parse().map_err(|_| {
-                                        Error::input(format!(
-                                            "point array `{arr_name}`: offset `{off}` is not an integer"
-                                        ))
-                                    })?)
-                                }
-                                f => {
-                                    return Err(Error::input(format!(
-                                        "point array `{arr_name}` has unknown format `{f}`"
-                                    )))
-                                }
-                            };
-                            let decl = ArrayDecl { name: arr_name, ty, ty_text, components, format, text: Vec::new() };
+                            let decl = array_decl(&a, arr_name)?;
                             if empty {
                                 point_arrays.push(decl);
                             } else {
@@ -274,20 +312,23 @@ pub(super) fn read_xml(bytes: &[u8]) -> Result<ImageData> {
             _ => {}
         }
     }
-    let file_attrs = file_attrs.ok_or_else(|| Error::input("no <VTKFile> element: not a VTK XML file"))?;
-    let image_attrs = image_attrs.ok_or_else(|| Error::input("no <ImageData> element (truncated file?)"))?;
-    let enc = Encoding {
-        big_endian: match get(&file_attrs, "byte_order").unwrap_or("LittleEndian") {
+    Ok(Markup { file_attrs, image_attrs, piece_extents, point_arrays, cell_names, appended_encoding })
+}
+
+/// The byte order, header size and compressor the `<VTKFile>` attributes declare.
+fn encoding_of(file_attrs: &[(String, String)]) -> Result<Encoding> {
+    Ok(Encoding {
+        big_endian: match get(file_attrs, "byte_order").unwrap_or("LittleEndian") {
             "LittleEndian" => false,
             "BigEndian" => true,
             o => return Err(Error::input(format!("unknown byte_order `{o}`"))),
         },
-        header: match get(&file_attrs, "header_type").unwrap_or("UInt32") {
+        header: match get(file_attrs, "header_type").unwrap_or("UInt32") {
             "UInt32" => 4,
             "UInt64" => 8,
             h => return Err(Error::input(format!("unsupported header_type `{h}` (VTK writes UInt32 or UInt64)"))),
         },
-        zlib: match get(&file_attrs, "compressor").map(str::trim).unwrap_or("") {
+        zlib: match get(file_attrs, "compressor").map(str::trim).unwrap_or("") {
             "" => false,
             "vtkZLibDataCompressor" => true,
             c => {
@@ -297,7 +338,21 @@ pub(super) fn read_xml(bytes: &[u8]) -> Result<ImageData> {
                 )))
             }
         },
-    };
+    })
+}
+
+/// An image's points, spacing and origin, with its extent as written.
+struct Geometry {
+    nx: usize,
+    ny: usize,
+    spacing: [f64; 2],
+    origin: [f64; 2],
+    extent_text: String,
+}
+
+/// The image's size, spacing and origin (the piece's extent shifted into the origin), with
+/// the extent as written.
+fn geometry(image_attrs: &[(String, String)], piece_extents: &[Option<String>]) -> Result<Geometry> {
     if piece_extents.is_empty() {
         return Err(Error::input("the image has no <Piece> (truncated file?)"));
     }
@@ -307,7 +362,7 @@ pub(super) fn read_xml(bytes: &[u8]) -> Result<ImageData> {
             piece_extents.len()
         )));
     }
-    let whole = get(&image_attrs, "WholeExtent").ok_or_else(|| Error::input("<ImageData> has no WholeExtent"))?;
+    let whole = get(image_attrs, "WholeExtent").ok_or_else(|| Error::input("<ImageData> has no WholeExtent"))?;
     let extent_text = piece_extents[0].clone().unwrap_or_else(|| whole.to_string());
     let ext: [i64; 6] = parse_numbers(&extent_text, "the extent")?;
     let count = |lo: i64, hi: i64| if hi >= lo { (hi - lo + 1) as usize } else { 0 };
@@ -322,83 +377,78 @@ pub(super) fn read_xml(bytes: &[u8]) -> Result<ImageData> {
             "the extent `{extent_text}` gives {nx} × {ny} × {nz} points: a 2D image needs at least 2 × 2 points in the x-y plane"
         )));
     }
-    let origin3: [f64; 3] = match get(&image_attrs, "Origin") {
+    let origin3: [f64; 3] = match get(image_attrs, "Origin") {
         Some(o) => parse_numbers(o, "Origin")?,
         None => [0.0; 3],
     };
-    let spacing3: [f64; 3] = match get(&image_attrs, "Spacing") {
+    let spacing3: [f64; 3] = match get(image_attrs, "Spacing") {
         Some(s) => parse_numbers(s, "Spacing")?,
         None => [1.0; 3],
     };
     let spacing = [spacing3[0], spacing3[1]];
     let origin = [origin3[0] + ext[0] as f64 * spacing[0], origin3[1] + ext[2] as f64 * spacing[1]];
-    if point_arrays.is_empty() && !cell_names.is_empty() {
-        let names: Vec<&str> = cell_names.iter().map(String::as_str).collect();
-        return Err(Error::input(format!(
-            "the file has cell data only ({}); point data is needed (ParaView: Cell Data to Point Data)",
-            list_names(&names)
-        )));
-    }
-    let n = nx.checked_mul(ny).ok_or_else(|| Error::input(format!("the extent `{extent_text}` is too large")))?;
-    let mut arrays = Vec::with_capacity(point_arrays.len());
-    for decl in point_arrays {
-        let ty = decl.ty.ok_or_else(|| {
-            Error::input(if decl.ty_text.is_empty() {
-                format!("point array `{}` has no `type`", decl.name)
-            } else {
-                format!("point array `{}` has type {}, which is not numeric", decl.name, decl.ty_text)
-            })
-        })?;
-        let what = format!("point array `{}`", decl.name);
-        let expected = n
-            .checked_mul(decl.components)
-            .and_then(|c| c.checked_mul(ty.size()))
-            .ok_or_else(|| Error::input(format!("{what} is too large")))?;
-        let values = match decl.format {
-            Format::Ascii => parse_ascii(&decl.text, n * decl.components, &what)?,
-            Format::Binary => {
-                let mut src = Base64Stream { text: &decl.text, pos: 0, pending: Vec::new() };
-                let raw = read_block(&mut src, enc, expected, ty.size(), n, decl.components, &what)?;
-                ty.decode(&raw, enc.big_endian)
-            }
-            Format::Appended(offset) => {
-                let start = appended
-                    .ok_or_else(|| Error::input(format!("{what} is appended but the file has no <AppendedData>")))?;
-                let data = appended_start(bytes, start)?;
-                let raw = match appended_encoding.as_deref().unwrap_or("raw") {
-                    "raw" => {
-                        let rest = data.get(offset..).ok_or_else(|| {
-                            Error::input(format!(
-                                "truncated: {what} starts at offset {offset}, past the end of the appended data"
-                            ))
-                        })?;
-                        let mut src = RawStream { data: rest, pos: 0 };
-                        read_block(&mut src, enc, expected, ty.size(), n, decl.components, &what)?
-                    }
-                    "base64" => {
-                        let rest = data.get(offset..).ok_or_else(|| {
-                            Error::input(format!(
-                                "truncated: {what} starts at offset {offset}, past the end of the appended data"
-                            ))
-                        })?;
-                        let mut src = Base64Stream { text: rest, pos: 0, pending: Vec::new() };
-                        read_block(&mut src, enc, expected, ty.size(), n, decl.components, &what)?
-                    }
-                    e => {
-                        return Err(Error::input(format!(
-                            "unknown AppendedData encoding `{e}` (expected raw or base64)"
-                        )))
-                    }
-                };
-                ty.decode(&raw, enc.big_endian)
-            }
-        };
-        arrays.push(PointArray { name: decl.name, components: decl.components, values });
-    }
-    if arrays.is_empty() {
-        return Err(Error::input("the file has no point data arrays"));
-    }
-    Ok(ImageData { nx, ny, spacing, origin, arrays })
+    Ok(Geometry { nx, ny, spacing, origin, extent_text })
+}
+
+/// Where the appended data is and how it is encoded.
+struct Appended<'a> {
+    bytes: &'a [u8],
+    /// The byte after the `<AppendedData ...>` tag, if there is one.
+    start: Option<usize>,
+    encoding: Option<&'a str>,
+}
+
+/// A declared point array's values: `n` tuples, read inline or from the appended data.
+fn decode_array(decl: ArrayDecl, n: usize, enc: Encoding, appended: &Appended) -> Result<PointArray> {
+    let ty = decl.ty.ok_or_else(|| {
+        Error::input(if decl.ty_text.is_empty() {
+            format!("point array `{}` has no `type`", decl.name)
+        } else {
+            format!("point array `{}` has type {}, which is not numeric", decl.name, decl.ty_text)
+        })
+    })?;
+    let what = format!("point array `{}`", decl.name);
+    let expected = n
+        .checked_mul(decl.components)
+        .and_then(|c| c.checked_mul(ty.size()))
+        .ok_or_else(|| Error::input(format!("{what} is too large")))?;
+    let values = match decl.format {
+        Format::Ascii => parse_ascii(&decl.text, n * decl.components, &what)?,
+        Format::Binary => {
+            let mut src = Base64Stream { text: &decl.text, pos: 0, pending: Vec::new() };
+            let raw = read_block(&mut src, enc, expected, ty.size(), n, decl.components, &what)?;
+            ty.decode(&raw, enc.big_endian)
+        }
+        Format::Appended(offset) => {
+            let start = appended
+                .start
+                .ok_or_else(|| Error::input(format!("{what} is appended but the file has no <AppendedData>")))?;
+            let data = appended_start(appended.bytes, start)?;
+            let raw = match appended.encoding.unwrap_or("raw") {
+                "raw" => {
+                    let rest = data.get(offset..).ok_or_else(|| {
+                        Error::input(format!(
+                            "truncated: {what} starts at offset {offset}, past the end of the appended data"
+                        ))
+                    })?;
+                    let mut src = RawStream { data: rest, pos: 0 };
+                    read_block(&mut src, enc, expected, ty.size(), n, decl.components, &what)?
+                }
+                "base64" => {
+                    let rest = data.get(offset..).ok_or_else(|| {
+                        Error::input(format!(
+                            "truncated: {what} starts at offset {offset}, past the end of the appended data"
+                        ))
+                    })?;
+                    let mut src = Base64Stream { text: rest, pos: 0, pending: Vec::new() };
+                    read_block(&mut src, enc, expected, ty.size(), n, decl.components, &what)?
+                }
+                e => return Err(Error::input(format!("unknown AppendedData encoding `{e}` (expected raw or base64)"))),
+            };
+            ty.decode(&raw, enc.big_endian)
+        }
+    };
+    Ok(PointArray { name: decl.name, components: decl.components, values })
 }
 
 pub(super) fn find(hay: &[u8], needle: &[u8]) -> Option<usize> {

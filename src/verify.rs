@@ -17,7 +17,7 @@ use crate::topology::Role;
 #[derive(Clone, Debug, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct Failure {
-    /// Certificate item (1–4, SPEC.md).
+    /// Certificate item (1–4, SPEC.md; 0 when the arrays do not fit the domain).
     pub item: u8,
     /// Offending vertex.
     pub vertex: usize,
@@ -82,8 +82,24 @@ impl Certificate {
 /// Item 5 (the values as written and read back) is this function applied to the file's values.
 pub fn certify<D: Domain>(domain: &D, f: &[f64], roles: &[Role], input: Option<&[f64]>) -> Certificate {
     let n = domain.n_vertices();
-    assert_eq!(f.len(), n);
-    assert_eq!(roles.len(), n);
+    if f.len() != n || roles.len() != n || input.is_some_and(|h| h.len() != n) {
+        // sizes that disagree certify nothing (item 0: the arrays themselves)
+        let sizes = format!(
+            "{} values, {} roles{} for {n} vertices",
+            f.len(),
+            roles.len(),
+            input.map(|h| format!(", {} input values", h.len())).unwrap_or_default()
+        );
+        return Certificate {
+            failure_count: 1,
+            failures: vec![Failure {
+                item: 0,
+                vertex: 0,
+                reason: format!("the arrays do not fit the domain: {sizes}"),
+            }],
+            ..Default::default()
+        };
+    }
     let mut failures = Vec::new();
     let (mut strict_minima, mut strict_maxima, mut flat) = (0, 0, 0);
     // a series' free end must lie inside the input's range (item 2)
@@ -316,6 +332,14 @@ pub fn spurious_components<D: Domain>(domain: &D, f: &[f64], prescribed: &[Optio
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn arrays_that_do_not_fit_the_domain_fail_instead_of_panicking() {
+        let s = crate::domain::Series::uniform(4);
+        let c = certify(&s, &[0.0, 1.0, 0.0], &[Role::Min, Role::Max, Role::Min, Role::Max], None);
+        assert!(!c.passed && c.failures[0].item == 0, "{c:?}");
+        assert!(c.summary().contains("3 values, 4 roles for 4 vertices"), "{}", c.summary());
+    }
     use crate::domain::Series;
 
     #[test]

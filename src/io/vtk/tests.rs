@@ -486,3 +486,12 @@ fn vtp_is_valid_poly_data() {
     let e = stage_vtp(&p, &bad).err().unwrap().to_string();
     assert!(e.contains("`kind`") && e.contains("4 cells"), "{e}");
 }
+
+#[test]
+fn malformed_markup_points_at_its_byte() {
+    let path = dir().join("malformed.vti");
+    std::fs::write(&path, "<VTKFile type=\"ImageData\">\n<ImageData WholeExtent=\"0 1 0 1 0 0\"></Piece>").unwrap();
+    let e = read_image(&path).unwrap_err();
+    assert!(e.to_string().contains("malformed XML near byte"), "{e}");
+    assert!(matches!(e.location(), Some(crate::error::Location::Byte(b)) if b > 20), "{:?}", e.location());
+}

@@ -222,9 +222,10 @@ fn scan_markup(markup: &[u8]) -> Result<Markup> {
     let mut cell_names: Vec<String> = Vec::new();
     let mut appended_encoding: Option<String> = None;
     loop {
-        let event = reader
-            .read_event()
-            .map_err(|e| Error::input(format!("malformed XML near byte {}: {e}", reader.error_position())))?;
+        let event = reader.read_event().map_err(|e| {
+            let at = reader.error_position();
+            Error::input(format!("malformed XML near byte {at}: {e}")).at(crate::error::Location::Byte(at))
+        })?;
         let (start, empty) = match &event {
             Event::Start(e) => (Some(e), false),
             Event::Empty(e) => (Some(e), true),

@@ -65,6 +65,25 @@ fn write_array(w: &mut dyn Write, indent: &str, ty: &str, name: &str, comps: usi
     writeln!(w, "{indent}</DataArray>")
 }
 
+/// A `<PointData>` or `<CellData>` section of Float64 arrays, the first one the active scalars.
+fn write_section(w: &mut dyn Write, tag: &str, arrays: &[(&str, &[f64])]) -> std::io::Result<()> {
+    match arrays.first() {
+        Some((first, _)) => writeln!(w, "      <{tag} Scalars=\"{}\">", xml_escape(first))?,
+        None => writeln!(w, "      <{tag}>")?,
+    }
+    for (name, values) in arrays {
+        write_array(w, "        ", "Float64", name, 1, &f64_bytes(values))?;
+    }
+    writeln!(w, "      </{tag}>")
+}
+
+/// The `<Points>` section: Float64 triples.
+fn write_points(w: &mut dyn Write, coords: &[f64]) -> std::io::Result<()> {
+    writeln!(w, "      <Points>")?;
+    write_array(w, "        ", "Float64", "Points", 3, &f64_bytes(coords))?;
+    writeln!(w, "      </Points>")
+}
+
 const XML_HEAD: &str = "<?xml version=\"1.0\"?>";
 
 fn file_open(kind: &str) -> String {
@@ -235,18 +254,10 @@ pub fn stage_vtp(path: &Path, poly: &PolyData) -> Result<Staged> {
             poly.polys.len()
         )?;
         for (tag, arrays) in [("PointData", &poly.point_arrays), ("CellData", &poly.cell_arrays)] {
-            match arrays.first() {
-                Some((first, _)) => writeln!(w, "      <{tag} Scalars=\"{}\">", xml_escape(first))?,
-                None => writeln!(w, "      <{tag}>")?,
-            }
-            for (name, values) in arrays {
-                write_array(w, "        ", "Float64", name, 1, &f64_bytes(values))?;
-            }
-            writeln!(w, "      </{tag}>")?;
+            let arrays: Vec<(&str, &[f64])> = arrays.iter().map(|(n, v)| (n.as_str(), v.as_slice())).collect();
+            write_section(w, tag, &arrays)?;
         }
-        writeln!(w, "      <Points>")?;
-        write_array(w, "        ", "Float64", "Points", 3, &f64_bytes(&coords))?;
-        writeln!(w, "      </Points>")?;
+        write_points(w, &coords)?;
         // empty cell lists are left out (VTK reads that as none; vtkio fails on empty arrays)
         let poly_conn: Vec<usize> = poly.polys.iter().flatten().copied().collect();
         let poly_offsets: Vec<usize> = (1..=poly.polys.len()).map(|k| 3 * k).collect();
@@ -305,17 +316,8 @@ pub fn stage_vtu(
         writeln!(w, "{}", file_open("UnstructuredGrid"))?;
         writeln!(w, "  <UnstructuredGrid>")?;
         writeln!(w, "    <Piece NumberOfPoints=\"{n}\" NumberOfCells=\"{}\">", triangles.len())?;
-        match arrays.first() {
-            Some((first, _)) => writeln!(w, "      <PointData Scalars=\"{}\">", xml_escape(first))?,
-            None => writeln!(w, "      <PointData>")?,
-        }
-        for (name, values) in arrays {
-            write_array(w, "        ", "Float64", name, 1, &f64_bytes(values))?;
-        }
-        writeln!(w, "      </PointData>")?;
-        writeln!(w, "      <Points>")?;
-        write_array(w, "        ", "Float64", "Points", 3, &f64_bytes(&coords))?;
-        writeln!(w, "      </Points>")?;
+        write_section(w, "PointData", arrays)?;
+        write_points(w, &coords)?;
         writeln!(w, "      <Cells>")?;
         write_array(w, "        ", "Int64", "connectivity", 1, &i64_bytes(&conn))?;
         write_array(w, "        ", "Int64", "offsets", 1, &i64_bytes(&offsets))?;

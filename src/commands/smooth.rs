@@ -112,11 +112,15 @@ pub fn smooth(args: &SmoothArgs) -> Result<String> {
     }
     let write_seconds = t.elapsed().as_secs_f64();
     let filled = field.filled.as_ref().map(|m| m.iter().filter(|&&b| b).count()).unwrap_or(0);
+    let negative = match &field.domain {
+        AnyDomain::Mesh(m) => crate::operators::negative_cotan_edges(m.positions(), m.faces()),
+        _ => 0,
+    };
     if let Some(path) = &args.report {
         let run = RunReport {
             input_file: field.path.display().to_string(),
             field: &field.description,
-            domain: facts(&field),
+            domain: facts(&field, negative),
             filled_missing: filled,
             output_file: args.output.display().to_string(),
             read_seconds,
@@ -132,19 +136,20 @@ pub fn smooth(args: &SmoothArgs) -> Result<String> {
         s.commit()?;
     }
 
-    Ok(summary(args, &field, &result, filled, hidden, [read_seconds, write_seconds, start.elapsed().as_secs_f64()]))
+    Ok(summary(
+        args,
+        &field,
+        &result,
+        [filled, negative, hidden],
+        [read_seconds, write_seconds, start.elapsed().as_secs_f64()],
+    ))
 }
 
 /// What `smooth` prints: warnings and notes, the input, the kept set, the certificate, fit and
-/// solver, the seconds (`[read, write, total]`) and the files written.
-fn summary(
-    args: &SmoothArgs,
-    field: &Field,
-    result: &Smoothed,
-    filled: usize,
-    hidden: usize,
-    seconds: [f64; 3],
-) -> String {
+/// solver, the seconds (`[read, write, total]`) and the files written; `counts`: samples
+/// filled, interior edges of negative cotangent weight, kept extrema hidden from the camera.
+fn summary(args: &SmoothArgs, field: &Field, result: &Smoothed, counts: [usize; 3], seconds: [f64; 3]) -> String {
+    let [filled, negative, hidden] = counts;
     let [read_seconds, write_seconds, total_seconds] = seconds;
     let r = &result.report;
     let mut text = String::new();
@@ -154,7 +159,7 @@ fn summary(
     for n in &field.notes {
         text += &format!("note: {n}\n");
     }
-    text += &input_line(field, r, filled);
+    text += &input_line(field, r, filled, negative);
     let kmin = r.kept.iter().filter(|k| k.role == Role::Min).count();
     text += &format!(
         "kept {kmin} minima and {} maxima{}; representative: {}\n",
@@ -175,7 +180,7 @@ fn summary(
     text
 }
 
-fn facts(field: &Field) -> DomainFacts<'_> {
+fn facts(field: &Field, negative: usize) -> DomainFacts<'_> {
     match &field.domain {
         AnyDomain::Series(_) => DomainFacts::Series { column: &field.description },
         AnyDomain::Grid(g) => {
@@ -186,14 +191,14 @@ fn facts(field: &Field) -> DomainFacts<'_> {
             components: m.n_components(),
             boundary_loops: m.boundary_loops(),
             genus: m.is_orientable().then(|| m.genus()),
-            negative_cotangent_edges: crate::operators::negative_cotan_edges(m.positions(), m.faces()),
+            negative_cotangent_edges: negative,
             reading_notes: &field.notes,
         },
     }
 }
 
 /// The summary's first line: the file, the field, the domain and the input's extrema.
-fn input_line(field: &Field, r: &Report, filled: usize) -> String {
+fn input_line(field: &Field, r: &Report, filled: usize, negative: usize) -> String {
     let path = field.path.display();
     let extrema = format!("{} minima and {} maxima in the input", r.input_minima, r.input_maxima);
     match &field.domain {
@@ -214,7 +219,7 @@ fn input_line(field: &Field, r: &Report, filled: usize) -> String {
             if filled > 0 { format!("filled {filled} missing (NaN) values harmonically\n") } else { String::new() },
             field.description,
             m.describe(),
-            crate::operators::negative_cotan_edges(m.positions(), m.faces()),
+            negative,
         ),
     }
 }

@@ -39,11 +39,20 @@ fn check_extension(path: &Path, allowed: &[&str], what: &str) -> Result<()> {
     if allowed.contains(&extension(path).as_str()) {
         return Ok(());
     }
-    Err(Error::Usage(format!(
+    Err(format_error(path, allowed, what))
+}
+
+/// The error for an output extension that `what` has no format for.
+fn format_error(path: &Path, allowed: &[&str], what: &str) -> Error {
+    Error::Usage(format!(
         "{}: the output of {what} is written as {}",
         path.display(),
         allowed.iter().map(|e| format!(".{e}")).collect::<Vec<_>>().join(", ")
-    )))
+    ))
+}
+
+fn mesh_format_error(path: &Path) -> Error {
+    format_error(path, MESH_OUTPUTS, "a mesh")
 }
 
 /// Checks before any work that `path` names an output format of `domain`.
@@ -151,7 +160,7 @@ pub fn stage_mesh(path: &Path, mesh: &TriMesh, arrays: &[(&str, &[f64])]) -> Res
             },
         ),
         "ply" => stage_ply(path, mesh.positions(), mesh.faces(), arrays),
-        _ => check_mesh_output(path).map(|()| unreachable!("not a mesh extension")),
+        _ => Err(mesh_format_error(path)),
     }
 }
 
@@ -247,8 +256,9 @@ pub fn read_results(path: &Path) -> Result<Stored> {
         "vti" => {
             let img = read_image(path)?;
             let grid = Grid2d::with_geometry(img.nx, img.ny, img.spacing, img.origin).map_err(|e| e.in_file(path))?;
+            let names = img.arrays.iter().map(|a| a.name.clone()).collect();
             let arrays = img.arrays.into_iter().filter(|a| a.components == 1).map(|a| (a.name, a.values)).collect();
-            stored(path, AnyDomain::Grid(grid), arrays)
+            stored(path, AnyDomain::Grid(grid), names, arrays)
         }
         "npz" => {
             let arrays = read_npz(path)?;
@@ -260,7 +270,8 @@ pub fn read_results(path: &Path) -> Result<Stored> {
                 return Err(Error::input(format!("array `{name}` has shape {shape:?}, the first {:?}", [*ny, *nx]))
                     .in_file(path));
             }
-            stored(path, AnyDomain::Grid(grid), arrays.into_iter().map(|(n, _, v)| (n, v)).collect())
+            let names = arrays.iter().map(|(n, _, _)| n.clone()).collect();
+            stored(path, AnyDomain::Grid(grid), names, arrays.into_iter().map(|(n, _, v)| (n, v)).collect())
         }
         e if MESH_OUTPUTS.contains(&e) => {
             let (mesh, data) = read_trimesh(path)?;
@@ -281,11 +292,8 @@ pub fn read_results(path: &Path) -> Result<Stored> {
 pub fn results_on_mesh(path: &Path, mesh: TriMesh, data: &MeshData) -> Result<Stored> {
     let n = mesh.n_vertices();
     let mut arrays = Vec::new();
-    for a in &data.arrays {
-        let verifiable = ["input", "smoothed", "representative", "role"].contains(&a.name.as_str());
-        if a.components == 1 && a.values.len() == n {
-            arrays.push((a.name.clone(), a.values.clone()));
-        } else if verifiable {
+    for a in data.arrays.iter().filter(|a| VERIFIABLE.contains(&a.name.as_str())) {
+        if a.components != 1 || a.values.len() != n {
             return Err(Error::input(format!(
                 "array `{}` has {} components ({} values for {n} vertices); a scalar is needed",
                 a.name,
@@ -294,12 +302,17 @@ pub fn results_on_mesh(path: &Path, mesh: TriMesh, data: &MeshData) -> Result<St
             ))
             .in_file(path));
         }
+        arrays.push((a.name.clone(), a.values.clone()));
     }
-    stored(path, AnyDomain::Mesh(mesh), arrays)
+    let names = data.arrays.iter().map(|a| a.name.clone()).collect();
+    stored(path, AnyDomain::Mesh(mesh), names, arrays)
 }
 
-fn stored(path: &Path, domain: AnyDomain, mut arrays: Vec<(String, Vec<f64>)>) -> Result<Stored> {
-    let names: Vec<String> = arrays.iter().map(|(n, _)| n.clone()).collect();
+/// The arrays a verifiable output holds.
+const VERIFIABLE: [&str; 4] = ["input", "smoothed", "representative", "role"];
+
+/// The four verifiable arrays from `arrays`; `names` are the file's arrays, for the message.
+fn stored(path: &Path, domain: AnyDomain, names: Vec<String>, mut arrays: Vec<(String, Vec<f64>)>) -> Result<Stored> {
     let mut take = |name: &str| -> Result<Vec<f64>> {
         match arrays.iter().position(|(n, _)| n == name) {
             Some(i) => Ok(arrays.swap_remove(i).1),

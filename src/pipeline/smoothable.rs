@@ -106,7 +106,8 @@ pub trait Smoothable: Domain {
     /// first construction in the order `choice` prefers that is not `excluded` (kind and
     /// why: the pipeline excludes one whose order makes the constraints infeasible); `fill`
     /// is the harmonic fills' Laplacian ([`Smoothable::own_fill_stiffness`] or the stiffness), the
-    /// factorisations' analyses are in `analyses`.
+    /// factorisations' analyses are in `analyses`. By default the surface constructions
+    /// (separatrix, harmonic, flooded) on the domain's Morse–Smale complex; series override it.
     fn representative(
         &self,
         h: &[f64],
@@ -115,7 +116,12 @@ pub trait Smoothable: Domain {
         fill: &Sparse,
         excluded: &[(RepresentativeKind, String)],
         analyses: &mut Analyses,
-    ) -> Result<Representative>;
+    ) -> Result<Representative>
+    where
+        Self: Sized,
+    {
+        surface_representative(self, h, kept, choice, fill, excluded, analyses)
+    }
 }
 
 impl Smoothable for Series {
@@ -315,6 +321,9 @@ impl Smoothable for TriMesh {
     fn mass(&self) -> Vec<f64> {
         lumped_mass(self.positions(), self.faces())
     }
+    /// The harmonic fills use [`positive_cotan_stiffness`]: cotangent weights of obtuse
+    /// triangles can be negative and break the maximum principle the representative relies on
+    /// (paper section 5).
     fn own_fill_stiffness(&self) -> Option<Sparse> {
         Some(positive_cotan_stiffness(self.positions(), self.faces()))
     }
@@ -322,20 +331,6 @@ impl Smoothable for TriMesh {
     /// gradients (three rows per triangle).
     fn stiffness_factor(&self, k: &Sparse) -> Option<Factor> {
         edge_factor(k).or_else(|| Some(gradient_factor(self.positions(), self.faces())))
-    }
-    /// As on grids, but the harmonic fills use [`positive_cotan_stiffness`] (`fill`):
-    /// cotangent weights of obtuse triangles can be negative and break the maximum principle
-    /// the representative relies on (paper section 5).
-    fn representative(
-        &self,
-        h: &[f64],
-        kept: &KeptSet,
-        choice: Option<RepresentativeChoice>,
-        fill: &Sparse,
-        excluded: &[(RepresentativeKind, String)],
-        analyses: &mut Analyses,
-    ) -> Result<Representative> {
-        surface_representative(self, h, kept, choice, fill, excluded, analyses)
     }
 }
 
@@ -345,16 +340,5 @@ impl Smoothable for Grid2d {
     }
     fn mass(&self) -> Vec<f64> {
         grid_mass(self)
-    }
-    fn representative(
-        &self,
-        h: &[f64],
-        kept: &KeptSet,
-        choice: Option<RepresentativeChoice>,
-        fill: &Sparse,
-        excluded: &[(RepresentativeKind, String)],
-        analyses: &mut Analyses,
-    ) -> Result<Representative> {
-        surface_representative(self, h, kept, choice, fill, excluded, analyses)
     }
 }

@@ -256,7 +256,8 @@ fn the_modules_form_no_cycle() {
             while let Some(at) = c[from..].find(start) {
                 let at = from + at;
                 from = at + start.len();
-                if at > 0 && (bytes[at - 1].is_ascii_alphanumeric() || bytes[at - 1] == b'_') {
+                // inside a longer path (`super::super::x`): the whole path is read from its start
+                if at > 0 && (bytes[at - 1].is_ascii_alphanumeric() || bytes[at - 1] == b'_' || bytes[at - 1] == b':') {
                     continue;
                 }
                 let end = c[at..]

@@ -1,5 +1,5 @@
 //! Triangle meshes: OBJ, OFF, PLY ascii and binary (ply-rs-bw), VTK XML `.vtu`/`.vtp`
-//! and legacy `.vtk` unstructured grids and polydata (vtkio); written as `.vtu`, `.vtp` (see
+//! and legacy `.vtk` unstructured grids and polydata ([`super::vtk`]); written as `.vtu`, `.vtp` (see
 //! [`super::vtk`]), binary PLY with Float64 vertex properties, and (geometry only) OBJ and OFF.
 //!
 //! Polygons with more than three corners are split into fans (reported). Per-vertex data comes
@@ -104,14 +104,13 @@ pub fn read_mesh(path: &Path) -> Result<MeshData> {
     if bytes.is_empty() {
         return Err(input(path, "the file is empty"));
     }
-    let mut data = match extension(path).as_str() {
+    let mut data = super::guarded(path, || match extension(path).as_str() {
         "obj" => read_obj(&bytes),
         "off" => read_off(&bytes),
         "ply" => read_ply(&bytes),
-        "vtu" | "vtp" | "vtk" => read_vtk(&bytes, &extension(path)),
+        "vtu" | "vtp" | "vtk" => read_vtk(&bytes),
         other => Err(Error::input(format!("`.{other}` is not a mesh format (obj, off, ply, vtu, vtp, vtk)"))),
-    }
-    .map_err(|e| e.in_file(path))?;
+    })?;
     if data.triangles.is_empty() {
         return Err(input(path, "the file holds no triangle"));
     }
@@ -397,177 +396,56 @@ fn read_ply(bytes: &[u8]) -> Result<MeshData> {
     Ok(data)
 }
 
-/// Cells as (type code, corner list) from either vtkio encoding, checked for consistency.
-fn cells_of(numbers: vtkio::model::VertexNumbers, what: &str) -> Result<Vec<Vec<usize>>> {
-    use vtkio::model::VertexNumbers;
-    let mut out = Vec::new();
-    match numbers {
-        VertexNumbers::Legacy { num_cells, vertices } => {
-            let mut at = 0usize;
-            for c in 0..num_cells as usize {
-                let k =
-                    *vertices.get(at).ok_or_else(|| Error::input(format!("{what}: the cell list ends at cell {c}")))?
-                        as usize;
-                let cell = vertices
-                    .get(at + 1..at + 1 + k)
-                    .ok_or_else(|| Error::input(format!("{what}: cell {c} is truncated")))?;
-                out.push(cell.iter().map(|&v| v as usize).collect());
-                at += 1 + k;
-            }
-        }
-        VertexNumbers::XML { connectivity, offsets } => {
-            let offsets: Vec<u64> =
-                if offsets.first() == Some(&0) && offsets.len() > 1 { offsets[1..].to_vec() } else { offsets };
-            let mut start = 0usize;
-            for (c, &end) in offsets.iter().enumerate() {
-                let end = end as usize;
-                let cell = connectivity
-                    .get(start..end)
-                    .ok_or_else(|| Error::input(format!("{what}: offsets of cell {c} run outside the connectivity")))?;
-                out.push(cell.iter().map(|&v| v as usize).collect());
-                start = end;
-            }
-        }
+/// A VTK data set's surface cells as triangles: triangles, quads, pixels and polygons (split
+/// into fans), triangle strips; vertex and line cells are dropped (reported). Other cells
+/// (volumes) are an error naming the first.
+fn read_vtk(bytes: &[u8]) -> Result<MeshData> {
+    use super::vtk::cell;
+    let ds = super::vtk::parse_dataset(bytes)?;
+    if ds.image.is_some() {
+        return Err(Error::input(
+            "the file holds image data, not a mesh: read it as a grid (--domain grid, or a .vti/.vtk image)",
+        ));
     }
-    Ok(out)
-}
-
-fn point_arrays(attrs: Vec<vtkio::model::Attribute>, n: usize) -> Result<Vec<PointArray>> {
-    use vtkio::model::{Attribute, ElementType};
-    let mut arrays = Vec::new();
-    for attr in attrs {
-        let mut push = |name: String, comps: usize, buf: &vtkio::IOBuffer| -> Result<()> {
-            let values = buf.cast_into::<f64>().ok_or_else(|| {
-                Error::input(format!("point array `{name}` has a data type that cannot be read as numbers"))
-            })?;
-            if values.len() != n * comps {
+    let mut data = MeshData { positions: ds.points, arrays: ds.point_data, ..MeshData::default() };
+    let (mut dropped, mut split) = (0usize, 0usize);
+    for c in 0..ds.cells.len() {
+        let corners = ds.cells.corners(c);
+        let ty = ds.cells.types[c];
+        match ty {
+            cell::TRIANGLE | cell::QUAD | cell::POLYGON | cell::PIXEL => {
+                if corners.len() < 3 || (ty == cell::TRIANGLE && corners.len() != 3) {
+                    return Err(Error::input(format!(
+                        "cell {c} is a {} with {} corners",
+                        cell::name(ty),
+                        corners.len()
+                    )));
+                }
+                if corners.len() > 3 {
+                    split += 1;
+                }
+                if ty == cell::PIXEL && corners.len() == 4 {
+                    // a pixel's corners run (0,0) (1,0) (0,1) (1,1)
+                    fan(&[corners[0], corners[1], corners[3], corners[2]], &mut data.triangles);
+                } else {
+                    fan(corners, &mut data.triangles);
+                }
+            }
+            cell::TRIANGLE_STRIP => strip(corners, &mut data.triangles),
+            cell::VERTEX | cell::POLY_VERTEX | cell::LINE | cell::POLY_LINE => dropped += 1,
+            other => {
                 return Err(Error::input(format!(
-                    "point array `{name}` holds {} values for {n} points × {comps}",
-                    values.len()
-                )));
-            }
-            arrays.push(PointArray { name, components: comps, values });
-            Ok(())
-        };
-        match attr {
-            Attribute::DataArray(da) => {
-                if !matches!(da.elem, ElementType::LookupTable) {
-                    push(da.name.clone(), da.elem.num_comp() as usize, &da.data)?;
-                }
-            }
-            Attribute::Field { data_array, .. } => {
-                for fa in data_array {
-                    push(fa.name.clone(), fa.elem as usize, &fa.data)?;
-                }
+                    "cell {c} is a {} cell: only surface cells (triangles, quads, polygons, strips) are supported",
+                    cell::name(other)
+                )))
             }
         }
-    }
-    Ok(arrays)
-}
-
-fn read_vtk(bytes: &[u8], ext: &str) -> Result<MeshData> {
-    use vtkio::model::{CellType, DataSet};
-    let parsed = std::panic::catch_unwind(|| {
-        if ext == "vtk" {
-            vtkio::Vtk::parse_legacy_be(bytes)
-        } else {
-            vtkio::Vtk::parse_xml(std::io::BufReader::new(bytes))
-        }
-    })
-    .map_err(|_| Error::input("the VTK reader failed on this file (malformed?)"))?
-    .map_err(|e| {
-        let raw = ext != "vtk" && bytes.windows(14).any(|w| w == b"encoding=\"raw\"");
-        Error::input(if raw {
-            format!(
-                "cannot parse the VTK file ({e}): its appended data is raw (ParaView's default), which the \
-                 reader does not support; save with `Data Mode: Ascii` or `Binary` (base64)"
-            )
-        } else {
-            format!("cannot parse the VTK file ({e}): truncated or malformed")
-        })
-    })?;
-    let mut data = MeshData::default();
-    let mut dropped = 0usize;
-    let mut split = 0usize;
-    let mut surface = |cell: &[usize], data: &mut MeshData, what: &str| -> Result<()> {
-        if cell.len() < 3 {
-            return Err(Error::input(format!("{what} has {} corners", cell.len())));
-        }
-        if cell.len() > 3 {
-            split += 1;
-        }
-        fan(cell, &mut data.triangles);
-        Ok(())
-    };
-    match parsed.data {
-        DataSet::UnstructuredGrid { pieces, .. } => {
-            let piece = only_piece(pieces)?;
-            data.positions = points_of(&piece.points)?;
-            let cells = cells_of(piece.cells.cell_verts, "cells")?;
-            if cells.len() != piece.cells.types.len() {
-                return Err(Error::input(format!("{} cells but {} cell types", cells.len(), piece.cells.types.len())));
-            }
-            for (c, (cell, ty)) in cells.iter().zip(&piece.cells.types).enumerate() {
-                match ty {
-                    CellType::Triangle | CellType::Quad | CellType::Polygon => {
-                        surface(cell, &mut data, &format!("cell {c}"))?
-                    }
-                    CellType::TriangleStrip => strip(cell, &mut data.triangles),
-                    CellType::Vertex | CellType::PolyVertex | CellType::Line | CellType::PolyLine => dropped += 1,
-                    other => {
-                        return Err(Error::input(format!(
-                            "cell {c} is a {other:?} cell: only surface cells (triangles, quads, polygons, strips) are supported"
-                        )))
-                    }
-                }
-            }
-            data.arrays = point_arrays(piece.data.point, data.positions.len())?;
-        }
-        DataSet::PolyData { pieces, .. } => {
-            let piece = only_piece(pieces)?;
-            data.positions = points_of(&piece.points)?;
-            if let Some(polys) = piece.polys {
-                for (c, cell) in cells_of(polys, "polygons")?.iter().enumerate() {
-                    surface(cell, &mut data, &format!("polygon {c}"))?;
-                }
-            }
-            if let Some(strips) = piece.strips {
-                for cell in cells_of(strips, "strips")? {
-                    strip(&cell, &mut data.triangles);
-                }
-            }
-            for v in [piece.verts, piece.lines].into_iter().flatten() {
-                dropped += v.num_cells();
-            }
-            data.arrays = point_arrays(piece.data.point, data.positions.len())?;
-        }
-        _ => return Err(Error::input("the data set is neither an unstructured grid nor polydata")),
     }
     polygon_note(split, &mut data.notes);
     if dropped > 0 {
         data.notes.push(format!("{dropped} vertex and line cells ignored"));
     }
     Ok(data)
-}
-
-/// The one inline piece of a data set (several pieces or external ones are refused).
-fn only_piece<P>(pieces: Vec<vtkio::model::Piece<P>>) -> Result<P> {
-    if pieces.len() != 1 {
-        return Err(Error::input(format!("{} pieces: only single-piece files are supported", pieces.len())));
-    }
-    match pieces.into_iter().next() {
-        Some(vtkio::model::Piece::Inline(piece)) => Ok(*piece),
-        _ => Err(Error::input("the file refers to external pieces")),
-    }
-}
-
-/// Point coordinates as triples.
-fn points_of(buf: &vtkio::IOBuffer) -> Result<Vec<[f64; 3]>> {
-    let p = buf.cast_into::<f64>().ok_or_else(|| Error::input("the point coordinates are not numbers"))?;
-    if p.len() % 3 != 0 {
-        return Err(Error::input("the point coordinates are not triples"));
-    }
-    Ok(p.chunks(3).map(|c| [c[0], c[1], c[2]]).collect())
 }
 
 /// Triangles of a triangle strip (alternating orientation kept consistent).

@@ -15,6 +15,33 @@ use crate::error::{Error, Result};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
+/// The marker in the message of a reader that failed internally (a panic caught while
+/// reading a file): the file is reported as bad input, the message says it is our bug.
+pub const READER_FAILURE: &str = "[reader failure]";
+
+/// Runs a reader on `path`, turning a panic inside it into an input error naming the file
+/// (exit 3) that carries [`READER_FAILURE`]. Errors are given the file name.
+///
+/// # Errors
+/// The reader's errors, and the caught panic.
+pub fn guarded<T>(path: &Path, read: impl FnOnce() -> Result<T>) -> Result<T> {
+    match std::panic::catch_unwind(std::panic::AssertUnwindSafe(read)) {
+        Ok(r) => r.map_err(|e| e.in_file(path)),
+        Err(payload) => {
+            let what = payload
+                .downcast_ref::<&str>()
+                .map(|s| s.to_string())
+                .or_else(|| payload.downcast_ref::<String>().cloned())
+                .unwrap_or_default();
+            Err(Error::input(format!(
+                "{READER_FAILURE} the reader failed on this file ({what}); the file is probably malformed, \
+                 and toposmooth should have said how: please report it"
+            ))
+            .in_file(path))
+        }
+    }
+}
+
 /// A complete file waiting under a temporary sibling name: [`Staged::commit`] renames it into
 /// place; dropped uncommitted, it is removed. Staging every output of a command before
 /// committing any means a failure leaves no output behind.

@@ -1,4 +1,5 @@
-//! The image data a VTK reader returns.
+//! What the VTK readers return: any data set as read ([`Dataset`]), and a 2D image
+//! ([`ImageData`]) made from one.
 
 use crate::domain::Grid2d;
 use crate::error::{Error, Result};
@@ -18,6 +19,195 @@ pub struct ImageData {
     pub origin: [f64; 2],
     /// Point data arrays, in file order.
     pub arrays: Vec<PointArray>,
+    /// What reading did (a Direction matrix turned into flips or a transposition).
+    pub notes: Vec<String>,
+}
+
+/// A VTK data set as the file holds it, before it becomes a domain.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Dataset {
+    /// The image geometry of image data (`None` for poly data and unstructured grids).
+    pub image: Option<ImageGeometry>,
+    /// Point coordinates (empty for image data).
+    pub points: Vec<[f64; 3]>,
+    /// Cells (empty for image data).
+    pub cells: Cells,
+    /// Point data arrays, in file order.
+    pub point_data: Vec<PointArray>,
+    /// Names of the cell data arrays, in file order.
+    pub cell_data: Vec<String>,
+    /// Arrays that are not numeric (strings, bits), which are not read: "`name` (type)".
+    pub skipped: Vec<String>,
+}
+
+/// The geometry of VTK image data: point `(i, j, k)` of the extent lies at
+/// `origin + direction · (i·sx, j·sy, k·sz)`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ImageGeometry {
+    /// `x0 x1 y0 y1 z0 z1`, inclusive.
+    pub extent: [i64; 6],
+    /// `Origin`: the position of index (0, 0, 0).
+    pub origin: [f64; 3],
+    /// `Spacing` along the index axes.
+    pub spacing: [f64; 3],
+    /// Row-major 3 × 3 (VTK's `Direction` attribute order); the identity when absent.
+    pub direction: [f64; 9],
+}
+
+impl ImageGeometry {
+    /// Points along each axis.
+    pub fn dims(&self) -> [usize; 3] {
+        let e = self.extent;
+        [0, 1, 2].map(|a| if e[2 * a + 1] >= e[2 * a] { (e[2 * a + 1] - e[2 * a]) as usize + 1 } else { 0 })
+    }
+}
+
+/// Cells in VTK's unstructured layout: cell `c` has type `types[c]` (VTK's cell type code)
+/// and corners `connectivity[offsets[c]..offsets[c + 1]]`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Cells {
+    /// One VTK cell type code per cell (see [`cell`]).
+    pub types: Vec<u8>,
+    /// `types.len() + 1` offsets, starting at 0.
+    pub offsets: Vec<usize>,
+    /// The corners of all cells, one after another.
+    pub connectivity: Vec<usize>,
+}
+
+impl Default for Cells {
+    fn default() -> Self {
+        Cells { types: Vec::new(), offsets: vec![0], connectivity: Vec::new() }
+    }
+}
+
+impl Cells {
+    /// Number of cells.
+    pub fn len(&self) -> usize {
+        self.types.len()
+    }
+
+    /// Whether there is no cell.
+    pub fn is_empty(&self) -> bool {
+        self.types.is_empty()
+    }
+
+    /// The corners of cell `c`.
+    pub fn corners(&self, c: usize) -> &[usize] {
+        &self.connectivity[self.offsets[c]..self.offsets[c + 1]]
+    }
+
+    /// Appends cells given as end offsets (VTK XML's layout, no leading 0) into
+    /// `connectivity`, all of type `ty`, or of the types given; indices shifted by `base`.
+    ///
+    /// # Errors
+    /// Offsets that decrease or run past the connectivity, or a type list of another length.
+    pub(crate) fn append(
+        &mut self,
+        connectivity: &[usize],
+        ends: &[usize],
+        types: CellTypes,
+        base: usize,
+        what: &str,
+    ) -> Result<()> {
+        if let CellTypes::Each(t) = &types {
+            if t.len() != ends.len() {
+                return Err(Error::input(format!("{what}: {} cells but {} cell types", ends.len(), t.len())));
+            }
+        }
+        let mut start = 0usize;
+        for (c, &end) in ends.iter().enumerate() {
+            if end < start || end > connectivity.len() {
+                return Err(Error::input(format!(
+                    "{what}: the offsets of cell {c} ({start}..{end}) run outside the connectivity ({} entries)",
+                    connectivity.len()
+                )));
+            }
+            let shifted = connectivity[start..end].iter().map(|&v| v.checked_add(base));
+            for v in shifted {
+                self.connectivity
+                    .push(v.ok_or_else(|| Error::input(format!("{what}: cell {c} has an index too large")))?);
+            }
+            self.offsets.push(self.connectivity.len());
+            self.types.push(match &types {
+                CellTypes::Each(t) => t[c],
+                CellTypes::PolyData(kind) => kind.cell_type(end - start),
+            });
+            start = end;
+        }
+        Ok(())
+    }
+}
+
+/// The types of cells being appended.
+pub(crate) enum CellTypes {
+    /// One type per cell.
+    Each(Vec<u8>),
+    /// Poly data cells of this section: the type follows the corner count.
+    PolyData(PolySection),
+}
+
+/// The cell sections of VTK poly data.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum PolySection {
+    Verts,
+    Lines,
+    Polys,
+    Strips,
+}
+
+impl PolySection {
+    /// VTK's cell type for a cell of `n` corners in this section.
+    fn cell_type(self, n: usize) -> u8 {
+        match (self, n) {
+            (PolySection::Verts, 1) => cell::VERTEX,
+            (PolySection::Verts, _) => cell::POLY_VERTEX,
+            (PolySection::Lines, 2) => cell::LINE,
+            (PolySection::Lines, _) => cell::POLY_LINE,
+            (PolySection::Polys, 3) => cell::TRIANGLE,
+            (PolySection::Polys, 4) => cell::QUAD,
+            (PolySection::Polys, _) => cell::POLYGON,
+            (PolySection::Strips, _) => cell::TRIANGLE_STRIP,
+        }
+    }
+}
+
+/// VTK's cell type codes (vtkCellType.h) that the readers name.
+#[allow(missing_docs)]
+pub mod cell {
+    pub const VERTEX: u8 = 1;
+    pub const POLY_VERTEX: u8 = 2;
+    pub const LINE: u8 = 3;
+    pub const POLY_LINE: u8 = 4;
+    pub const TRIANGLE: u8 = 5;
+    pub const TRIANGLE_STRIP: u8 = 6;
+    pub const POLYGON: u8 = 7;
+    pub const PIXEL: u8 = 8;
+    pub const QUAD: u8 = 9;
+    pub const TETRA: u8 = 10;
+
+    /// A readable name for a cell type code.
+    pub fn name(t: u8) -> String {
+        let known = [
+            "vertex",
+            "poly-vertex",
+            "line",
+            "poly-line",
+            "triangle",
+            "triangle strip",
+            "polygon",
+            "pixel",
+            "quad",
+            "tetrahedron",
+            "voxel",
+            "hexahedron",
+            "wedge",
+            "pyramid",
+        ];
+        match t {
+            1..=14 => known[usize::from(t) - 1].to_string(),
+            _ => format!("type-{t}"),
+        }
+    }
 }
 
 /// One point data array, converted to f64.

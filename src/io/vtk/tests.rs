@@ -113,13 +113,11 @@ fn vti_round_trip_bits_and_geometry() {
         assert_eq!(img.names(), ["f & <g>", "b"]);
         assert_eq!(bits(&img.arrays[0].values), bits(&a));
         assert_eq!(bits(&img.arrays[1].values), bits(&b));
-        // vtkio reads our file too, with the same data
-        let vtk = vtkio::Vtk::parse_xml(std::io::BufReader::new(std::fs::File::open(&p).unwrap())).unwrap();
-        let vtkio::model::DataSet::ImageData { pieces, .. } = vtk.data else { panic!("not image data") };
-        let vtkio::model::Piece::Inline(piece) = &pieces[0] else { panic!("not inline") };
-        let vtkio::model::Attribute::DataArray(arr) = &piece.data.point[0] else { panic!("no array") };
-        assert_eq!(arr.name, "f & <g>");
-        assert_eq!(bits(&arr.data.cast_into::<f64>().unwrap()), bits(&a));
+        // the data set as written: extent from 0, z spacing 1, no direction
+        let ds = read_dataset(&p).unwrap();
+        let g = ds.image.unwrap();
+        assert_eq!(g.extent, [0, nx as i64 - 1, 0, ny as i64 - 1, 0, 0]);
+        assert_eq!((g.origin, g.spacing), ([origin[0], origin[1], 0.0], [spacing[0], spacing[1], 1.0]));
     }
     // a large array over many blocks
     let p = d.join("big.vti");
@@ -396,14 +394,23 @@ fn bad_vti_files_give_clear_errors() {
     let p = edited("extent.vti", "0 512 0 64 0 0", "0 511 0 64 0 0");
     let e = error_of(&p);
     assert!(e.contains("33280 points") && e.contains("`Vectors_`"), "{e}");
-    // unknown compressor
+    // unknown compressor; zlib data labelled lz4
+    let p = edited("foo.vti", "vtkZLibDataCompressor", "vtkFooDataCompressor");
+    let e = error_of(&p);
+    assert!(e.contains("vtkFooDataCompressor") && e.contains("vtkLZ4DataCompressor"), "{e}");
     let p = edited("lz4.vti", "vtkZLibDataCompressor", "vtkLZ4DataCompressor");
-    assert!(error_of(&p).contains("vtkLZ4DataCompressor"));
-    // 3D extent, too thin
+    let e = error_of(&p);
+    assert!(e.contains("`Vectors_`") && e.contains("does not decompress"), "{e}");
+    // an extent that the data does not fill; a 3D image (written by VTK); a line
     let p = edited("3d.vti", "0 512 0 64 0 0", "0 512 0 64 0 3");
-    assert!(error_of(&p).contains("along z"));
+    let e = error_of(&p);
+    assert!(e.contains("`Vectors_`") && e.contains("133380 points"), "{e}");
+    let vol = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/vtk/vol.appended-raw-zlib-u64.vti");
+    let e = read_image(&vol).unwrap_err().to_string();
+    assert!(e.contains("vol.appended-raw-zlib-u64.vti") && e.contains("3 points along z"), "{e}");
     let p = edited("thin.vti", "0 512 0 64 0 0", "0 512 0 0 0 0");
-    assert!(error_of(&p).contains("2 × 2"));
+    let e = error_of(&p);
+    assert!(e.contains("`Vectors_`") && e.contains("513 points"), "{e}");
     // corrupt base64, non-numeric ascii, string array, cell data only, not VTK, not ImageData
     let p = edited("b64.vti", "_GQAAAACAAAAY", "_GQAAAAC*AAAY");
     assert!(error_of(&p).contains("base64"));
@@ -444,7 +451,6 @@ fn bad_vti_files_give_clear_errors() {
 
 #[test]
 fn vtp_is_valid_poly_data() {
-    use vtkio::model::{Attribute, DataSet, Piece, VertexNumbers};
     let poly = PolyData {
         points: vec![[0.0, 0.0, 0.0], [1.0, 0.5, 0.0], [2.0, 0.25, 1.0], [0.1, 0.2, 0.3]],
         verts: vec![0, 3],
@@ -459,25 +465,20 @@ fn vtp_is_valid_poly_data() {
     for needle in ["type=\"PolyData\"", "NumberOfVerts=\"2\"", "NumberOfLines=\"2\"", "<Verts>", "<Lines>"] {
         assert!(text.contains(needle), "{needle}");
     }
-    let vtk = vtkio::Vtk::parse_xml(std::io::BufReader::new(std::fs::File::open(&p).unwrap())).unwrap();
-    let DataSet::PolyData { pieces, .. } = vtk.data else { panic!("not poly data") };
-    let Piece::Inline(piece) = &pieces[0] else { panic!("not inline") };
-    assert_eq!(piece.points.cast_into::<f64>().unwrap(), poly.points.concat());
-    let topo = |t: &Option<VertexNumbers>| match t.clone().unwrap() {
-        VertexNumbers::XML { connectivity, offsets } => (connectivity, offsets),
-        VertexNumbers::Legacy { .. } => panic!("legacy"),
-    };
-    assert_eq!(topo(&piece.verts), (vec![0, 3], vec![1, 2]));
-    assert_eq!(topo(&piece.lines), (vec![0, 1, 2, 3, 1], vec![3, 5]));
-    let Attribute::DataArray(a) = &piece.data.point[0] else { panic!() };
-    assert_eq!((a.name.as_str(), a.data.cast_into::<f64>().unwrap()), ("value", poly.point_arrays[0].1.clone()));
-    let Attribute::DataArray(c) = &piece.data.cell[0] else { panic!() };
-    assert_eq!((c.name.as_str(), c.data.cast_into::<f64>().unwrap()), ("kind", poly.cell_arrays[0].1.clone()));
+    let ds = read_dataset(&p).unwrap();
+    assert_eq!(ds.points, poly.points);
+    // verts, then lines, in VTK's cell order
+    assert_eq!(ds.cells.types, vec![cell::VERTEX, cell::VERTEX, cell::POLY_LINE, cell::LINE]);
+    assert_eq!(ds.cells.connectivity, vec![0, 3, 0, 1, 2, 3, 1]);
+    assert_eq!(ds.cells.offsets, vec![0, 1, 2, 5, 7]);
+    assert_eq!((ds.point_data[0].name.as_str(), &ds.point_data[0].values), ("value", &poly.point_arrays[0].1));
+    assert_eq!(ds.cell_data, vec!["kind".to_string()]);
     // empty cell lists are valid too
     let only_points = PolyData { points: poly.points.clone(), ..Default::default() };
     let q = dir().join("points.vtp");
     stage_vtp(&q, &only_points).unwrap().commit().unwrap();
-    vtkio::Vtk::parse_xml(std::io::BufReader::new(std::fs::File::open(&q).unwrap())).unwrap();
+    let ds = read_dataset(&q).unwrap();
+    assert_eq!((ds.points.len(), ds.cells.len()), (4, 0));
     // argument errors
     let bad = PolyData { lines: vec![vec![0, 9]], ..poly.clone() };
     let e = stage_vtp(&p, &bad).err().unwrap().to_string();

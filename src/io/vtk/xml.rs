@@ -1,108 +1,17 @@
-//! The VTK XML ImageData reader (`.vti`): every layout VTK writes, raw appended data included.
+//! The VTK XML reader: image data (`.vti`), poly data (`.vtp`) and unstructured grids
+//! (`.vtu`), in every layout VTK writes: ascii, inline base64, appended base64 or raw;
+//! uncompressed, zlib, lz4 or lzma; UInt32 or UInt64 headers; either byte order.
+//!
+//! quick-xml reads the markup up to the `<AppendedData>` tag (raw appended data is not XML);
+//! the arrays are decoded by [`super::decode`], whose size checks run before any allocation.
 
-use super::data::{list_names, ImageData, PointArray};
-use crate::error::{Error, Result};
-use std::io::Read;
+use super::data::{CellTypes, Dataset, ImageGeometry, PointArray, PolySection};
+use super::decode::{parse_ascii, read_block, Base64Stream, Compressor, Encoding, Numbers, RawStream, Scalar, Shape};
+use crate::error::{Error, Location, Result};
 
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub(super) enum Scalar {
-    I8,
-    U8,
-    I16,
-    U16,
-    I32,
-    U32,
-    I64,
-    U64,
-    F32,
-    F64,
-}
+type Attrs = Vec<(String, String)>;
 
-impl Scalar {
-    fn parse(s: &str) -> Option<Scalar> {
-        Some(match s {
-            "Int8" | "Char" => Scalar::I8,
-            "UInt8" | "UnsignedChar" => Scalar::U8,
-            "Int16" | "Short" => Scalar::I16,
-            "UInt16" | "UnsignedShort" => Scalar::U16,
-            "Int32" | "Int" => Scalar::I32,
-            "UInt32" | "UnsignedInt" => Scalar::U32,
-            "Int64" | "Long" | "LongLong" | "IdType" => Scalar::I64,
-            "UInt64" | "UnsignedLong" | "UnsignedLongLong" => Scalar::U64,
-            "Float32" | "Float" => Scalar::F32,
-            "Float64" | "Double" => Scalar::F64,
-            _ => return None,
-        })
-    }
-
-    fn size(self) -> usize {
-        match self {
-            Scalar::I8 | Scalar::U8 => 1,
-            Scalar::I16 | Scalar::U16 => 2,
-            Scalar::I32 | Scalar::U32 | Scalar::F32 => 4,
-            Scalar::I64 | Scalar::U64 | Scalar::F64 => 8,
-        }
-    }
-
-    /// Converts raw bytes (a whole number of elements) to f64.
-    fn decode(self, bytes: &[u8], big_endian: bool) -> Vec<f64> {
-        macro_rules! conv {
-            ($t:ty, $n:expr) => {
-                bytes
-                    .chunks_exact($n)
-                    .map(|c| {
-                        let a: [u8; $n] = c.try_into().expect("chunk size");
-                        (if big_endian { <$t>::from_be_bytes(a) } else { <$t>::from_le_bytes(a) }) as f64
-                    })
-                    .collect()
-            };
-        }
-        match self {
-            Scalar::I8 => bytes.iter().map(|&b| b as i8 as f64).collect(),
-            Scalar::U8 => bytes.iter().map(|&b| b as f64).collect(),
-            Scalar::I16 => conv!(i16, 2),
-            Scalar::U16 => conv!(u16, 2),
-            Scalar::I32 => conv!(i32, 4),
-            Scalar::U32 => conv!(u32, 4),
-            Scalar::I64 => conv!(i64, 8),
-            Scalar::U64 => conv!(u64, 8),
-            Scalar::F32 => conv!(f32, 4),
-            Scalar::F64 => conv!(f64, 8),
-        }
-    }
-}
-
-#[derive(Clone, Copy, Debug)]
-pub(super) struct Encoding {
-    big_endian: bool,
-    /// Bytes per header word: 4 (UInt32) or 8 (UInt64).
-    header: usize,
-    zlib: bool,
-}
-
-#[derive(Debug)]
-pub(super) enum Format {
-    Ascii,
-    Binary,
-    Appended(usize),
-}
-
-#[derive(Debug)]
-pub(super) struct ArrayDecl {
-    name: String,
-    /// None for a type that is not numeric (an error only if the array is read).
-    ty: Option<Scalar>,
-    /// The `type` attribute as written.
-    ty_text: String,
-    components: usize,
-    format: Format,
-    text: Vec<u8>,
-}
-
-/// Largest allocation made on the word of a file's header before the data is seen to exist.
-pub(super) const CAPACITY: usize = 1 << 24;
-
-pub(super) fn attrs(e: &quick_xml::events::BytesStart) -> Result<Vec<(String, String)>> {
+pub(super) fn attrs(e: &quick_xml::events::BytesStart) -> Result<Attrs> {
     let tag = String::from_utf8_lossy(e.name().as_ref()).into_owned();
     e.attributes()
         .map(|a| {
@@ -124,17 +33,107 @@ pub(super) fn get<'a>(attrs: &'a [(String, String)], key: &str) -> Option<&'a st
 pub(super) fn parse_numbers<const N: usize, T: std::str::FromStr>(s: &str, what: &str) -> Result<[T; N]> {
     let parts: Vec<&str> = s.split_whitespace().collect();
     let parsed: Option<Vec<T>> = parts.iter().map(|p| p.parse::<T>().ok()).collect();
-    match parsed {
-        Some(v) if v.len() == N => Ok(v.try_into().unwrap_or_else(|_| unreachable!())),
+    match parsed.map(<[T; N]>::try_from) {
+        Some(Ok(v)) => Ok(v),
         _ => Err(Error::input(format!("{what} must be {N} numbers, found `{s}`"))),
     }
 }
 
-pub(super) fn read_xml(bytes: &[u8]) -> Result<ImageData> {
+/// The sections of a piece that hold data arrays.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Section {
+    PointData,
+    CellData,
+    Points,
+    Cells,
+    Poly(PolySection),
+}
+
+impl Section {
+    fn of(tag: &[u8]) -> Option<Section> {
+        Some(match tag {
+            b"PointData" => Section::PointData,
+            b"CellData" => Section::CellData,
+            b"Points" => Section::Points,
+            b"Cells" => Section::Cells,
+            b"Verts" => Section::Poly(PolySection::Verts),
+            b"Lines" => Section::Poly(PolySection::Lines),
+            b"Polys" => Section::Poly(PolySection::Polys),
+            b"Strips" => Section::Poly(PolySection::Strips),
+            _ => return None,
+        })
+    }
+}
+
+#[derive(Debug)]
+enum Format {
+    Ascii,
+    Binary,
+    Appended(usize),
+}
+
+/// A `<DataArray>` as declared, with its inline text.
+#[derive(Debug)]
+struct ArrayDecl {
+    name: String,
+    /// None for a type that is not numeric (String, Bit).
+    ty: Option<Scalar>,
+    /// The `type` attribute as written.
+    ty_text: String,
+    components: usize,
+    format: Format,
+    text: Vec<u8>,
+}
+
+/// A `<Piece>`: its attributes and its arrays, by section.
+#[derive(Debug, Default)]
+struct PieceDecl {
+    attrs: Attrs,
+    arrays: Vec<(Section, ArrayDecl)>,
+}
+
+impl PieceDecl {
+    fn array(&self, section: Section, name: &str) -> Option<&ArrayDecl> {
+        self.arrays.iter().find(|(s, a)| *s == section && a.name == name).map(|(_, a)| a)
+    }
+
+    fn first(&self, section: Section) -> Option<&ArrayDecl> {
+        self.arrays.iter().find(|(s, _)| *s == section).map(|(_, a)| a)
+    }
+
+    /// A count attribute (`NumberOfPoints`, ...); absent means 0.
+    fn count(&self, key: &str) -> Result<usize> {
+        match get(&self.attrs, key) {
+            None => Ok(0),
+            Some(v) => v
+                .trim()
+                .parse()
+                .map_err(|_| Error::input(format!("<Piece> attribute {key}=\"{v}\" is not a non-negative integer"))),
+        }
+    }
+}
+
+/// The markup: the `<VTKFile>` and data set attributes, and the pieces.
+struct Markup {
+    file_attrs: Option<Attrs>,
+    kind: String,
+    dataset_attrs: Attrs,
+    pieces: Vec<PieceDecl>,
+    appended_encoding: Option<String>,
+}
+
+/// Where the appended data is and how it is encoded.
+struct Appended<'a> {
+    /// The bytes after the `_` marker, if there is appended data.
+    data: Option<&'a [u8]>,
+    base64: bool,
+}
+
+/// Reads a VTK XML file of image data, poly data or an unstructured grid.
+pub(super) fn read_xml(bytes: &[u8]) -> Result<Dataset> {
     // Appended data may be raw binary, which is not XML: parse the markup up to and including
     // the <AppendedData ...> start tag only.
-    let appended_tag = find(bytes, b"<AppendedData");
-    let (markup, appended) = match appended_tag {
+    let (markup, after) = match find(bytes, b"<AppendedData") {
         Some(at) => {
             let close = bytes[at..]
                 .iter()
@@ -145,40 +144,272 @@ pub(super) fn read_xml(bytes: &[u8]) -> Result<ImageData> {
         }
         None => (bytes, None),
     };
-    let Markup { file_attrs, image_attrs, piece_extents, point_arrays, cell_names, appended_encoding } =
-        scan_markup(markup)?;
-    let file_attrs = file_attrs.ok_or_else(|| Error::input("no <VTKFile> element: not a VTK XML file"))?;
-    let image_attrs = image_attrs.ok_or_else(|| Error::input("no <ImageData> element (truncated file?)"))?;
-    let enc = encoding_of(&file_attrs)?;
-    let Geometry { nx, ny, spacing, origin, extent_text } = geometry(&image_attrs, &piece_extents)?;
-    if point_arrays.is_empty() && !cell_names.is_empty() {
-        let names: Vec<&str> = cell_names.iter().map(String::as_str).collect();
+    let m = scan_markup(markup)?;
+    let file_attrs = m.file_attrs.as_deref().ok_or_else(|| Error::input("no <VTKFile> element: not a VTK XML file"))?;
+    let enc = encoding_of(file_attrs)?;
+    let appended = Appended {
+        data: after.map(|close| appended_start(bytes, close)).transpose()?,
+        base64: match m.appended_encoding.as_deref().unwrap_or("raw") {
+            "raw" => false,
+            "base64" => true,
+            e => return Err(Error::input(format!("unknown AppendedData encoding `{e}` (expected raw or base64)"))),
+        },
+    };
+    let reader = Decoder { enc, appended };
+    if m.pieces.is_empty() {
+        return Err(Error::input(format!("the {} has no <Piece> (truncated file?)", m.kind)));
+    }
+    match m.kind.as_str() {
+        "ImageData" => image(&m, &reader),
+        "PolyData" | "UnstructuredGrid" => {
+            let mut ds = Dataset::default();
+            for (k, piece) in m.pieces.iter().enumerate() {
+                let at = if m.pieces.len() > 1 { format!("piece {}: ", k + 1) } else { String::new() };
+                mesh_piece(piece, m.kind == "PolyData", &reader, &mut ds).map_err(|e| prefix(e, &at))?;
+            }
+            Ok(ds)
+        }
+        other => Err(Error::input(format!("unexpected data set <{other}>"))),
+    }
+}
+
+fn prefix(e: Error, at: &str) -> Error {
+    match e {
+        Error::Input { path, at: loc, message } if !at.is_empty() => {
+            Error::Input { path, at: loc, message: format!("{at}{message}") }
+        }
+        e => e,
+    }
+}
+
+/// Decodes the declared arrays.
+struct Decoder<'a> {
+    enc: Encoding,
+    appended: Appended<'a>,
+}
+
+impl Decoder<'_> {
+    fn numbers(&self, decl: &ArrayDecl, tuples: Option<usize>, of: &str, what: &str) -> Result<Numbers> {
+        let ty = decl.ty.ok_or_else(|| {
+            Error::input(if decl.ty_text.is_empty() {
+                format!("{what} has no `type`")
+            } else {
+                format!("{what} has type {}, which is not numeric", decl.ty_text)
+            })
+        })?;
+        let shape = Shape { tuples, components: decl.components, ty, of };
+        match decl.format {
+            Format::Ascii => parse_ascii(ty, &decl.text, shape.count(what)?, what),
+            Format::Binary => read_block(&mut Base64Stream::new(&decl.text), self.enc, shape, what),
+            Format::Appended(offset) => {
+                let data = self
+                    .appended
+                    .data
+                    .ok_or_else(|| Error::input(format!("{what} is appended but the file has no <AppendedData>")))?;
+                let rest = data.get(offset..).ok_or_else(|| {
+                    Error::input(format!(
+                        "truncated: {what} starts at offset {offset}, past the end of the appended data"
+                    ))
+                })?;
+                if self.appended.base64 {
+                    read_block(&mut Base64Stream::new(rest), self.enc, shape, what)
+                } else {
+                    read_block(&mut RawStream { data: rest, pos: 0 }, self.enc, shape, what)
+                }
+            }
+        }
+    }
+
+    /// A point or cell data array (`tuples` of them), as f64.
+    fn data_array(&self, decl: &ArrayDecl, tuples: usize, of: &str) -> Result<PointArray> {
+        let what = format!("{} array `{}`", if of == "cells" { "cell" } else { "point" }, decl.name);
+        let values = self.numbers(decl, Some(tuples), of, &what)?.into_f64(&what)?;
+        Ok(PointArray { name: decl.name.clone(), components: decl.components, values })
+    }
+
+    /// The arrays of a data section that are numeric, and the names of those that are not.
+    fn section(
+        &self,
+        piece: &PieceDecl,
+        section: Section,
+        tuples: usize,
+        of: &str,
+        ds_skipped: &mut Vec<String>,
+    ) -> Result<Vec<PointArray>> {
+        let mut out = Vec::new();
+        for (s, decl) in &piece.arrays {
+            if *s != section {
+                continue;
+            }
+            if decl.ty.is_none() {
+                ds_skipped.push(format!("`{}` ({})", decl.name, decl.ty_text));
+                continue;
+            }
+            out.push(self.data_array(decl, tuples, of)?);
+        }
+        Ok(out)
+    }
+
+    fn indices(&self, decl: &ArrayDecl, tuples: Option<usize>, what: &str) -> Result<Vec<usize>> {
+        self.numbers(decl, tuples, "values", what)?.into_indices(what)
+    }
+}
+
+fn image(m: &Markup, reader: &Decoder) -> Result<Dataset> {
+    if m.pieces.len() > 1 {
         return Err(Error::input(format!(
-            "the file has cell data only ({}); point data is needed (ParaView: Cell Data to Point Data)",
-            list_names(&names)
+            "the image is split into {} pieces; only single-piece files are supported",
+            m.pieces.len()
         )));
     }
-    let n = nx.checked_mul(ny).ok_or_else(|| Error::input(format!("the extent `{extent_text}` is too large")))?;
-    let appended = Appended { bytes, start: appended, encoding: appended_encoding.as_deref() };
-    let mut arrays = Vec::with_capacity(point_arrays.len());
-    for decl in point_arrays {
-        arrays.push(decode_array(decl, n, enc, &appended)?);
+    let piece = &m.pieces[0];
+    let a = &m.dataset_attrs;
+    let extent_text = get(&piece.attrs, "Extent")
+        .or_else(|| get(a, "WholeExtent"))
+        .ok_or_else(|| Error::input("<ImageData> has no WholeExtent"))?;
+    let extent: [i64; 6] = parse_numbers(extent_text, "the extent")?;
+    let origin = match get(a, "Origin") {
+        Some(o) => parse_numbers(o, "Origin")?,
+        None => [0.0; 3],
+    };
+    let spacing = match get(a, "Spacing") {
+        Some(s) => parse_numbers(s, "Spacing")?,
+        None => [1.0; 3],
+    };
+    let direction = match get(a, "Direction") {
+        Some(d) => parse_numbers(d, "Direction")?,
+        None => [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0],
+    };
+    let geometry = ImageGeometry { extent, origin, spacing, direction };
+    let [nx, ny, nz] = geometry.dims();
+    let n = nx
+        .checked_mul(ny)
+        .and_then(|v| v.checked_mul(nz))
+        .ok_or_else(|| Error::input(format!("the extent `{extent_text}` is too large")))?;
+    let mut ds = Dataset { image: Some(geometry), ..Dataset::default() };
+    ds.point_data = reader.section(piece, Section::PointData, n, "points", &mut ds.skipped)?;
+    ds.cell_data = cell_names(piece);
+    Ok(ds)
+}
+
+/// Names of the cell arrays (their values are not read).
+fn cell_names(piece: &PieceDecl) -> Vec<String> {
+    piece.arrays.iter().filter(|(s, _)| *s == Section::CellData).map(|(_, a)| a.name.clone()).collect()
+}
+
+/// Appends one poly data or unstructured grid piece to `ds`.
+fn mesh_piece(piece: &PieceDecl, poly: bool, reader: &Decoder, ds: &mut Dataset) -> Result<()> {
+    let n = piece.count("NumberOfPoints")?;
+    let base = ds.points.len();
+    if n > 0 {
+        let decl =
+            piece.first(Section::Points).ok_or_else(|| Error::input("the piece has points but no <Points> array"))?;
+        if decl.components != 3 {
+            return Err(Error::input(format!("the points have {} components instead of 3", decl.components)));
+        }
+        let xyz =
+            reader.numbers(decl, Some(n), "points", "the point coordinates")?.into_f64("the point coordinates")?;
+        ds.points.extend(xyz.chunks_exact(3).map(|c| [c[0], c[1], c[2]]));
     }
-    if arrays.is_empty() {
-        return Err(Error::input("the file has no point data arrays"));
+    if poly {
+        for (section, key, name) in [
+            // VTK numbers poly data cells in this order
+            (PolySection::Verts, "NumberOfVerts", "verts"),
+            (PolySection::Lines, "NumberOfLines", "lines"),
+            (PolySection::Polys, "NumberOfPolys", "polys"),
+            (PolySection::Strips, "NumberOfStrips", "strips"),
+        ] {
+            let count = piece.count(key)?;
+            cell_section(piece, Section::Poly(section), count, CellTypes::PolyData(section), name, base, reader, ds)?;
+        }
+    } else {
+        let count = piece.count("NumberOfCells")?;
+        let types = match piece.array(Section::Cells, "types") {
+            Some(decl) if count > 0 => {
+                let t = reader.indices(decl, Some(count), "the cell types")?;
+                let t: Option<Vec<u8>> = t.iter().map(|&v| u8::try_from(v).ok()).collect();
+                CellTypes::Each(t.ok_or_else(|| Error::input("the cell types: a type code above 255"))?)
+            }
+            None if count > 0 => return Err(Error::input("the <Cells> have no `types` array")),
+            _ => CellTypes::Each(Vec::new()),
+        };
+        cell_section(piece, Section::Cells, count, types, "cells", base, reader, ds)?;
     }
-    Ok(ImageData { nx, ny, spacing, origin, arrays })
+    let point_data = reader.section(piece, Section::PointData, n, "points", &mut ds.skipped)?;
+    merge_arrays(&mut ds.point_data, point_data, base == 0)?;
+    if base == 0 {
+        ds.cell_data = cell_names(piece);
+    }
+    Ok(())
+}
+
+/// One section of cells: `connectivity` and `offsets` (VTK's end offsets; a leading 0, as
+/// some writers add, is accepted).
+#[allow(clippy::too_many_arguments)]
+fn cell_section(
+    piece: &PieceDecl,
+    section: Section,
+    count: usize,
+    types: CellTypes,
+    name: &str,
+    base: usize,
+    reader: &Decoder,
+    ds: &mut Dataset,
+) -> Result<()> {
+    if count == 0 {
+        return Ok(());
+    }
+    let need = |array: &str| {
+        piece.array(section, array).ok_or_else(|| Error::input(format!("the {name} have no `{array}` array")))
+    };
+    let mut ends = reader.indices(need("offsets")?, None, &format!("the {name}' offsets"))?;
+    if ends.len() == count + 1 && ends.first() == Some(&0) {
+        ends.remove(0);
+    }
+    if ends.len() != count {
+        return Err(Error::input(format!("the {name}' offsets hold {} values for {count} cells", ends.len())));
+    }
+    let total = ends.last().copied().unwrap_or(0);
+    let conn = reader.indices(need("connectivity")?, Some(total), &format!("the {name}' connectivity"))?;
+    if let Some((k, &v)) = conn.iter().enumerate().find(|(_, &v)| v >= ds.points.len() - base) {
+        return Err(Error::input(format!(
+            "the {name}' connectivity: entry {} refers to point {v}, but the piece has {} points",
+            k + 1,
+            ds.points.len() - base
+        )));
+    }
+    ds.cells.append(&conn, &ends, types, base, &format!("the {name}"))
+}
+
+/// Appends a piece's arrays to those of the pieces before (the first piece sets the list).
+fn merge_arrays(all: &mut Vec<PointArray>, piece: Vec<PointArray>, first: bool) -> Result<()> {
+    if first {
+        *all = piece;
+        return Ok(());
+    }
+    let names = |v: &[PointArray]| v.iter().map(|a| format!("{}({})", a.name, a.components)).collect::<Vec<_>>();
+    if names(all) != names(&piece) {
+        return Err(Error::input(format!(
+            "the pieces carry different point arrays ({} and {})",
+            names(all).join(", "),
+            names(&piece).join(", ")
+        )));
+    }
+    for (a, p) in all.iter_mut().zip(piece) {
+        a.values.extend(p.values);
+    }
+    Ok(())
 }
 
 /// A point array's declaration from its `<DataArray>` attributes.
-fn array_decl(a: &[(String, String)], arr_name: String) -> Result<ArrayDecl> {
-    let ty_text = get(a, "type").unwrap_or("");
-    let ty = Scalar::parse(ty_text);
-    let ty_text = ty_text.to_string();
+fn array_decl(a: &[(String, String)]) -> Result<ArrayDecl> {
+    let name = get(a, "Name").unwrap_or("").to_string();
+    let ty_text = get(a, "type").unwrap_or("").to_string();
+    let ty = Scalar::from_xml(&ty_text);
     let components = match get(a, "NumberOfComponents") {
         None => 1,
         Some(c) => c.trim().parse::<usize>().ok().filter(|&c| c > 0).ok_or_else(|| {
-            Error::input(format!("point array `{arr_name}`: NumberOfComponents `{c}` is not a positive integer"))
+            Error::input(format!("array `{name}`: NumberOfComponents `{c}` is not a positive integer"))
         })?,
     };
     let format = match get(a, "format").unwrap_or("ascii") {
@@ -189,131 +420,122 @@ fn array_decl(a: &[(String, String)], arr_name: String) -> Result<ArrayDecl> {
             Format::Appended(
                 off.trim()
                     .parse()
-                    .map_err(|_| Error::input(format!("point array `{arr_name}`: offset `{off}` is not an integer")))?,
+                    .map_err(|_| Error::input(format!("array `{name}`: offset `{off}` is not an integer")))?,
             )
         }
-        f => return Err(Error::input(format!("point array `{arr_name}` has unknown format `{f}`"))),
+        f => return Err(Error::input(format!("array `{name}` has unknown format `{f}`"))),
     };
-    Ok(ArrayDecl { name: arr_name, ty, ty_text, components, format, text: Vec::new() })
+    Ok(ArrayDecl { name, ty, ty_text, components, format, text: Vec::new() })
 }
 
-/// What the markup declares: the `<VTKFile>` and `<ImageData>` attributes, each piece's
-/// extent, the point arrays (with their inline text) and the cell arrays' names, and the
-/// encoding of the appended data.
-struct Markup {
-    file_attrs: Option<Vec<(String, String)>>,
-    image_attrs: Option<Vec<(String, String)>>,
-    piece_extents: Vec<Option<String>>,
-    point_arrays: Vec<ArrayDecl>,
-    cell_names: Vec<String>,
-    appended_encoding: Option<String>,
+/// Checks the `<VTKFile>` element: the data set type it declares.
+fn file_kind(a: &Attrs) -> Result<String> {
+    match get(a, "type") {
+        Some(t @ ("ImageData" | "PolyData" | "UnstructuredGrid")) => Ok(t.to_string()),
+        Some(t) if t.starts_with('P') => {
+            Err(Error::input(format!("this is a parallel file ({t}) that only points to piece files: read the pieces")))
+        }
+        Some(t) => Err(Error::input(format!(
+            "the data set is {t}: only ImageData (.vti), PolyData (.vtp) and UnstructuredGrid (.vtu) are read \
+             (ParaView: Resample To Image, or Extract Surface then Triangulate)"
+        ))),
+        None => Err(Error::input("<VTKFile> has no `type`")),
+    }
 }
 
 /// Reads the markup (up to the `<AppendedData>` start tag).
 fn scan_markup(markup: &[u8]) -> Result<Markup> {
     use quick_xml::events::Event;
     let mut reader = quick_xml::Reader::from_reader(markup);
-    let mut file_attrs: Option<Vec<(String, String)>> = None;
-    let mut image_attrs: Option<Vec<(String, String)>> = None;
-    let mut piece_extents: Vec<Option<String>> = Vec::new();
-    let mut section = ""; // "PointData", "CellData" or "" (elsewhere)
-    let mut current: Option<ArrayDecl> = None;
-    let mut point_arrays: Vec<ArrayDecl> = Vec::new();
-    let mut cell_names: Vec<String> = Vec::new();
-    let mut appended_encoding: Option<String> = None;
+    let mut m = Markup {
+        file_attrs: None,
+        kind: String::new(),
+        dataset_attrs: Vec::new(),
+        pieces: Vec::new(),
+        appended_encoding: None,
+    };
+    // open elements; text belongs to a <DataArray> only when it is the innermost one
+    let mut stack: Vec<Vec<u8>> = Vec::new();
+    let mut section: Option<Section> = None;
+    let mut current: Option<(Section, ArrayDecl)> = None;
     loop {
         let event = reader.read_event().map_err(|e| {
             let at = reader.error_position();
-            Error::input(format!("malformed XML near byte {at}: {e}")).at(crate::error::Location::Byte(at))
+            Error::input(format!("malformed XML near byte {at}: {e}")).at(Location::Byte(at))
         })?;
-        let (start, empty) = match &event {
-            Event::Start(e) => (Some(e), false),
-            Event::Empty(e) => (Some(e), true),
-            _ => (None, false),
-        };
-        if let Some(e) = start {
-            let name = e.name().as_ref().to_vec();
-            match name.as_slice() {
-                b"VTKFile" => {
-                    let a = attrs(e)?;
-                    match get(&a, "type") {
-                        Some("ImageData") => {}
-                        Some(t @ "PImageData") => {
-                            return Err(Error::input(format!(
-                                "this is a parallel file ({t}) that only points to piece files: read the .vti pieces"
-                            )))
-                        }
-                        Some(t) => {
-                            return Err(Error::input(format!(
-                                "the data set is {t}; only ImageData (.vti) is supported"
-                            )))
-                        }
-                        None => return Err(Error::input("the <VTKFile> element has no `type`")),
+        match &event {
+            Event::Start(e) | Event::Empty(e) => {
+                let empty = matches!(event, Event::Empty(_));
+                let name = e.name().as_ref().to_vec();
+                let parent = stack.last().map(Vec::as_slice);
+                match name.as_slice() {
+                    b"VTKFile" => {
+                        let a = attrs(e)?;
+                        m.kind = file_kind(&a)?;
+                        m.file_attrs = Some(a);
                     }
-                    file_attrs = Some(a);
-                }
-                b"ImageData" => image_attrs = Some(attrs(e)?),
-                b"Piece" => {
-                    let a = attrs(e)?;
-                    piece_extents.push(get(&a, "Extent").map(str::to_string));
-                }
-                b"PointData" | b"CellData" if !empty => {
-                    section = if name == b"PointData" { "PointData" } else { "CellData" };
-                }
-                b"DataArray" => {
-                    let a = attrs(e)?;
-                    let arr_name = get(&a, "Name").unwrap_or("").to_string();
-                    match section {
-                        "PointData" => {
-                            let decl = array_decl(&a, arr_name)?;
+                    b"Piece" if parent.is_some_and(|p| p == m.kind.as_bytes()) => {
+                        m.pieces.push(PieceDecl { attrs: attrs(e)?, arrays: Vec::new() })
+                    }
+                    b"AppendedData" => m.appended_encoding = get(&attrs(e)?, "encoding").map(str::to_string),
+                    b"DataArray" => {
+                        if let (Some(s), Some(_)) = (section, m.pieces.last()) {
+                            let decl = array_decl(&attrs(e)?)?;
                             if empty {
-                                point_arrays.push(decl);
+                                if let Some(p) = m.pieces.last_mut() {
+                                    p.arrays.push((s, decl));
+                                }
                             } else {
-                                current = Some(decl);
+                                current = Some((s, decl));
                             }
                         }
-                        "CellData" => cell_names.push(arr_name),
-                        _ => {}
                     }
+                    n if !m.kind.is_empty() && n == m.kind.as_bytes() && parent == Some(b"VTKFile") => {
+                        m.dataset_attrs = attrs(e)?
+                    }
+                    n if parent == Some(b"Piece") => section = Section::of(n),
+                    _ => {}
                 }
-                b"AppendedData" => {
-                    appended_encoding = Some(get(&attrs(e)?, "encoding").unwrap_or("raw").to_string());
-                    break;
+                if !empty {
+                    stack.push(name);
                 }
-                _ => {}
             }
-            continue;
-        }
-        match event {
             Event::Text(t) => {
-                if let Some(c) = current.as_mut() {
-                    c.text.extend_from_slice(&t);
+                if let (Some((_, c)), Some(b"DataArray")) = (current.as_mut(), stack.last().map(Vec::as_slice)) {
+                    c.text.extend_from_slice(t);
                 }
             }
             Event::CData(t) => {
-                if let Some(c) = current.as_mut() {
-                    c.text.extend_from_slice(&t);
+                if let (Some((_, c)), Some(b"DataArray")) = (current.as_mut(), stack.last().map(Vec::as_slice)) {
+                    c.text.extend_from_slice(t);
                 }
             }
-            Event::End(e) => match e.name().as_ref() {
-                b"DataArray" => {
-                    if let Some(c) = current.take() {
-                        point_arrays.push(c);
-                    }
+            Event::End(e) => {
+                let name = e.name().as_ref().to_vec();
+                if stack.last() == Some(&name) {
+                    stack.pop();
                 }
-                b"PointData" | b"CellData" => section = "",
-                _ => {}
-            },
+                if name == b"DataArray" && stack.last().is_some_and(|p| Section::of(p).is_some()) {
+                    if let (Some(c), Some(p)) = (current.take(), m.pieces.last_mut()) {
+                        p.arrays.push(c);
+                    }
+                } else if Section::of(&name).is_some() && stack.last().is_some_and(|p| p == b"Piece") {
+                    section = None;
+                }
+            }
             Event::Eof => {
-                if let Some(c) = current {
-                    return Err(Error::input(format!("truncated: the file ends inside point array `{}`", c.name)));
+                if let Some((_, c)) = current {
+                    return Err(Error::input(format!("truncated: the file ends inside array `{}`", c.name)));
                 }
                 break;
             }
             _ => {}
         }
     }
-    Ok(Markup { file_attrs, image_attrs, piece_extents, point_arrays, cell_names, appended_encoding })
+    if m.file_attrs.is_some() && m.dataset_attrs.is_empty() && m.pieces.is_empty() {
+        return Err(Error::input(format!("no <{}> element (truncated file?)", m.kind)));
+    }
+    Ok(m)
 }
 
 /// The byte order, header size and compressor the `<VTKFile>` attributes declare.
@@ -329,127 +551,19 @@ fn encoding_of(file_attrs: &[(String, String)]) -> Result<Encoding> {
             "UInt64" => 8,
             h => return Err(Error::input(format!("unsupported header_type `{h}` (VTK writes UInt32 or UInt64)"))),
         },
-        zlib: match get(file_attrs, "compressor").map(str::trim).unwrap_or("") {
-            "" => false,
-            "vtkZLibDataCompressor" => true,
+        compressor: match get(file_attrs, "compressor").map(str::trim).unwrap_or("") {
+            "" => Compressor::None,
+            "vtkZLibDataCompressor" => Compressor::Zlib,
+            "vtkLZ4DataCompressor" => Compressor::Lz4,
+            "vtkLZMADataCompressor" => Compressor::Lzma,
             c => {
                 return Err(Error::input(format!(
-                    "data compressed with `{c}`, which is not supported: only vtkZLibDataCompressor or no compression \
-                     (re-save it from ParaView with another compressor)"
+                    "data compressed with `{c}`, which is not supported: VTK's compressors are \
+                     vtkZLibDataCompressor, vtkLZ4DataCompressor and vtkLZMADataCompressor"
                 )))
             }
         },
     })
-}
-
-/// An image's points, spacing and origin, with its extent as written.
-struct Geometry {
-    nx: usize,
-    ny: usize,
-    spacing: [f64; 2],
-    origin: [f64; 2],
-    extent_text: String,
-}
-
-/// The image's size, spacing and origin (the piece's extent shifted into the origin), with
-/// the extent as written.
-fn geometry(image_attrs: &[(String, String)], piece_extents: &[Option<String>]) -> Result<Geometry> {
-    if piece_extents.is_empty() {
-        return Err(Error::input("the image has no <Piece> (truncated file?)"));
-    }
-    if piece_extents.len() > 1 {
-        return Err(Error::input(format!(
-            "the image is split into {} pieces; only single-piece files are supported",
-            piece_extents.len()
-        )));
-    }
-    let whole = get(image_attrs, "WholeExtent").ok_or_else(|| Error::input("<ImageData> has no WholeExtent"))?;
-    let extent_text = piece_extents[0].clone().unwrap_or_else(|| whole.to_string());
-    let ext: [i64; 6] = parse_numbers(&extent_text, "the extent")?;
-    let count = |lo: i64, hi: i64| if hi >= lo { (hi - lo + 1) as usize } else { 0 };
-    let (nx, ny, nz) = (count(ext[0], ext[1]), count(ext[2], ext[3]), count(ext[4], ext[5]));
-    if nz > 1 {
-        return Err(Error::input(format!(
-            "the extent `{extent_text}` has {nz} points along z: only 2D images (one point along z) are supported"
-        )));
-    }
-    if nx < 2 || ny < 2 || nz < 1 {
-        return Err(Error::input(format!(
-            "the extent `{extent_text}` gives {nx} × {ny} × {nz} points: a 2D image needs at least 2 × 2 points in the x-y plane"
-        )));
-    }
-    let origin3: [f64; 3] = match get(image_attrs, "Origin") {
-        Some(o) => parse_numbers(o, "Origin")?,
-        None => [0.0; 3],
-    };
-    let spacing3: [f64; 3] = match get(image_attrs, "Spacing") {
-        Some(s) => parse_numbers(s, "Spacing")?,
-        None => [1.0; 3],
-    };
-    let spacing = [spacing3[0], spacing3[1]];
-    let origin = [origin3[0] + ext[0] as f64 * spacing[0], origin3[1] + ext[2] as f64 * spacing[1]];
-    Ok(Geometry { nx, ny, spacing, origin, extent_text })
-}
-
-/// Where the appended data is and how it is encoded.
-struct Appended<'a> {
-    bytes: &'a [u8],
-    /// The byte after the `<AppendedData ...>` tag, if there is one.
-    start: Option<usize>,
-    encoding: Option<&'a str>,
-}
-
-/// A declared point array's values: `n` tuples, read inline or from the appended data.
-fn decode_array(decl: ArrayDecl, n: usize, enc: Encoding, appended: &Appended) -> Result<PointArray> {
-    let ty = decl.ty.ok_or_else(|| {
-        Error::input(if decl.ty_text.is_empty() {
-            format!("point array `{}` has no `type`", decl.name)
-        } else {
-            format!("point array `{}` has type {}, which is not numeric", decl.name, decl.ty_text)
-        })
-    })?;
-    let what = format!("point array `{}`", decl.name);
-    let expected = n
-        .checked_mul(decl.components)
-        .and_then(|c| c.checked_mul(ty.size()))
-        .ok_or_else(|| Error::input(format!("{what} is too large")))?;
-    let values = match decl.format {
-        Format::Ascii => parse_ascii(&decl.text, n * decl.components, &what)?,
-        Format::Binary => {
-            let mut src = Base64Stream { text: &decl.text, pos: 0, pending: Vec::new() };
-            let raw = read_block(&mut src, enc, expected, ty.size(), n, decl.components, &what)?;
-            ty.decode(&raw, enc.big_endian)
-        }
-        Format::Appended(offset) => {
-            let start = appended
-                .start
-                .ok_or_else(|| Error::input(format!("{what} is appended but the file has no <AppendedData>")))?;
-            let data = appended_start(appended.bytes, start)?;
-            let raw = match appended.encoding.unwrap_or("raw") {
-                "raw" => {
-                    let rest = data.get(offset..).ok_or_else(|| {
-                        Error::input(format!(
-                            "truncated: {what} starts at offset {offset}, past the end of the appended data"
-                        ))
-                    })?;
-                    let mut src = RawStream { data: rest, pos: 0 };
-                    read_block(&mut src, enc, expected, ty.size(), n, decl.components, &what)?
-                }
-                "base64" => {
-                    let rest = data.get(offset..).ok_or_else(|| {
-                        Error::input(format!(
-                            "truncated: {what} starts at offset {offset}, past the end of the appended data"
-                        ))
-                    })?;
-                    let mut src = Base64Stream { text: rest, pos: 0, pending: Vec::new() };
-                    read_block(&mut src, enc, expected, ty.size(), n, decl.components, &what)?
-                }
-                e => return Err(Error::input(format!("unknown AppendedData encoding `{e}` (expected raw or base64)"))),
-            };
-            ty.decode(&raw, enc.big_endian)
-        }
-    };
-    Ok(PointArray { name: decl.name, components: decl.components, values })
 }
 
 pub(super) fn find(hay: &[u8], needle: &[u8]) -> Option<usize> {
@@ -457,7 +571,7 @@ pub(super) fn find(hay: &[u8], needle: &[u8]) -> Option<usize> {
 }
 
 /// The appended data after the `_` marker that follows the `<AppendedData>` tag ending at `close`.
-pub(super) fn appended_start(bytes: &[u8], close: usize) -> Result<&[u8]> {
+fn appended_start(bytes: &[u8], close: usize) -> Result<&[u8]> {
     let rest = &bytes[close..];
     let skip = rest.iter().position(|b| !b.is_ascii_whitespace()).unwrap_or(rest.len());
     match rest.get(skip) {
@@ -465,192 +579,4 @@ pub(super) fn appended_start(bytes: &[u8], close: usize) -> Result<&[u8]> {
         Some(_) => Err(Error::input("the appended data does not start with the `_` marker")),
         None => Err(Error::input("truncated: the file ends before the appended data")),
     }
-}
-
-pub(super) fn parse_ascii(text: &[u8], count: usize, what: &str) -> Result<Vec<f64>> {
-    let text = std::str::from_utf8(text).map_err(|_| Error::input(format!("{what}: ascii data is not text")))?;
-    let mut out = Vec::with_capacity(count.min(CAPACITY));
-    for (i, tok) in text.split_ascii_whitespace().enumerate() {
-        let v = tok
-            .parse::<f64>()
-            .map_err(|_| Error::input(format!("{what}: value {} (`{tok}`) is not a number", i + 1)))?;
-        out.push(v);
-    }
-    if out.len() != count {
-        return Err(Error::input(format!("{what} holds {} values, the extent needs {count}", out.len())));
-    }
-    Ok(out)
-}
-
-/// A source of decoded bytes: raw appended data or base64 text.
-pub(super) trait ByteSource {
-    /// Exactly `n` bytes, or an error saying the data ends early.
-    fn take(&mut self, n: usize) -> Result<Vec<u8>>;
-}
-
-pub(super) struct RawStream<'a> {
-    data: &'a [u8],
-    pos: usize,
-}
-
-impl ByteSource for RawStream<'_> {
-    fn take(&mut self, n: usize) -> Result<Vec<u8>> {
-        let end =
-            self.pos.checked_add(n).filter(|&e| e <= self.data.len()).ok_or_else(|| {
-                Error::input(format!("truncated: {n} bytes needed, {} left", self.data.len() - self.pos))
-            })?;
-        let out = self.data[self.pos..end].to_vec();
-        self.pos = end;
-        Ok(out)
-    }
-}
-
-/// Base64 text decoded group by group, so that streams encoded separately and concatenated
-/// (VTK encodes the header and the data apart, each padded) decode as well as one stream.
-pub(super) struct Base64Stream<'a> {
-    text: &'a [u8],
-    pos: usize,
-    pending: Vec<u8>,
-}
-
-pub(super) fn b64_value(c: u8) -> Option<u8> {
-    match c {
-        b'A'..=b'Z' => Some(c - b'A'),
-        b'a'..=b'z' => Some(c - b'a' + 26),
-        b'0'..=b'9' => Some(c - b'0' + 52),
-        b'+' => Some(62),
-        b'/' => Some(63),
-        _ => None,
-    }
-}
-
-impl Base64Stream<'_> {
-    /// Decodes the next group of 4 characters (skipping whitespace) into `pending`.
-    fn next_group(&mut self) -> Result<bool> {
-        let mut group = [0u8; 4];
-        let mut k = 0;
-        while k < 4 {
-            match self.text.get(self.pos) {
-                None | Some(b'<') => {
-                    return if k == 0 { Ok(false) } else { Err(Error::input("truncated base64 data")) };
-                }
-                Some(c) if c.is_ascii_whitespace() => self.pos += 1,
-                Some(&c) => {
-                    group[k] = c;
-                    k += 1;
-                    self.pos += 1;
-                }
-            }
-        }
-        let pad = group.iter().rev().take_while(|&&c| c == b'=').count();
-        if pad > 2 {
-            return Err(Error::input("invalid base64 data (`===`)"));
-        }
-        let mut v = 0u32;
-        for (i, &c) in group.iter().enumerate() {
-            let d = if i >= 4 - pad {
-                0
-            } else {
-                b64_value(c).ok_or_else(|| Error::input(format!("invalid base64 character `{}`", c.escape_ascii())))?
-            };
-            v = (v << 6) | u32::from(d);
-        }
-        let b = v.to_be_bytes();
-        self.pending.extend_from_slice(&b[1..4 - pad]);
-        Ok(true)
-    }
-}
-
-impl ByteSource for Base64Stream<'_> {
-    fn take(&mut self, n: usize) -> Result<Vec<u8>> {
-        // at most 3 bytes per 4 characters left: refuse absurd sizes before allocating
-        let left = (self.text.len() - self.pos) / 4 * 3 + self.pending.len();
-        if n > left {
-            return Err(Error::input(format!("truncated: {n} bytes needed, at most {left} left")));
-        }
-        while self.pending.len() < n {
-            if !self.next_group()? {
-                return Err(Error::input(format!("truncated: {n} bytes needed, {} left", self.pending.len())));
-            }
-        }
-        let rest = self.pending.split_off(n);
-        Ok(std::mem::replace(&mut self.pending, rest))
-    }
-}
-
-pub(super) fn header_word(src: &mut dyn ByteSource, enc: Encoding) -> Result<usize> {
-    let b = src.take(enc.header)?;
-    let v = match (enc.header, enc.big_endian) {
-        (4, false) => u64::from(u32::from_le_bytes(b[..4].try_into().expect("4 bytes"))),
-        (4, true) => u64::from(u32::from_be_bytes(b[..4].try_into().expect("4 bytes"))),
-        (_, false) => u64::from_le_bytes(b[..8].try_into().expect("8 bytes")),
-        (_, true) => u64::from_be_bytes(b[..8].try_into().expect("8 bytes")),
-    };
-    usize::try_from(v).map_err(|_| Error::input(format!("header value {v} is too large")))
-}
-
-/// Reads one array's block (header then data, compressed or not) and checks it holds
-/// `expected` bytes.
-pub(super) fn read_block(
-    src: &mut dyn ByteSource,
-    enc: Encoding,
-    expected: usize,
-    elem: usize,
-    tuples: usize,
-    comps: usize,
-    what: &str,
-) -> Result<Vec<u8>> {
-    let ctx = |m: &dyn std::fmt::Display| Error::input(format!("{what}: {m}"));
-    let size_err = |got: usize| {
-        Error::input(format!(
-            "{what} holds {got} bytes ({} values), but {tuples} points × {comps} components need {expected} bytes",
-            got / elem
-        ))
-    };
-    if !enc.zlib {
-        let nbytes = header_word(src, enc).map_err(|e| ctx(&e))?;
-        if nbytes != expected {
-            return Err(size_err(nbytes));
-        }
-        return src.take(nbytes).map_err(|e| ctx(&e));
-    }
-    let blocks = header_word(src, enc).map_err(|e| ctx(&e))?;
-    let block_size = header_word(src, enc).map_err(|e| ctx(&e))?;
-    let last_size = header_word(src, enc).map_err(|e| ctx(&e))?;
-    if blocks == 0 {
-        return if expected == 0 { Ok(Vec::new()) } else { Err(size_err(0)) };
-    }
-    if block_size == 0 || last_size > block_size {
-        return Err(ctx(&format!("corrupt compression header (block size {block_size}, last block {last_size})")));
-    }
-    let last = if last_size == 0 { block_size } else { last_size };
-    let total = (blocks - 1).checked_mul(block_size).and_then(|t| t.checked_add(last));
-    if total != Some(expected) {
-        return Err(match total {
-            Some(t) => size_err(t),
-            None => ctx(&"corrupt compression header"),
-        });
-    }
-    let mut sizes = Vec::with_capacity(blocks.min(CAPACITY));
-    for _ in 0..blocks {
-        sizes.push(header_word(src, enc).map_err(|e| ctx(&e))?);
-    }
-    let mut out = Vec::with_capacity(expected.min(CAPACITY));
-    for (i, &cs) in sizes.iter().enumerate() {
-        let want = if i + 1 == blocks { last } else { block_size };
-        let compressed = src.take(cs).map_err(|e| ctx(&e))?;
-        let before = out.len();
-        flate2::read::ZlibDecoder::new(&compressed[..])
-            .take(want as u64 + 1)
-            .read_to_end(&mut out)
-            .map_err(|e| ctx(&format!("block {} of {blocks} does not decompress: {e}", i + 1)))?;
-        if out.len() - before != want {
-            return Err(ctx(&format!(
-                "block {} of {blocks} decompresses to {} bytes instead of {want}",
-                i + 1,
-                out.len() - before
-            )));
-        }
-    }
-    Ok(out)
 }

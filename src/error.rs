@@ -273,6 +273,16 @@ impl Error {
     }
 }
 
+/// Where and why the last panic happened, as the command-line tool's panic hook records it
+/// (`None` where no hook records panics): [`crate::io::guarded`] and the tool's top level
+/// put it in their one-line messages instead of the panic's own text.
+pub(crate) static LAST_PANIC: std::sync::Mutex<Option<String>> = std::sync::Mutex::new(None);
+
+/// The last panic recorded by the hook, taken.
+pub(crate) fn take_last_panic() -> Option<String> {
+    LAST_PANIC.lock().ok().and_then(|mut p| p.take())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -560,7 +560,9 @@ fn run(cli: Cli) -> Result<String> {
 }
 
 fn main() {
-    match run(Cli::parse()) {
+    commands::install_panic_hook();
+    let cli = Cli::parse();
+    match commands::catch_panics(|| run(cli)) {
         Ok(text) => print!("{text}"),
         Err(e) => {
             eprintln!("error: {}", commands::cli_message(&e));

@@ -242,3 +242,19 @@ fn a_flipped_image_lands_where_vtk_puts_it() {
     let swapped = read_image(&fixtures().join("img_swap.appended-raw-zlib-u64.vti")).unwrap();
     assert_eq!((swapped.nx, swapped.ny), (5, 7));
 }
+
+#[test]
+fn the_active_scalars_are_the_default_array_as_in_a_vtk_filter() {
+    for file in ["img.ascii.vti", "img.legacy-binary-v51.vtk", "img.pyvista-default.vti"] {
+        let img = read_image(&fixtures().join(file)).unwrap();
+        assert_eq!(img.active_scalars.as_deref(), Some("f"), "{file}");
+        // three arrays, two of them scalar: the tool takes `f` without --array
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_toposmooth"))
+            .args(["extrema", fixtures().join(file).to_str().unwrap()])
+            .output()
+            .unwrap();
+        let text = String::from_utf8_lossy(&out.stdout);
+        assert!(out.status.success(), "{file}: {}", String::from_utf8_lossy(&out.stderr));
+        assert!(text.contains("`f`") || text.contains(" f"), "{file}: {text}");
+    }
+}

@@ -264,16 +264,21 @@ pub fn read_field(
 struct Raw {
     grid: Grid2d,
     arrays: Vec<(String, usize, Vec<f64>)>,
+    /// Arrays of the file that are not numeric: "`name` (type)".
+    skipped: Vec<String>,
+    /// The array a VTK file marks as its active scalars.
+    active: Option<String>,
 }
 
 fn read_raw(path: &Path) -> Result<Raw> {
-    let from_field = |f: GridField| Raw { arrays: vec![(f.array, 1, f.values)], grid: f.grid };
+    let from_field =
+        |f: GridField| Raw { arrays: vec![(f.array, 1, f.values)], grid: f.grid, skipped: Vec::new(), active: None };
     match extension(path).as_str() {
         "vti" | "vtk" => {
             let img = read_image(path)?;
             let grid = Grid2d::with_geometry(img.nx, img.ny, img.spacing, img.origin).map_err(|e| e.in_file(path))?;
             let arrays = img.arrays.into_iter().map(|a| (a.name, a.components, a.values)).collect();
-            Ok(Raw { grid, arrays })
+            Ok(Raw { grid, arrays, skipped: img.skipped, active: img.active_scalars })
         }
         "npy" => read_npy(path).map(from_field),
         "png" | "tif" | "tiff" => read_raster(path).map(from_field),
@@ -298,11 +303,22 @@ fn pick<'a>(path: &Path, raw: &'a Raw, name: Option<&str>, vector: bool) -> Resu
     };
     if let Some(name) = name {
         return raw.arrays.iter().find(|(n, _, _)| n == name).ok_or_else(|| {
-            Error::input(format!("no point array named `{name}`; the file has {}", listing())).in_file(path)
+            let quoted = format!("`{name}` (");
+            match raw.skipped.iter().find(|s| s.starts_with(&quoted)) {
+                Some(s) => Error::input(format!("point array {s} does not hold numbers")),
+                None => Error::input(format!("no point array named `{name}`; the file has {}", listing())),
+            }
+            .in_file(path)
         });
     }
     let fits: Vec<&(String, usize, Vec<f64>)> =
         raw.arrays.iter().filter(|(_, c, _)| if vector { *c == 2 || *c == 3 } else { *c == 1 }).collect();
+    // as a VTK filter does: the active scalars when they fit
+    if let Some(active) = raw.active.as_deref().and_then(|a| fits.iter().find(|(n, _, _)| n == a)) {
+        if !vector {
+            return Ok(active);
+        }
+    }
     match fits.as_slice() {
         [one] => Ok(one),
         [] => Err(Error::input(format!(

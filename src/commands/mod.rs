@@ -45,6 +45,41 @@ pub fn parse_persistence(s: &str) -> Result<Selection> {
     Ok(if relative { Selection::Relative(v / 100.0) } else { Selection::Absolute(v) })
 }
 
+/// The marker of the message the tool prints when it panics outside a reader (a bug: exit 1).
+pub const INTERNAL_FAILURE: &str = "[internal failure]";
+
+/// Makes panics silent (no panic text reaches the user): the hook records where and why, and
+/// [`catch_panics`] or [`crate::io::guarded`] report it in one line.
+pub fn install_panic_hook() {
+    std::panic::set_hook(Box::new(|info| {
+        let at = info.location().map(|l| format!(" at {}:{}", l.file(), l.line())).unwrap_or_default();
+        let text = crate::io::panic_text(info.payload());
+        if let Ok(mut last) = crate::error::LAST_PANIC.lock() {
+            *last = Some(format!("{text}{at}"));
+        }
+    }));
+}
+
+/// Runs the tool, turning a panic into an internal error (exit 1) carrying
+/// [`INTERNAL_FAILURE`].
+///
+/// # Errors
+/// The run's errors, and the caught panic.
+pub fn catch_panics(run: impl FnOnce() -> Result<String>) -> Result<String> {
+    let run = || {
+        if std::env::var_os("TOPOSMOOTH_DEBUG_PANIC").is_some_and(|v| v == "internal") {
+            panic!("TOPOSMOOTH_DEBUG_PANIC=internal");
+        }
+        run()
+    };
+    std::panic::catch_unwind(std::panic::AssertUnwindSafe(run)).unwrap_or_else(|payload| {
+        let what = crate::error::take_last_panic().unwrap_or_else(|| crate::io::panic_text(&*payload));
+        Err(Error::internal(format!(
+            "{INTERNAL_FAILURE} toposmooth failed ({what}); this is a bug in toposmooth: please report it"
+        )))
+    })
+}
+
 /// An error as the command line words it: a setting the library names (`data_weight`) is
 /// named by its flag (`--data-weight`).
 pub fn cli_message(e: &Error) -> String {

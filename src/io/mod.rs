@@ -25,21 +25,33 @@ pub const READER_FAILURE: &str = "[reader failure]";
 /// # Errors
 /// The reader's errors, and the caught panic.
 pub fn guarded<T>(path: &Path, read: impl FnOnce() -> Result<T>) -> Result<T> {
+    let read = || {
+        // the tests' way into this branch (a reader that panics)
+        if std::env::var_os("TOPOSMOOTH_DEBUG_PANIC").is_some_and(|v| v == "reader") {
+            panic!("TOPOSMOOTH_DEBUG_PANIC=reader");
+        }
+        read()
+    };
     match std::panic::catch_unwind(std::panic::AssertUnwindSafe(read)) {
         Ok(r) => r.map_err(|e| e.in_file(path)),
         Err(payload) => {
-            let what = payload
-                .downcast_ref::<&str>()
-                .map(|s| s.to_string())
-                .or_else(|| payload.downcast_ref::<String>().cloned())
-                .unwrap_or_default();
+            let what = crate::error::take_last_panic().unwrap_or_else(|| panic_text(&*payload));
             Err(Error::input(format!(
-                "{READER_FAILURE} the reader failed on this file ({what}); the file is probably malformed, \
-                 and toposmooth should have said how: please report it"
+                "{READER_FAILURE} the reader failed on this file ({what}): the file is malformed in a way \
+                 toposmooth does not describe yet; please report it with the file"
             ))
             .in_file(path))
         }
     }
+}
+
+/// The text a panic was raised with.
+pub fn panic_text(payload: &(dyn std::any::Any + Send)) -> String {
+    payload
+        .downcast_ref::<&str>()
+        .map(|s| s.to_string())
+        .or_else(|| payload.downcast_ref::<String>().cloned())
+        .unwrap_or_else(|| "no message".into())
 }
 
 /// A complete file waiting under a temporary sibling name: [`Staged::commit`] renames it into

@@ -263,6 +263,12 @@ fn check_field<D: Domain>(domain: &D, values: &[f64]) -> Result<(f64, f64)> {
     if lo == hi {
         return Err(Error::input(format!("the field is constant ({lo}): it has no extrema to keep")));
     }
+    if !(hi - lo).is_finite() {
+        return Err(Error::input(format!(
+            "the values run from {lo:e} to {hi:e}: their range (max − min) overflows Float64 arithmetic, \
+             which the smoothing works in; rescale the field first (divide it by 1e10, say)"
+        )));
+    }
     if let Some((v, size)) = constant_component(domain, values) {
         return Err(Error::input(format!(
             "the connected component of vertex {v} ({size} vertices) is constant ({}): it has no extrema to keep",

@@ -21,6 +21,10 @@ pub struct ImageData {
     pub arrays: Vec<PointArray>,
     /// What reading did (a Direction matrix turned into flips or a transposition).
     pub notes: Vec<String>,
+    /// Point arrays that are not numeric, not read: "`name` (type)".
+    pub skipped: Vec<String>,
+    /// The active scalars, if the file names them.
+    pub active_scalars: Option<String>,
 }
 
 /// A VTK data set as the file holds it, before it becomes a domain.
@@ -38,6 +42,9 @@ pub struct Dataset {
     pub cell_data: Vec<String>,
     /// Arrays that are not numeric (strings, bits), which are not read: "`name` (type)".
     pub skipped: Vec<String>,
+    /// The active scalars (XML `<PointData Scalars=...>`, a legacy file's first `SCALARS`):
+    /// the array a VTK filter processes when none is named.
+    pub active_scalars: Option<String>,
 }
 
 /// The geometry of VTK image data: point `(i, j, k)` of the extent lies at
@@ -245,7 +252,13 @@ impl ImageData {
     /// An input error listing the available names when there is none of that name.
     pub fn array(&self, name: &str) -> Result<&PointArray> {
         self.arrays.iter().find(|a| a.name == name).ok_or_else(|| {
-            Error::input(format!("no point array named `{name}`; the file has: {}", list_names(&self.names())))
+            let quoted = format!("`{name}` (");
+            match self.skipped.iter().find(|s| s.starts_with(&quoted)) {
+                Some(s) => Error::input(format!("point array {s} does not hold numbers")),
+                None => {
+                    Error::input(format!("no point array named `{name}`; the file has: {}", list_names(&self.names())))
+                }
+            }
         })
     }
 

@@ -273,19 +273,31 @@ pub(crate) struct Shape<'a> {
     pub(crate) of: &'a str,
 }
 
+/// The most values one array may hold (2²⁹, 4 GiB as f64): far beyond what can be smoothed
+/// on one machine, and a bound on what a small compressed file can make the reader allocate.
+pub(crate) const MAX_VALUES: usize = 1 << 29;
+
 impl Shape<'_> {
     /// Values in all (tuples × components) when the shape fixes them, or an error if that
-    /// overflows.
+    /// exceeds [`MAX_VALUES`].
     pub(crate) fn count(&self, what: &str) -> Result<Option<usize>> {
         let Some(tuples) = self.tuples else { return Ok(None) };
-        tuples.checked_mul(self.components).filter(|c| c.checked_mul(self.ty.size()).is_some()).map(Some).ok_or_else(
-            || Error::input(format!("{what}: {tuples} {} × {} components is too large", self.of, self.components)),
-        )
+        tuples.checked_mul(self.components).filter(|&c| c <= MAX_VALUES).map(Some).ok_or_else(|| {
+            Error::input(format!(
+                "{what}: {tuples} {} × {} components is more than the {MAX_VALUES} values an array may hold",
+                self.of, self.components
+            ))
+        })
     }
 
     /// Checks that `got` bytes are what the shape needs.
     fn check_bytes(&self, what: &str, got: usize) -> Result<()> {
         let elem = self.ty.size() * self.components;
+        if got / self.ty.size() > MAX_VALUES {
+            return Err(Error::input(format!(
+                "{what} holds {got} bytes, more than the {MAX_VALUES} values an array may hold"
+            )));
+        }
         let need = self.count(what)?.map(|c| c * self.ty.size());
         if need.is_some_and(|n| n != got) || got % elem != 0 {
             let need = match (need, self.tuples) {

@@ -38,6 +38,7 @@ pub(super) fn image_of(ds: Dataset) -> Result<ImageData> {
         )));
     }
     let mut arrays = ds.point_data;
+    let skipped = &ds.skipped;
     if arrays.is_empty() {
         return Err(if !ds.cell_data.is_empty() {
             let names: Vec<&str> = ds.cell_data.iter().map(String::as_str).collect();
@@ -45,8 +46,8 @@ pub(super) fn image_of(ds: Dataset) -> Result<ImageData> {
                 "the file has cell data only ({}); point data is needed (ParaView: Cell Data to Point Data)",
                 list_names(&names)
             ))
-        } else if !ds.skipped.is_empty() {
-            Error::input(format!("the file's point arrays are not numeric: {}", ds.skipped.join(", ")))
+        } else if !skipped.is_empty() {
+            Error::input(format!("the file's point arrays are not numeric: {}", skipped.join(", ")))
         } else {
             Error::input("the file has no point data arrays")
         });
@@ -75,7 +76,16 @@ pub(super) fn image_of(ds: Dataset) -> Result<ImageData> {
             flips.join(" and ")
         ));
     }
-    Ok(ImageData { nx: nxg, ny: nyg, spacing, origin, arrays, notes })
+    Ok(ImageData {
+        nx: nxg,
+        ny: nyg,
+        spacing,
+        origin,
+        arrays,
+        notes,
+        skipped: ds.skipped,
+        active_scalars: ds.active_scalars,
+    })
 }
 
 /// For each index axis, the physical axis it runs along and its sign, if the direction is a

@@ -7,7 +7,7 @@
 //! Every count is checked against the bytes left before anything of its size is allocated.
 
 use super::data::{CellTypes, Dataset, ImageGeometry, PointArray, PolySection};
-use super::decode::{parse_ascii, Numbers, Scalar};
+use super::decode::{parse_ascii, Numbers, Scalar, MAX_VALUES};
 use crate::error::{Error, Location, Result};
 
 /// A cursor over the file: keywords and ascii numbers as tokens, binary data as bytes.
@@ -69,6 +69,9 @@ impl<'a> Cursor<'a> {
     /// `count` values of type `ty`: ascii tokens, or big-endian binary right after the
     /// keyword line.
     fn values(&mut self, ty: Scalar, count: usize, what: &str) -> Result<Numbers> {
+        if count > MAX_VALUES {
+            return Err(self.err(format!("{what}: {count} values, more than the {MAX_VALUES} an array may hold")));
+        }
         if self.binary {
             let keyword = self.pos.saturating_sub(1);
             // the data starts after the newline that ends the keyword line
@@ -350,6 +353,9 @@ fn attributes(cur: &mut Cursor, ds: &mut Dataset) -> Result<()> {
                 };
                 let n = if point { points } else { ds.cells.len().max(cell_count(ds)) };
                 let arrays = attribute(cur, &kw, n)?;
+                if point && kw == "SCALARS" && ds.active_scalars.is_none() {
+                    ds.active_scalars = arrays.first().map(|a| a.name.clone());
+                }
                 if point {
                     ds.point_data.extend(arrays);
                 } else {

@@ -90,6 +90,8 @@ struct ArrayDecl {
 struct PieceDecl {
     attrs: Attrs,
     arrays: Vec<(Section, ArrayDecl)>,
+    /// The `Scalars` attribute of `<PointData>`: the active scalars.
+    active_scalars: Option<String>,
 }
 
 impl PieceDecl {
@@ -289,6 +291,7 @@ fn image(m: &Markup, reader: &Decoder) -> Result<Dataset> {
     let mut ds = Dataset { image: Some(geometry), ..Dataset::default() };
     ds.point_data = reader.section(piece, Section::PointData, n, "points", &mut ds.skipped)?;
     ds.cell_data = cell_names(piece);
+    ds.active_scalars = piece.active_scalars.clone();
     Ok(ds)
 }
 
@@ -307,8 +310,9 @@ fn mesh_piece(piece: &PieceDecl, poly: bool, reader: &Decoder, ds: &mut Dataset)
         if decl.components != 3 {
             return Err(Error::input(format!("the points have {} components instead of 3", decl.components)));
         }
-        let xyz =
-            reader.numbers(decl, Some(n), "points", "the point coordinates")?.into_f64("the point coordinates")?;
+        let xyz = reader
+            .numbers(decl, Some(n), "points", "the array of point coordinates")?
+            .into_f64("the array of point coordinates")?;
         ds.points.extend(xyz.chunks_exact(3).map(|c| [c[0], c[1], c[2]]));
     }
     if poly {
@@ -339,6 +343,7 @@ fn mesh_piece(piece: &PieceDecl, poly: bool, reader: &Decoder, ds: &mut Dataset)
     merge_arrays(&mut ds.point_data, point_data, base == 0)?;
     if base == 0 {
         ds.cell_data = cell_names(piece);
+        ds.active_scalars = piece.active_scalars.clone();
     }
     Ok(())
 }
@@ -461,7 +466,12 @@ fn scan_markup(markup: &[u8]) -> Result<Markup> {
     loop {
         let event = reader.read_event().map_err(|e| {
             let at = reader.error_position();
-            Error::input(format!("malformed XML near byte {at}: {e}")).at(Location::Byte(at))
+            let cut = if reader.buffer_position() >= markup.len() as u64 {
+                "truncated: the file ends inside the markup; "
+            } else {
+                ""
+            };
+            Error::input(format!("{cut}malformed XML near byte {at}: {e}")).at(Location::Byte(at))
         })?;
         match &event {
             Event::Start(e) | Event::Empty(e) => {
@@ -475,7 +485,7 @@ fn scan_markup(markup: &[u8]) -> Result<Markup> {
                         m.file_attrs = Some(a);
                     }
                     b"Piece" if parent.is_some_and(|p| p == m.kind.as_bytes()) => {
-                        m.pieces.push(PieceDecl { attrs: attrs(e)?, arrays: Vec::new() })
+                        m.pieces.push(PieceDecl { attrs: attrs(e)?, ..PieceDecl::default() })
                     }
                     b"AppendedData" => m.appended_encoding = get(&attrs(e)?, "encoding").map(str::to_string),
                     b"DataArray" => {
@@ -493,7 +503,15 @@ fn scan_markup(markup: &[u8]) -> Result<Markup> {
                     n if !m.kind.is_empty() && n == m.kind.as_bytes() && parent == Some(b"VTKFile") => {
                         m.dataset_attrs = attrs(e)?
                     }
-                    n if parent == Some(b"Piece") => section = Section::of(n),
+                    n if parent == Some(b"Piece") => {
+                        section = Section::of(n);
+                        if section == Some(Section::PointData) {
+                            let scalars = get(&attrs(e)?, "Scalars").map(str::to_string);
+                            if let Some(p) = m.pieces.last_mut() {
+                                p.active_scalars = scalars;
+                            }
+                        }
+                    }
                     _ => {}
                 }
                 if !empty {

@@ -1,0 +1,9 @@
+#![no_main]
+//! Fuzz target: PNG masks as outlines to mesh.
+
+#[path = "common.rs"]
+mod common;
+
+libfuzzer_sys::fuzz_target!(|data: &[u8]| {
+    common::check(toposmooth::apps::outline::read_outline(&common::as_file(data, "png")));
+});

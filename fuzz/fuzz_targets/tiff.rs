@@ -1,0 +1,9 @@
+#![no_main]
+//! Fuzz target: TIFF images as grids.
+
+#[path = "common.rs"]
+mod common;
+
+libfuzzer_sys::fuzz_target!(|data: &[u8]| {
+    common::check(toposmooth::io::grid::read_raster(&common::as_file(data, "tif")));
+});

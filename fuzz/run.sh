@@ -4,6 +4,9 @@
 # Seeds each corpus from the repository's own files (tests/fixtures, datasets); copies every
 # crash into tests/corpus/TARGET/, which tests/corpus.rs reads in CI; prints one line per
 # target with its executions and crashes (also written to fuzz/last-run.txt).
+# FUZZ_SANITIZER=address runs under AddressSanitizer (13x slower here: 300 against 4,100
+# executions a second on the VTK XML target); the default, none, finds panics, aborts,
+# timeouts and out-of-memory at full speed (the crate has no unsafe code).
 set -euo pipefail
 cd "$(dirname "$0")"
 SECONDS_EACH="${1:-120}"
@@ -46,8 +49,9 @@ export TOPOSMOOTH_FUZZ_DIR="${TOPOSMOOTH_FUZZ_DIR:-/dev/shm}"
 for t in $TARGETS; do
     log="artifacts/$t.log"
     mkdir -p "artifacts/$t"
-    # -malloc_limit_mb: any single allocation above it is a crash (inputs are at most 64 kB)
-    cargo +nightly fuzz run "$t" --release -- -max_total_time="$SECONDS_EACH" -max_len=65536 \
+    # -rss_limit_mb: a run whose memory grows past it is a crash (inputs are at most 64 kB);
+    # under AddressSanitizer -malloc_limit_mb also catches any single allocation above it
+    cargo +nightly fuzz run "$t" --release -s "${FUZZ_SANITIZER:-none}" -- -max_total_time="$SECONDS_EACH" -max_len=65536 \
         -rss_limit_mb=4096 -malloc_limit_mb=512 -print_final_stats=1 >"$log" 2>&1 || true
     runs=$(grep -a -o 'stat::number_of_executed_units: *[0-9]*' "$log" | grep -o '[0-9]*$' | tail -1)
     crashes=$(find "artifacts/$t" -type f \( -name 'crash-*' -o -name 'oom-*' -o -name 'leak-*' -o -name 'timeout-*' \) | wc -l)

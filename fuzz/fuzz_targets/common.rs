@@ -4,6 +4,7 @@
 
 use std::path::PathBuf;
 
+#[allow(dead_code)]
 /// Writes `data` to this process's scratch file with extension `ext`.
 pub fn as_file(data: &[u8], ext: &str) -> PathBuf {
     let dir = std::env::var_os("TOPOSMOOTH_FUZZ_DIR").map(PathBuf::from).unwrap_or_else(std::env::temp_dir);

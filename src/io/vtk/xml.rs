@@ -448,21 +448,93 @@ fn file_kind(a: &Attrs) -> Result<String> {
     }
 }
 
+/// The state of the markup scan: what has been declared, and where the scan is.
+struct Scan {
+    m: Markup,
+    /// Open elements; text belongs to a `<DataArray>` only when it is the innermost one.
+    stack: Vec<Vec<u8>>,
+    section: Option<Section>,
+    current: Option<(Section, ArrayDecl)>,
+}
+
+impl Scan {
+    fn start(&mut self, e: &quick_xml::events::BytesStart, empty: bool) -> Result<()> {
+        let name = e.name().as_ref().to_vec();
+        let m = &mut self.m;
+        let parent = self.stack.last().map(Vec::as_slice);
+        match name.as_slice() {
+            b"VTKFile" => {
+                let a = attrs(e)?;
+                m.kind = file_kind(&a)?;
+                m.file_attrs = Some(a);
+            }
+            b"Piece" if parent.is_some_and(|p| p == m.kind.as_bytes()) => {
+                m.pieces.push(PieceDecl { attrs: attrs(e)?, ..PieceDecl::default() })
+            }
+            b"AppendedData" => m.appended_encoding = get(&attrs(e)?, "encoding").map(str::to_string),
+            b"DataArray" => {
+                if let (Some(s), Some(piece)) = (self.section, m.pieces.last_mut()) {
+                    let decl = array_decl(&attrs(e)?)?;
+                    if empty {
+                        piece.arrays.push((s, decl));
+                    } else {
+                        self.current = Some((s, decl));
+                    }
+                }
+            }
+            n if !m.kind.is_empty() && n == m.kind.as_bytes() && parent == Some(b"VTKFile") => {
+                m.dataset_attrs = attrs(e)?
+            }
+            n if parent == Some(b"Piece") => {
+                self.section = Section::of(n);
+                if self.section == Some(Section::PointData) {
+                    let scalars = get(&attrs(e)?, "Scalars").map(str::to_string);
+                    if let Some(p) = m.pieces.last_mut() {
+                        p.active_scalars = scalars;
+                    }
+                }
+            }
+            _ => {}
+        }
+        if !empty {
+            self.stack.push(name);
+        }
+        Ok(())
+    }
+
+    fn text(&mut self, t: &[u8]) {
+        if let (Some((_, c)), Some(b"DataArray")) = (self.current.as_mut(), self.stack.last().map(Vec::as_slice)) {
+            c.text.extend_from_slice(t);
+        }
+    }
+
+    fn end(&mut self, name: &[u8]) {
+        if self.stack.last().is_some_and(|n| n == name) {
+            self.stack.pop();
+        }
+        let parent = self.stack.last();
+        if name == b"DataArray" && parent.is_some_and(|p| Section::of(p).is_some()) {
+            if let (Some(c), Some(p)) = (self.current.take(), self.m.pieces.last_mut()) {
+                p.arrays.push(c);
+            }
+        } else if Section::of(name).is_some() && parent.is_some_and(|p| p == b"Piece") {
+            self.section = None;
+        }
+    }
+}
+
 /// Reads the markup (up to the `<AppendedData>` start tag).
 fn scan_markup(markup: &[u8]) -> Result<Markup> {
     use quick_xml::events::Event;
     let mut reader = quick_xml::Reader::from_reader(markup);
-    let mut m = Markup {
+    let m = Markup {
         file_attrs: None,
         kind: String::new(),
         dataset_attrs: Vec::new(),
         pieces: Vec::new(),
         appended_encoding: None,
     };
-    // open elements; text belongs to a <DataArray> only when it is the innermost one
-    let mut stack: Vec<Vec<u8>> = Vec::new();
-    let mut section: Option<Section> = None;
-    let mut current: Option<(Section, ArrayDecl)> = None;
+    let mut scan = Scan { m, stack: Vec::new(), section: None, current: None };
     loop {
         let event = reader.read_event().map_err(|e| {
             let at = reader.error_position();
@@ -474,75 +546,13 @@ fn scan_markup(markup: &[u8]) -> Result<Markup> {
             Error::input(format!("{cut}malformed XML near byte {at}: {e}")).at(Location::Byte(at))
         })?;
         match &event {
-            Event::Start(e) | Event::Empty(e) => {
-                let empty = matches!(event, Event::Empty(_));
-                let name = e.name().as_ref().to_vec();
-                let parent = stack.last().map(Vec::as_slice);
-                match name.as_slice() {
-                    b"VTKFile" => {
-                        let a = attrs(e)?;
-                        m.kind = file_kind(&a)?;
-                        m.file_attrs = Some(a);
-                    }
-                    b"Piece" if parent.is_some_and(|p| p == m.kind.as_bytes()) => {
-                        m.pieces.push(PieceDecl { attrs: attrs(e)?, ..PieceDecl::default() })
-                    }
-                    b"AppendedData" => m.appended_encoding = get(&attrs(e)?, "encoding").map(str::to_string),
-                    b"DataArray" => {
-                        if let (Some(s), Some(_)) = (section, m.pieces.last()) {
-                            let decl = array_decl(&attrs(e)?)?;
-                            if empty {
-                                if let Some(p) = m.pieces.last_mut() {
-                                    p.arrays.push((s, decl));
-                                }
-                            } else {
-                                current = Some((s, decl));
-                            }
-                        }
-                    }
-                    n if !m.kind.is_empty() && n == m.kind.as_bytes() && parent == Some(b"VTKFile") => {
-                        m.dataset_attrs = attrs(e)?
-                    }
-                    n if parent == Some(b"Piece") => {
-                        section = Section::of(n);
-                        if section == Some(Section::PointData) {
-                            let scalars = get(&attrs(e)?, "Scalars").map(str::to_string);
-                            if let Some(p) = m.pieces.last_mut() {
-                                p.active_scalars = scalars;
-                            }
-                        }
-                    }
-                    _ => {}
-                }
-                if !empty {
-                    stack.push(name);
-                }
-            }
-            Event::Text(t) => {
-                if let (Some((_, c)), Some(b"DataArray")) = (current.as_mut(), stack.last().map(Vec::as_slice)) {
-                    c.text.extend_from_slice(t);
-                }
-            }
-            Event::CData(t) => {
-                if let (Some((_, c)), Some(b"DataArray")) = (current.as_mut(), stack.last().map(Vec::as_slice)) {
-                    c.text.extend_from_slice(t);
-                }
-            }
-            Event::End(e) => {
-                let name = e.name().as_ref().to_vec();
-                if stack.last() == Some(&name) {
-                    stack.pop();
-                }
-                if name == b"DataArray" && stack.last().is_some_and(|p| Section::of(p).is_some()) {
-                    if let (Some(c), Some(p)) = (current.take(), m.pieces.last_mut()) {
-                        p.arrays.push(c);
-                    }
-                } else if Section::of(&name).is_some() && stack.last().is_some_and(|p| p == b"Piece") {
-                    section = None;
-                }
-            }
+            Event::Start(e) => scan.start(e, false)?,
+            Event::Empty(e) => scan.start(e, true)?,
+            Event::Text(t) => scan.text(t),
+            Event::CData(t) => scan.text(t),
+            Event::End(e) => scan.end(e.name().as_ref()),
             Event::Eof => {
-                if let Some((_, c)) = current {
+                if let Some((_, c)) = scan.current {
                     return Err(Error::input(format!("truncated: the file ends inside array `{}`", c.name)));
                 }
                 break;
@@ -550,6 +560,7 @@ fn scan_markup(markup: &[u8]) -> Result<Markup> {
             _ => {}
         }
     }
+    let m = scan.m;
     if m.file_attrs.is_some() && m.dataset_attrs.is_empty() && m.pieces.is_empty() {
         return Err(Error::input(format!("no <{}> element (truncated file?)", m.kind)));
     }

@@ -137,8 +137,8 @@ enum Command {
     /// holes from JSON, the shapes of an SVG, or the largest region of a PNG mask.
     Mesh {
         /// Outline: .json (`{"outline": [[x, y], ...], "holes": [[[x, y], ...], ...]}`), .svg
-        /// (polygon, polyline, path, rect, circle, ellipse: the first is the outer boundary, later
-        /// ones holes; y negated) or .png (inside: alpha ≥ 50 %, or dark pixels without alpha;
+        /// (the visible filled shapes as drawn, CSS, units, <use> and transforms resolved: the
+        /// first subpath is the outer boundary, later ones holes; user units, y negated) or .png (inside: alpha ≥ 50 %, or dark pixels without alpha;
         /// pixel-corner coordinates, y up).
         input: PathBuf,
         /// Output mesh: .obj, .off, .ply, .vtu or .vtp (z = 0).

@@ -23,7 +23,7 @@ mod svg;
 
 use shape::{fmt_point, loop_name, orient, short};
 pub use shape::{
-    Outline, CURVE_SEGMENTS, DEFAULT_AREA_DIVISOR, DEFAULT_MIN_ANGLE, MAX_MIN_ANGLE, MAX_TRIANGLES, TRACE_TOLERANCE,
+    Outline, CURVE_TOLERANCE, DEFAULT_AREA_DIVISOR, DEFAULT_MIN_ANGLE, MAX_MIN_ANGLE, MAX_TRIANGLES, TRACE_TOLERANCE,
 };
 
 use crate::domain::TriMesh;
@@ -36,13 +36,21 @@ use std::path::Path;
 ///
 /// - `.json`: `{"outline": [[x, y], ...], "holes": [[[x, y], ...], ...]}` (`holes` optional;
 ///   `cage` is accepted for `outline`, as in `handles.json`).
-/// - `.svg`: `<polygon>`, `<polyline>`, `<path>` (M, L, H, V, Z, and the curves C, S, Q, T, A
-///   flattened into [`CURVE_SEGMENTS`] segments each; absolute and relative), `<rect>`,
-///   `<circle>`, `<ellipse>`, with `transform` attributes applied. Every subpath and shape is a
-///   closed loop (as SVG fills them); the first is the outer boundary, later ones are holes.
-///   Coordinates are the SVG's user units with y negated (SVG's y points down), so the shape
-///   stays upright; the `viewBox` is not applied. Shapes inside `<defs>`, `<clipPath>`,
-///   `<mask>`, `<symbol>`, `<pattern>` and `<marker>` are ignored.
+/// - `.svg`: the document as drawn, read with usvg (CSS in `<style>` and `style`, `display`,
+///   `visibility`, units (mm, cm, in, pt, pc, %, em), `<use>`, `<symbol>`, nested `<svg>`,
+///   transforms; `<rect>` with `rx`/`ry`, `<circle>`, `<ellipse>`, `<polygon>`, `<polyline>`,
+///   `<path>`). Every visible filled shape counts (not those with `fill="none"`, nor text,
+///   images, markers, strokes; `clip-path` and `mask` are not applied); each of its subpaths
+///   is a closed loop (as SVG fills them), the first the outer boundary and later ones holes,
+///   whatever the `fill-rule`. Subpaths that enclose nothing (a `<line>`, two points) are left
+///   out. Curves are flattened into points at equal parameter steps, as many as keep each
+///   within [`CURVE_TOLERANCE`] × the diagonal of the drawing's bounding box (its corners and
+///   control points); usvg draws elliptical arcs as cubics of at most a quarter turn, within
+///   0.03 % of the radius. Coordinates are the root's user units (the `viewBox` mapping to
+///   the page undone, so a drawing in mm stays in mm) with y negated (SVG's y points down),
+///   so the shape stays upright. usvg computes in 32-bit floats (about 7 significant digits).
+///   The loops are validated when read ([`Outline::validate`]), with messages naming the
+///   SVG element of each loop.
 /// - `.png`: a mask. Inside are the pixels with alpha ≥ 50 %; without an alpha channel (or
 ///   when every pixel is opaque) the dark ones (grey level < 50 %). The boundary of the
 ///   largest 4-connected inside region (islands elsewhere are dropped) is traced along pixel
@@ -52,13 +60,14 @@ use std::path::Path;
 ///   spans `[0, w] × [0, h]`. Where two inside pixels touch only at a corner, each boundary
 ///   passing there is moved a quarter pixel into its own pixel, so loops never touch.
 ///
-/// Repeated consecutive corners (and a last corner equal to the first) are dropped. The
-/// outline is not validated here: [`triangulate`] does it.
+/// Repeated consecutive corners (and a last corner equal to the first) are dropped. JSON and
+/// PNG outlines are not validated here: [`triangulate`] does it.
 ///
 /// # Errors
-/// Input errors naming the file: an unknown extension, malformed content, SVG features that
-/// cannot be read (`<use>`, rounded rectangles, unknown transforms), a PNG with no inside
-/// pixel. I/O errors.
+/// Input errors naming the file: an unknown extension, malformed content, a PNG with no inside
+/// pixel; in an SVG, invalid geometry naming the element (its id, tag, line and column): a
+/// negative width, height or radius, a number that is not finite, malformed `points`, `d` or
+/// `transform`, no visible filled shape, loops that cross, touch or nest wrongly. I/O errors.
 pub fn read_outline(path: &Path) -> Result<Outline> {
     let bytes = std::fs::read(path).map_err(|source| Error::Io { path: path.to_path_buf(), source })?;
     let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();

@@ -2,8 +2,10 @@
 
 use crate::error::{Error, Result};
 
-/// Straight segments that replace each SVG curve command (C, S, Q, T, A).
-pub const CURVE_SEGMENTS: usize = 16;
+/// Largest distance between an SVG curve and the polyline that replaces it, as a fraction of
+/// the diagonal of the drawing's bounding box (the corners and control points of all its
+/// visible filled shapes, in user units).
+pub const CURVE_TOLERANCE: f64 = 1e-3;
 /// Douglas–Peucker tolerance, in pixels, for the boundary traced from a PNG mask.
 pub const TRACE_TOLERANCE: f64 = 0.75;
 /// Default smallest angle of the refinement, in degrees.
@@ -142,6 +144,11 @@ impl Outline {
     /// [`Error::Input`] naming the loop, and for intersections the two edges (edge `i` runs
     /// from corner `i` to corner `i + 1`, 0-based) and where they meet.
     pub fn validate(&self) -> Result<()> {
+        self.validate_named(&loop_name)
+    }
+
+    /// [`Outline::validate`] with messages naming loop `k` as `loop_name(k)`.
+    pub(super) fn validate_named(&self, loop_name: &dyn Fn(usize) -> String) -> Result<()> {
         if self.loops.is_empty() {
             return Err(Error::input("the outline has no loop"));
         }
@@ -158,7 +165,7 @@ impl Outline {
                 return Err(Error::input(format!("{}: corner {i} is not finite ({:?})", loop_name(k), l[i])));
             }
         }
-        self.check_intersections()?;
+        self.check_intersections(loop_name)?;
         let outer = &self.loops[0];
         for (h, hole) in self.loops.iter().enumerate().skip(1) {
             if !inside(outer, hole[0]) {
@@ -193,7 +200,7 @@ impl Outline {
 
     /// No two edges meet except consecutive edges at their shared corner. Edges are swept in
     /// order of their smallest x; only pairs whose x and y ranges overlap are tested.
-    fn check_intersections(&self) -> Result<()> {
+    fn check_intersections(&self, loop_name: &dyn Fn(usize) -> String) -> Result<()> {
         struct Edge {
             k: usize,
             i: usize,

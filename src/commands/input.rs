@@ -10,6 +10,7 @@ use crate::io::mesh::is_mesh_file;
 pub use crate::io::mesh::read_trimesh;
 use crate::io::series_csv::{read_series, SeriesCsv, SeriesCsvOptions};
 use crate::io::vtk::read_image;
+use crate::series_fill::fill_missing_series;
 use std::path::{Path, PathBuf};
 
 /// What kind of domain a file holds.
@@ -89,11 +90,20 @@ pub struct MeshInput {
     pub path: PathBuf,
 }
 
+/// A series ready to smooth.
+#[derive(Clone, Debug)]
+pub struct SeriesInput {
+    /// The series as read, its missing values filled (`--fill-missing`).
+    pub data: SeriesCsv,
+    /// Samples filled by `--fill-missing` (true), when any were.
+    pub filled: Option<Vec<bool>>,
+}
+
 /// A field read by a command.
 #[derive(Clone, Debug)]
 pub enum FieldInput {
     /// A series.
-    Series(SeriesCsv),
+    Series(SeriesInput),
     /// A grid.
     Grid(GridInput),
     /// A field on a triangle mesh.
@@ -209,10 +219,14 @@ pub fn is_grid_file(path: &Path, kind: DomainKind) -> Result<bool> {
         DomainKind::Auto => match extension(path).as_str() {
             "vti" | "vtk" | "npy" | "png" | "tif" | "tiff" => true,
             _ => {
-                let text = std::fs::read_to_string(path).map_err(|source| Error::Io { path: path.into(), source })?;
+                let bytes = std::fs::read(path).map_err(|source| Error::Io { path: path.into(), source })?;
+                crate::io::content::expect_text(path, &bytes, "CSV text")?;
+                let text = String::from_utf8_lossy(&bytes);
+                let text = text.trim_start_matches('\u{feff}');
+                let dialect = crate::io::csv_dialect::sniff(text);
                 let first = text.lines().map(str::trim).find(|l| !l.is_empty()).unwrap_or("");
-                let cells: Vec<&str> = first.trim_start_matches('\u{feff}').split(',').collect();
-                cells.len() >= 3 && cells.iter().all(|c| c.trim().parse::<f64>().is_ok())
+                let cells: Vec<&str> = first.split(char::from(dialect.delimiter)).collect();
+                cells.len() >= 3 && cells.iter().all(|c| dialect.number(c).is_some())
             }
         },
     })
@@ -225,8 +239,9 @@ pub fn read_field(
     csv: &SeriesCsvOptions,
     grid: &GridOptions,
 ) -> Result<FieldInput> {
-    let grid_wanted = grid.uv.is_some() || grid.derive.is_some() || grid.fill_missing || grid.array.is_some();
+    let grid_wanted = grid.uv.is_some() || grid.derive.is_some() || grid.array.is_some();
     if let Some(p) = path {
+        crate::io::content::check_extension(p)?;
         let mesh = match kind {
             DomainKind::Mesh => true,
             DomainKind::Auto => is_mesh_file(p),
@@ -243,11 +258,11 @@ pub fn read_field(
         Some(p) if !is_grid_file(p, kind)? => {
             if grid_wanted || grid.spacing.is_some() {
                 return Err(Error::Usage(format!(
-                    "{} is read as a series; --array, --spacing, --derive, --u/--v and --fill-missing are for grids (use --domain grid for a CSV matrix)",
+                    "{} is read as a series; --array, --spacing, --derive and --u/--v are for grids (use --domain grid for a CSV matrix)",
                     p.display()
                 )));
             }
-            Ok(FieldInput::Series(read_series(p, csv)?))
+            read_series_input(p, csv, grid.fill_missing).map(FieldInput::Series)
         }
         Some(p) if grid.uv.is_some() => {
             Err(Error::Usage(format!("give either an input file ({}) or --u and --v, not both", p.display())))
@@ -260,6 +275,22 @@ pub fn read_field(
     }
 }
 
+/// Reads a series from CSV; with `fill_missing` its missing values (empty cells, NaN) are
+/// filled linearly in x ([`fill_missing_series`]) instead of refused.
+///
+/// # Errors
+/// As [`read_series`]; every value missing.
+pub fn read_series_input(path: &Path, csv: &SeriesCsvOptions, fill_missing: bool) -> Result<SeriesInput> {
+    let options = SeriesCsvOptions { allow_missing: fill_missing, ..csv.clone() };
+    let mut data = read_series(path, &options)?;
+    let mut filled = None;
+    if data.values.iter().any(|v| v.is_nan()) {
+        let mask = fill_missing_series(&data.x, &mut data.values).map_err(|e| e.in_file(path))?;
+        filled = Some(mask);
+    }
+    Ok(SeriesInput { data, filled })
+}
+
 /// One array of a raw read: name, components, values.
 struct Raw {
     grid: Grid2d,
@@ -268,6 +299,7 @@ struct Raw {
 
 fn read_raw(path: &Path) -> Result<Raw> {
     let from_field = |f: GridField| Raw { arrays: vec![(f.array, 1, f.values)], grid: f.grid };
+    crate::io::content::check_extension(path)?;
     match extension(path).as_str() {
         "vti" | "vtk" => {
             let img = read_image(path)?;
@@ -414,6 +446,8 @@ pub struct SeriesAxis {
     pub x: Vec<f64>,
     /// The x column's text per row, written back out.
     pub x_text: Vec<String>,
+    /// The x column's header, written back out.
+    pub x_name: String,
     /// Where x came from.
     pub source: crate::io::series_csv::XSource,
 }
@@ -445,14 +479,14 @@ impl FieldInput {
     pub fn into_field(self, path: &Path) -> Result<Field> {
         use crate::domain::{AnyDomain, Series};
         Ok(match self {
-            FieldInput::Series(data) => Field {
+            FieldInput::Series(SeriesInput { data, filled }) => Field {
                 domain: AnyDomain::Series(Series::with_coordinates(data.x.clone()).map_err(|e| e.in_file(path))?),
                 values: data.values,
                 path: path.to_path_buf(),
                 description: data.column,
-                filled: None,
+                filled,
                 notes: Vec::new(),
-                axis: Some(SeriesAxis { x: data.x, x_text: data.x_text, source: data.x_source }),
+                axis: Some(SeriesAxis { x: data.x, x_text: data.x_text, x_name: data.x_name, source: data.x_source }),
             },
             FieldInput::Grid(g) => Field {
                 domain: AnyDomain::Grid(g.grid),

@@ -1,6 +1,8 @@
 //! Reading and writing files. Every output goes to a temporary file in the target's directory
 //! and is renamed into place, so a failed run never leaves a half-written file.
 
+pub mod content;
+pub mod csv_dialect;
 #[cfg(all(feature = "io-vtk", feature = "io-npz"))]
 pub mod export;
 pub mod grid;
@@ -8,6 +10,8 @@ pub mod grid;
 pub mod mesh;
 pub mod npz;
 pub mod series_csv;
+pub mod series_output;
+pub mod timestamps;
 #[cfg(feature = "io-vtk")]
 pub mod vtk;
 

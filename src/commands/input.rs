@@ -5,9 +5,10 @@
 use crate::derive::{describe_missing, fill_missing, magnitude, vorticity};
 use crate::domain::{Domain, Grid2d, TriMesh};
 use crate::error::{Error, Result};
-use crate::io::grid::{read_grid_csv, read_npy, read_raster, GridField};
+use crate::io::grid::{read_grid_csv, read_raster, GridField};
 use crate::io::mesh::is_mesh_file;
 pub use crate::io::mesh::read_trimesh;
+use crate::io::npy_input::{is_numpy, read_numpy, NumpyField, Wanted};
 use crate::io::series_csv::{read_series, SeriesCsv, SeriesCsvOptions};
 use crate::io::vtk::read_image;
 use crate::series_fill::fill_missing_series;
@@ -217,7 +218,7 @@ pub fn is_grid_file(path: &Path, kind: DomainKind) -> Result<bool> {
         DomainKind::Series | DomainKind::Mesh => false,
         DomainKind::Grid => true,
         DomainKind::Auto => match extension(path).as_str() {
-            "vti" | "vtk" | "npy" | "png" | "tif" | "tiff" => true,
+            "vti" | "vtk" | "npy" | "npz" | "png" | "tif" | "tiff" => true,
             _ => {
                 let bytes = std::fs::read(path).map_err(|source| Error::Io { path: path.into(), source })?;
                 crate::io::content::expect_text(path, &bytes, "CSV text")?;
@@ -253,6 +254,13 @@ pub fn read_field(
     }
     if let Some(v) = &grid.values {
         return Err(Error::Usage(format!("--values {} is for meshes", v.display())));
+    }
+    if let Some(p) = path.filter(|p| is_numpy(p) && kind != DomainKind::Grid) {
+        if grid.derive.is_none() && grid.uv.is_none() {
+            if let Some(series) = numpy_series(p, kind, csv, grid)? {
+                return Ok(FieldInput::Series(series));
+            }
+        }
     }
     match path {
         Some(p) if !is_grid_file(p, kind)? => {
@@ -291,13 +299,55 @@ pub fn read_series_input(path: &Path, csv: &SeriesCsvOptions, fill_missing: bool
     Ok(SeriesInput { data, filled })
 }
 
+/// A NumPy file's 1-D array as a series (x = 0, 1, 2, …), filled with `--fill-missing`; `None`
+/// when the file's array is a grid (and `kind` allows one).
+fn numpy_series(
+    path: &Path,
+    kind: DomainKind,
+    csv: &SeriesCsvOptions,
+    grid: &GridOptions,
+) -> Result<Option<SeriesInput>> {
+    let wanted = if kind == DomainKind::Series { Wanted::Series } else { Wanted::Any };
+    let NumpyField::Series { name, mut values } = read_numpy(path, grid.array.as_deref(), wanted)? else {
+        return Ok(None);
+    };
+    if csv.column.is_some() || csv.x_column.is_some() || grid.spacing.is_some() {
+        return Err(Error::Usage(format!(
+            "{}: a NumPy series is its array, on x = 0, 1, 2, …: --column, --x and --spacing do not apply (choose the array with --array)",
+            path.display()
+        )));
+    }
+    let n = values.len();
+    let x: Vec<f64> = (0..n).map(|i| i as f64).collect();
+    let mut filled = None;
+    if let Some(i) = values.iter().position(|v| v.is_nan()) {
+        if !grid.fill_missing {
+            let count = values.iter().filter(|v| v.is_nan()).count();
+            return Err(Error::input(format!(
+                "array `{name}`: {count} missing (NaN) values, the first at index {i}; --fill-missing fills them linearly"
+            ))
+            .in_file(path));
+        }
+        filled = Some(fill_missing_series(&x, &mut values).map_err(|e| e.in_file(path))?);
+    }
+    let data = SeriesCsv {
+        column: name,
+        values,
+        x_text: (0..n).map(|i| i.to_string()).collect(),
+        x,
+        x_name: "x".into(),
+        x_source: crate::io::series_csv::XSource::Index,
+    };
+    Ok(Some(SeriesInput { data, filled }))
+}
+
 /// One array of a raw read: name, components, values.
 struct Raw {
     grid: Grid2d,
     arrays: Vec<(String, usize, Vec<f64>)>,
 }
 
-fn read_raw(path: &Path) -> Result<Raw> {
+fn read_raw(path: &Path, array: Option<&str>) -> Result<Raw> {
     let from_field = |f: GridField| Raw { arrays: vec![(f.array, 1, f.values)], grid: f.grid };
     crate::io::content::check_extension(path)?;
     match extension(path).as_str() {
@@ -307,7 +357,12 @@ fn read_raw(path: &Path) -> Result<Raw> {
             let arrays = img.arrays.into_iter().map(|a| (a.name, a.components, a.values)).collect();
             Ok(Raw { grid, arrays })
         }
-        "npy" => read_npy(path).map(from_field),
+        "npy" | "npz" => match read_numpy(path, array, Wanted::Grid)? {
+            NumpyField::Grid(f) => Ok(from_field(f)),
+            NumpyField::Series { name, .. } => {
+                Err(Error::input(format!("array `{name}` is 1-D: a series, not a grid")).in_file(path))
+            }
+        },
         "png" | "tif" | "tiff" => read_raster(path).map(from_field),
         _ => read_grid_csv(path).map(from_field),
     }
@@ -358,7 +413,7 @@ pub fn read_grid(path: &Path, opts: &GridOptions) -> Result<GridInput> {
     let (grid, mut values, description, source) = match (&opts.uv, opts.derive) {
         (Some(_), None) => return Err(Error::Usage("--u and --v need --derive vorticity|magnitude".into())),
         (Some((pu, pv)), Some(d)) => {
-            let (ru, rv) = (read_raw(pu)?, read_raw(pv)?);
+            let (ru, rv) = (read_raw(pu, opts.array.as_deref())?, read_raw(pv, opts.array.as_deref())?);
             if (ru.grid.nx(), ru.grid.ny()) != (rv.grid.nx(), rv.grid.ny()) {
                 return Err(Error::input(format!(
                     "{} is {} × {} but {} is {} × {}",
@@ -377,7 +432,7 @@ pub fn read_grid(path: &Path, opts: &GridOptions) -> Result<GridInput> {
             (grid, values, format!("{d:?} of ({}, {})", pu.display(), pv.display()).to_lowercase(), pu.clone())
         }
         (None, Some(d)) => {
-            let raw = read_raw(path)?;
+            let raw = read_raw(path, opts.array.as_deref())?;
             let a = pick(path, &raw, opts.array.as_deref(), true)?;
             if a.1 != 2 && a.1 != 3 {
                 return Err(Error::input(format!(
@@ -398,7 +453,7 @@ pub fn read_grid(path: &Path, opts: &GridOptions) -> Result<GridInput> {
             )
         }
         (None, None) => {
-            let raw = read_raw(path)?;
+            let raw = read_raw(path, opts.array.as_deref())?;
             let a = pick(path, &raw, opts.array.as_deref(), false)?;
             if a.1 != 1 {
                 return Err(Error::input(format!(

@@ -247,7 +247,8 @@ impl Cells<'_> {
                     match &first_aware {
                         None => first_aware = Some((s.aware, *line, cell.to_string())),
                         Some((aware, at, first)) if *aware != s.aware => {
-                            let (with, without) = if s.aware { ("has", "has none") } else { ("has none", "has one") };
+                            let (with, without) =
+                                if s.aware { ("has a", "has none") } else { ("has no", "has one") };
                             return Err(self.error(
                                 *line,
                                 format!(

@@ -66,6 +66,7 @@ pub mod pipeline;
 #[cfg(feature = "plot")]
 pub mod plot;
 pub(crate) mod representative;
+pub mod series_fill;
 pub mod smoother;
 pub mod solve;
 pub mod verify;

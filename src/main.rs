@@ -218,7 +218,9 @@ struct GridCli {
     /// Grid: y velocity component file.
     #[arg(long = "v", value_name = "FILE", requires = "u")]
     v: Option<PathBuf>,
-    /// Grid: fill missing (NaN) samples by harmonic interpolation instead of refusing them.
+    /// Fill missing samples (NaN, empty CSV cells) instead of refusing them: harmonically on
+    /// grids and meshes, linearly in x on series (ends: the nearest value); filled samples are
+    /// never kept extrema, and the output marks them (`filled`).
     #[arg(long)]
     fill_missing: bool,
     /// Mesh: the field as one value per vertex and line of a text file (instead of --array;
@@ -273,7 +275,7 @@ struct CsvArgs {
 
 impl CsvArgs {
     fn options(&self) -> SeriesCsvOptions {
-        SeriesCsvOptions { column: self.column.clone(), x_column: self.x_column.clone() }
+        SeriesCsvOptions { column: self.column.clone(), x_column: self.x_column.clone(), ..Default::default() }
     }
 }
 

@@ -29,7 +29,7 @@ fn smooth_then_verify_the_exchange_rate() {
     assert!(r["seconds"]["solve"].as_f64().unwrap() >= 0.0);
     // the x column keeps its dates
     let csv = std::fs::read_to_string(&out).unwrap();
-    assert!(csv.starts_with("x,input,output,u,role\n1999-01-04,0.8466,0.8466,"), "{}", &csv[..80]);
+    assert!(csv.starts_with("date,input,output,u,role\n1999-01-04,0.8466,0.8466,"), "{}", &csv[..80]);
 
     // tamper: a spurious maximum in the output is caught, and so is a changed input column
     let mut lines: Vec<String> = csv.lines().map(str::to_string).collect();

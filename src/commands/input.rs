@@ -5,11 +5,13 @@
 use crate::derive::{describe_missing, fill_missing, magnitude, vorticity};
 use crate::domain::{Domain, Grid2d, TriMesh};
 use crate::error::{Error, Result};
-use crate::io::grid::{read_grid_csv, read_npy, read_raster, GridField};
+use crate::io::grid::{read_grid_csv, read_raster, GridField};
 use crate::io::mesh::is_mesh_file;
 pub use crate::io::mesh::read_trimesh;
+use crate::io::npy_input::{is_numpy, read_numpy, NumpyField, Wanted};
 use crate::io::series_csv::{read_series, SeriesCsv, SeriesCsvOptions};
 use crate::io::vtk::read_image;
+use crate::series_fill::fill_missing_series;
 use std::path::{Path, PathBuf};
 
 /// What kind of domain a file holds.
@@ -89,11 +91,20 @@ pub struct MeshInput {
     pub path: PathBuf,
 }
 
+/// A series ready to smooth.
+#[derive(Clone, Debug)]
+pub struct SeriesInput {
+    /// The series as read, its missing values filled (`--fill-missing`).
+    pub data: SeriesCsv,
+    /// Samples filled by `--fill-missing` (true), when any were.
+    pub filled: Option<Vec<bool>>,
+}
+
 /// A field read by a command.
 #[derive(Clone, Debug)]
 pub enum FieldInput {
     /// A series.
-    Series(SeriesCsv),
+    Series(SeriesInput),
     /// A grid.
     Grid(GridInput),
     /// A field on a triangle mesh.
@@ -207,12 +218,16 @@ pub fn is_grid_file(path: &Path, kind: DomainKind) -> Result<bool> {
         DomainKind::Series | DomainKind::Mesh => false,
         DomainKind::Grid => true,
         DomainKind::Auto => match extension(path).as_str() {
-            "vti" | "vtk" | "npy" | "png" | "tif" | "tiff" => true,
+            "vti" | "vtk" | "npy" | "npz" | "png" | "tif" | "tiff" => true,
             _ => {
-                let text = std::fs::read_to_string(path).map_err(|source| Error::Io { path: path.into(), source })?;
+                let bytes = std::fs::read(path).map_err(|source| Error::Io { path: path.into(), source })?;
+                crate::io::content::expect_text(path, &bytes, "CSV text")?;
+                let text = String::from_utf8_lossy(&bytes);
+                let text = text.trim_start_matches('\u{feff}');
+                let dialect = crate::io::csv_dialect::sniff(text);
                 let first = text.lines().map(str::trim).find(|l| !l.is_empty()).unwrap_or("");
-                let cells: Vec<&str> = first.trim_start_matches('\u{feff}').split(',').collect();
-                cells.len() >= 3 && cells.iter().all(|c| c.trim().parse::<f64>().is_ok())
+                let cells: Vec<&str> = first.split(char::from(dialect.delimiter)).collect();
+                cells.len() >= 3 && cells.iter().all(|c| dialect.number(c).is_some())
             }
         },
     })
@@ -225,8 +240,9 @@ pub fn read_field(
     csv: &SeriesCsvOptions,
     grid: &GridOptions,
 ) -> Result<FieldInput> {
-    let grid_wanted = grid.uv.is_some() || grid.derive.is_some() || grid.fill_missing || grid.array.is_some();
+    let grid_wanted = grid.uv.is_some() || grid.derive.is_some() || grid.array.is_some();
     if let Some(p) = path {
+        crate::io::content::check_extension(p)?;
         let mesh = match kind {
             DomainKind::Mesh => true,
             DomainKind::Auto => is_mesh_file(p),
@@ -239,15 +255,22 @@ pub fn read_field(
     if let Some(v) = &grid.values {
         return Err(Error::Usage(format!("--values {} is for meshes", v.display())));
     }
+    if let Some(p) = path.filter(|p| is_numpy(p) && kind != DomainKind::Grid) {
+        if grid.derive.is_none() && grid.uv.is_none() {
+            if let Some(series) = numpy_series(p, kind, csv, grid)? {
+                return Ok(FieldInput::Series(series));
+            }
+        }
+    }
     match path {
         Some(p) if !is_grid_file(p, kind)? => {
             if grid_wanted || grid.spacing.is_some() {
                 return Err(Error::Usage(format!(
-                    "{} is read as a series; --array, --spacing, --derive, --u/--v and --fill-missing are for grids (use --domain grid for a CSV matrix)",
+                    "{} is read as a series; --array, --spacing, --derive and --u/--v are for grids (use --domain grid for a CSV matrix)",
                     p.display()
                 )));
             }
-            Ok(FieldInput::Series(read_series(p, csv)?))
+            read_series_input(p, csv, grid.fill_missing).map(FieldInput::Series)
         }
         Some(p) if grid.uv.is_some() => {
             Err(Error::Usage(format!("give either an input file ({}) or --u and --v, not both", p.display())))
@@ -260,6 +283,64 @@ pub fn read_field(
     }
 }
 
+/// Reads a series from CSV; with `fill_missing` its missing values (empty cells, NaN) are
+/// filled linearly in x ([`fill_missing_series`]) instead of refused.
+///
+/// # Errors
+/// As [`read_series`]; every value missing.
+pub fn read_series_input(path: &Path, csv: &SeriesCsvOptions, fill_missing: bool) -> Result<SeriesInput> {
+    let options = SeriesCsvOptions { allow_missing: fill_missing, ..csv.clone() };
+    let mut data = read_series(path, &options)?;
+    let mut filled = None;
+    if data.values.iter().any(|v| v.is_nan()) {
+        let mask = fill_missing_series(&data.x, &mut data.values).map_err(|e| e.in_file(path))?;
+        filled = Some(mask);
+    }
+    Ok(SeriesInput { data, filled })
+}
+
+/// A NumPy file's 1-D array as a series (x = 0, 1, 2, …), filled with `--fill-missing`; `None`
+/// when the file's array is a grid (and `kind` allows one).
+fn numpy_series(
+    path: &Path,
+    kind: DomainKind,
+    csv: &SeriesCsvOptions,
+    grid: &GridOptions,
+) -> Result<Option<SeriesInput>> {
+    let wanted = if kind == DomainKind::Series { Wanted::Series } else { Wanted::Any };
+    let NumpyField::Series { name, mut values } = read_numpy(path, grid.array.as_deref(), wanted)? else {
+        return Ok(None);
+    };
+    if csv.column.is_some() || csv.x_column.is_some() || grid.spacing.is_some() {
+        return Err(Error::Usage(format!(
+            "{}: a NumPy series is its array, on x = 0, 1, 2, …: --column, --x and --spacing do not apply (choose the array with --array)",
+            path.display()
+        )));
+    }
+    let n = values.len();
+    let x: Vec<f64> = (0..n).map(|i| i as f64).collect();
+    let mut filled = None;
+    if let Some(i) = values.iter().position(|v| v.is_nan()) {
+        if !grid.fill_missing {
+            let count = values.iter().filter(|v| v.is_nan()).count();
+            return Err(Error::input(format!(
+                "array `{name}`: {count} missing (NaN) values, the first at index {i}; --fill-missing fills them linearly"
+            ))
+            .in_file(path));
+        }
+        filled = Some(fill_missing_series(&x, &mut values).map_err(|e| e.in_file(path))?);
+    }
+    let data = SeriesCsv {
+        column: name,
+        values,
+        x_text: (0..n).map(|i| i.to_string()).collect(),
+        x,
+        x_name: "x".into(),
+        x_source: crate::io::series_csv::XSource::Index,
+    };
+    Ok(Some(SeriesInput { data, filled }))
+}
+
 /// One array of a raw read: name, components, values.
 struct Raw {
     grid: Grid2d,
@@ -270,9 +351,10 @@ struct Raw {
     active: Option<String>,
 }
 
-fn read_raw(path: &Path) -> Result<Raw> {
+fn read_raw(path: &Path, array: Option<&str>) -> Result<Raw> {
     let from_field =
         |f: GridField| Raw { arrays: vec![(f.array, 1, f.values)], grid: f.grid, skipped: Vec::new(), active: None };
+    crate::io::content::check_extension(path)?;
     match extension(path).as_str() {
         "vti" | "vtk" => {
             let img = read_image(path)?;
@@ -280,7 +362,12 @@ fn read_raw(path: &Path) -> Result<Raw> {
             let arrays = img.arrays.into_iter().map(|a| (a.name, a.components, a.values)).collect();
             Ok(Raw { grid, arrays, skipped: img.skipped, active: img.active_scalars })
         }
-        "npy" => read_npy(path).map(from_field),
+        "npy" | "npz" => match read_numpy(path, array, Wanted::Grid)? {
+            NumpyField::Grid(f) => Ok(from_field(f)),
+            NumpyField::Series { name, .. } => {
+                Err(Error::input(format!("array `{name}` is 1-D: a series, not a grid")).in_file(path))
+            }
+        },
         "png" | "tif" | "tiff" => read_raster(path).map(from_field),
         _ => read_grid_csv(path).map(from_field),
     }
@@ -342,7 +429,7 @@ pub fn read_grid(path: &Path, opts: &GridOptions) -> Result<GridInput> {
     let (grid, mut values, description, source) = match (&opts.uv, opts.derive) {
         (Some(_), None) => return Err(Error::Usage("--u and --v need --derive vorticity|magnitude".into())),
         (Some((pu, pv)), Some(d)) => {
-            let (ru, rv) = (read_raw(pu)?, read_raw(pv)?);
+            let (ru, rv) = (read_raw(pu, opts.array.as_deref())?, read_raw(pv, opts.array.as_deref())?);
             if (ru.grid.nx(), ru.grid.ny()) != (rv.grid.nx(), rv.grid.ny()) {
                 return Err(Error::input(format!(
                     "{} is {} × {} but {} is {} × {}",
@@ -361,7 +448,7 @@ pub fn read_grid(path: &Path, opts: &GridOptions) -> Result<GridInput> {
             (grid, values, format!("{d:?} of ({}, {})", pu.display(), pv.display()).to_lowercase(), pu.clone())
         }
         (None, Some(d)) => {
-            let raw = read_raw(path)?;
+            let raw = read_raw(path, opts.array.as_deref())?;
             let a = pick(path, &raw, opts.array.as_deref(), true)?;
             if a.1 != 2 && a.1 != 3 {
                 return Err(Error::input(format!(
@@ -382,7 +469,7 @@ pub fn read_grid(path: &Path, opts: &GridOptions) -> Result<GridInput> {
             )
         }
         (None, None) => {
-            let raw = read_raw(path)?;
+            let raw = read_raw(path, opts.array.as_deref())?;
             let a = pick(path, &raw, opts.array.as_deref(), false)?;
             if a.1 != 1 {
                 return Err(Error::input(format!(
@@ -430,6 +517,8 @@ pub struct SeriesAxis {
     pub x: Vec<f64>,
     /// The x column's text per row, written back out.
     pub x_text: Vec<String>,
+    /// The x column's header, written back out.
+    pub x_name: String,
     /// Where x came from.
     pub source: crate::io::series_csv::XSource,
 }
@@ -461,14 +550,14 @@ impl FieldInput {
     pub fn into_field(self, path: &Path) -> Result<Field> {
         use crate::domain::{AnyDomain, Series};
         Ok(match self {
-            FieldInput::Series(data) => Field {
+            FieldInput::Series(SeriesInput { data, filled }) => Field {
                 domain: AnyDomain::Series(Series::with_coordinates(data.x.clone()).map_err(|e| e.in_file(path))?),
                 values: data.values,
                 path: path.to_path_buf(),
                 description: data.column,
-                filled: None,
+                filled,
                 notes: Vec::new(),
-                axis: Some(SeriesAxis { x: data.x, x_text: data.x_text, source: data.x_source }),
+                axis: Some(SeriesAxis { x: data.x, x_text: data.x_text, x_name: data.x_name, source: data.x_source }),
             },
             FieldInput::Grid(g) => Field {
                 domain: AnyDomain::Grid(g.grid),

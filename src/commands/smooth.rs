@@ -45,6 +45,8 @@ struct RunReport<'a> {
     #[serde(flatten)]
     domain: DomainFacts<'a>,
     filled_missing: usize,
+    /// The filled samples (vertex indices), when any were.
+    filled_samples: Vec<usize>,
     output_file: String,
     read_seconds: f64,
     write_seconds: f64,
@@ -82,7 +84,18 @@ pub fn smooth(args: &SmoothArgs) -> Result<String> {
     }
     check_output(&args.output, &field.domain)?;
     let read_seconds = start.elapsed().as_secs_f64();
+    let filled_samples: Vec<usize> =
+        field.filled.as_ref().map(|m| (0..m.len()).filter(|&i| m[i]).collect()).unwrap_or_default();
+    check_explicit_not_filled(&field, &args.settings.selection, &filled_samples)?;
     let result = smooth_any(&field.domain, &field.values, &args.settings).map_err(|e| e.in_file(&field.path))?;
+    if let (AnyDomain::Series(_), Some(&i)) =
+        (&field.domain, filled_samples.iter().find(|&&i| matches!(result.roles[i], Role::Min | Role::Max)))
+    {
+        return Err(Error::Internal {
+            path: Some(field.path.clone()),
+            message: format!("the filled sample {i} came out a kept extremum (the fill should prevent it)"),
+        });
+    }
 
     let t = Instant::now();
     // every output is staged first and committed together at the end
@@ -93,8 +106,8 @@ pub fn smooth(args: &SmoothArgs) -> Result<String> {
         roles: &result.roles,
         filled: field.filled.as_deref(),
     };
-    let x_text = field.axis.as_ref().map(|a| a.x_text.as_slice());
-    let mut staged = vec![stage_results(&args.output, &field.domain, x_text, &results)?];
+    let x_axis = field.axis.as_ref().map(|a| (a.x_name.as_str(), a.x_text.as_slice()));
+    let mut staged = vec![stage_results(&args.output, &field.domain, x_axis, &results)?];
     if let Some(path) = &args.complex {
         let Some(ms) = &result.complex else {
             return Err(Error::Internal {
@@ -111,7 +124,7 @@ pub fn smooth(args: &SmoothArgs) -> Result<String> {
         hidden = h;
     }
     let write_seconds = t.elapsed().as_secs_f64();
-    let filled = field.filled.as_ref().map(|m| m.iter().filter(|&&b| b).count()).unwrap_or(0);
+    let filled = filled_samples.len();
     let negative = match &field.domain {
         AnyDomain::Mesh(m) => crate::operators::negative_cotan_edges(m.positions(), m.faces()),
         _ => 0,
@@ -122,6 +135,7 @@ pub fn smooth(args: &SmoothArgs) -> Result<String> {
             field: &field.description,
             domain: facts(&field, negative),
             filled_missing: filled,
+            filled_samples,
             output_file: args.output.display().to_string(),
             read_seconds,
             write_seconds,
@@ -143,6 +157,30 @@ pub fn smooth(args: &SmoothArgs) -> Result<String> {
         [filled, negative, hidden],
         [read_seconds, write_seconds, start.elapsed().as_secs_f64()],
     ))
+}
+
+/// An explicit kept list (`--keep-min`, `--keep-max`) may not name a filled sample: its value
+/// is not the input's.
+fn check_explicit_not_filled(field: &Field, selection: &crate::topology::Selection, filled: &[usize]) -> Result<()> {
+    let crate::topology::Selection::Explicit { minima, maxima } = selection else {
+        return Ok(());
+    };
+    match minima.iter().chain(maxima).find(|i| filled.binary_search(i).is_ok()) {
+        Some(&i) => Err(Error::input(format!(
+            "{} was filled by --fill-missing: a kept extremum must be a sample the file gives",
+            sample_name(field, i)
+        ))
+        .in_file(&field.path)),
+        None => Ok(()),
+    }
+}
+
+/// A sample or vertex for messages: a series' sample with its x as written.
+fn sample_name(field: &Field, i: usize) -> String {
+    match &field.axis {
+        Some(a) => format!("sample {i} ({} = {})", a.x_name, a.x_text[i]),
+        None => field.domain.describe_vertex(i),
+    }
 }
 
 /// What `smooth` prints: warnings and notes, the input, the kept set, the certificate, fit and
@@ -203,7 +241,22 @@ fn input_line(field: &Field, r: &Report, filled: usize, negative: usize) -> Stri
     let extrema = format!("{} minima and {} maxima in the input", r.input_minima, r.input_maxima);
     match &field.domain {
         AnyDomain::Series(_) => {
-            format!("{path}: {} samples of `{}`, {extrema} (SoS, ends included)\n", r.vertices, field.description)
+            let filled_note = match field.filled.as_ref() {
+                Some(mask) if filled > 0 => {
+                    let which: Vec<String> =
+                        (0..mask.len()).filter(|&i| mask[i]).take(5).map(|i| sample_name(field, i)).collect();
+                    format!(
+                        "; {filled} missing samples filled linearly in x ({}{}), none of them kept",
+                        which.join(", "),
+                        if filled > 5 { ", …" } else { "" }
+                    )
+                }
+                _ => String::new(),
+            };
+            format!(
+                "{path}: {} samples of `{}`, {extrema} (SoS, ends included){filled_note}\n",
+                r.vertices, field.description
+            )
         }
         AnyDomain::Grid(g) => format!(
             "{path}: {} of a {} × {} grid (spacing {}, {}){}; {extrema} (SoS, boundary included)\n",

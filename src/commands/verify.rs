@@ -25,6 +25,7 @@ pub struct VerifyArgs {
 /// Runs `verify`: `Ok(text)` when the file is certified, [`Error::Uncertified`] (exit 1) when not.
 pub fn verify(args: &VerifyArgs) -> Result<String> {
     let ext = args.file.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
+    crate::io::content::check_extension(&args.file)?;
     match ext.as_str() {
         e if MESH_OUTPUTS.contains(&e) => {
             let (mesh, data) = read_trimesh(&args.file)?;
@@ -41,6 +42,10 @@ pub fn verify(args: &VerifyArgs) -> Result<String> {
         }
         "obj" | "off" | "vtk" if crate::io::mesh::is_mesh_file(&args.file) => Err(Error::Usage(format!(
             "{}: a mesh file holds no smoothing output; verify the .vtu, .vtp or .ply that `smooth` wrote",
+            args.file.display()
+        ))),
+        "png" | "tif" | "tiff" => Err(Error::Usage(format!(
+            "{}: an image holds no smoothing output (plots are views, not certified arrays); verify the .csv, .vti, .npz, .vtu, .vtp or .ply that `smooth` wrote",
             args.file.display()
         ))),
         "npy" => Err(Error::Usage(format!(
@@ -79,6 +84,18 @@ fn verify_results(args: &VerifyArgs, out: Stored) -> Result<String> {
             break;
         }
     }
+    if let Some(i) = out.filled.as_ref().and_then(|f| {
+        (0..n).find(|&i| f.get(i).copied().unwrap_or(false) && matches!(out.roles[i], Role::Min | Role::Max))
+    }) {
+        problems.push(format!(
+            "{} is a kept {} but was filled (column `filled`): a kept extremum must be a sample the input gives",
+            d.describe_vertex(i),
+            out.roles[i].label()
+        ));
+    }
+    if out.filled.as_ref().is_some_and(|f| f.len() != n) {
+        problems.push("the `filled` column does not have one entry per sample".into());
+    }
     if !out.roles.contains(&Role::Min) || !out.roles.contains(&Role::Max) {
         problems.push("the role array keeps no minimum or no maximum".into());
     }
@@ -110,7 +127,11 @@ fn verify_results(args: &VerifyArgs, out: Stored) -> Result<String> {
 fn compare_input(args: &VerifyArgs, orig: &Path, out: &Stored) -> Result<Option<String>> {
     let mut opts = args.grid.clone();
     let kind = match &out.domain {
-        AnyDomain::Series(_) => DomainKind::Series,
+        AnyDomain::Series(_) => {
+            // the file says which samples were filled: the original is read with them filled
+            opts.fill_missing |= out.filled.is_some();
+            DomainKind::Series
+        }
         AnyDomain::Grid(g) => {
             let vti = args.file.extension().is_some_and(|e| e.eq_ignore_ascii_case("vti"));
             if opts.spacing.is_none() && vti {

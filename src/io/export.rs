@@ -103,13 +103,19 @@ pub struct Results<'a> {
 }
 
 /// Stages a smoothing result at `path` in the format its extension names: a series as
-/// `x,input,output,u,role` CSV (`x_text` is the x column as read, dates as dates); a grid as
+/// `X,input,output,u,role[,filled]` CSV (`x_axis`: the x column's header and its text as read,
+/// dates as dates; `x` and the indices without); a grid as
 /// `.vti` or `.npz` (every array) or `.npy` / CSV (the smoothed array); a mesh as `.vtu`, `.vtp`
 /// or `.ply` (every array).
 ///
 /// # Errors
 /// Usage errors for an extension the domain has no format for; I/O errors naming the file.
-pub fn stage_results(path: &Path, domain: &AnyDomain, x_text: Option<&[String]>, r: &Results) -> Result<Staged> {
+pub fn stage_results(
+    path: &Path,
+    domain: &AnyDomain,
+    x_axis: Option<(&str, &[String])>,
+    r: &Results,
+) -> Result<Staged> {
     check_output(path, domain)?;
     let roles = role_codes(r.roles);
     let filled: Option<Vec<f64>> = r.filled.map(|m| m.iter().map(|&b| f64::from(u8::from(b))).collect());
@@ -120,16 +126,18 @@ pub fn stage_results(path: &Path, domain: &AnyDomain, x_text: Option<&[String]>,
     }
     match domain {
         AnyDomain::Series(s) => {
-            let x_text = match x_text {
-                Some(t) => t.to_vec(),
-                None => (0..s.n_vertices()).map(|i| i.to_string()).collect(),
+            let (x_name, x_text) = match x_axis {
+                Some((name, t)) => (name.to_string(), t.to_vec()),
+                None => ("x".to_string(), (0..s.n_vertices()).map(|i| i.to_string()).collect()),
             };
             let out = SeriesOutput {
+                x_name,
                 x_text,
                 input: r.input.to_vec(),
                 output: r.smoothed.to_vec(),
                 u: r.representative.to_vec(),
                 roles: r.roles.to_vec(),
+                filled: r.filled.map(<[bool]>::to_vec),
             };
             stage_series_output(path, &out)
         }
@@ -244,6 +252,8 @@ pub struct Stored {
     pub representative: Vec<f64>,
     /// The roles decoded from the `role` array or column.
     pub roles: Vec<Role>,
+    /// Series: the samples the `filled` column marks, when it has one.
+    pub filled: Option<Vec<bool>>,
 }
 
 /// Reads a result that [`stage_results`] wrote: `.vti`, `.npz`, a mesh (`.vtu`, `.vtp`,
@@ -280,7 +290,14 @@ pub fn read_results(path: &Path) -> Result<Stored> {
         _ => {
             let out = read_series_output(path)?;
             let domain = AnyDomain::Series(Series::uniform(out.input.len()));
-            Ok(Stored { domain, input: out.input, smoothed: out.output, representative: out.u, roles: out.roles })
+            Ok(Stored {
+                domain,
+                input: out.input,
+                smoothed: out.output,
+                representative: out.u,
+                roles: out.roles,
+                filled: out.filled,
+            })
         }
     }
 }
@@ -335,7 +352,7 @@ fn stored(path: &Path, domain: AnyDomain, names: Vec<String>, mut arrays: Vec<(S
             })
         })
         .collect::<Result<Vec<Role>>>()?;
-    Ok(Stored { domain, input, smoothed, representative, roles })
+    Ok(Stored { domain, input, smoothed, representative, roles, filled: None })
 }
 
 #[cfg(test)]

@@ -33,14 +33,20 @@ fn finish(path: &Path, nx: usize, ny: usize, values: Vec<f64>, array: String) ->
     Ok(GridField { grid, values, array })
 }
 
-/// Reads a CSV matrix: one grid row per line, comma-separated numbers or `NaN`. A first line
-/// with no number at all is taken as a header and skipped.
+/// Reads a CSV matrix: one grid row per line, numbers or `NaN` separated by `,`, `;` or tabs
+/// (sniffed; decimal commas with `;` or tabs). A first line with no number at all is taken as
+/// a header and skipped.
 ///
 /// # Errors
 /// Input errors naming the file and line: rows of different lengths, a cell that is not a
 /// number, an infinite value, fewer than 2 rows or columns.
 pub fn read_grid_csv(path: &Path) -> Result<GridField> {
-    let text = std::fs::read_to_string(path).map_err(|e| io_err(path, e))?;
+    let bytes = std::fs::read(path).map_err(|e| io_err(path, e))?;
+    super::content::expect_text(path, &bytes, "a CSV matrix (text)")?;
+    let text = String::from_utf8(bytes)
+        .map_err(|e| err(path, format!("not UTF-8 text (byte {})", e.utf8_error().valid_up_to())))?;
+    let dialect = super::csv_dialect::sniff(text.trim_start_matches('\u{feff}'));
+    let sep = char::from(dialect.delimiter);
     let mut rows: Vec<Vec<f64>> = Vec::new();
     let mut nx = 0;
     for (k, line) in text.lines().enumerate() {
@@ -48,8 +54,8 @@ pub fn read_grid_csv(path: &Path) -> Result<GridField> {
         if line.is_empty() {
             continue;
         }
-        let cells: Vec<&str> = line.split(',').map(str::trim).collect();
-        let parsed: Vec<Option<f64>> = cells.iter().map(|c| c.parse::<f64>().ok()).collect();
+        let cells: Vec<&str> = line.split(sep).map(str::trim).collect();
+        let parsed: Vec<Option<f64>> = cells.iter().map(|c| dialect.number(c)).collect();
         if rows.is_empty() && nx == 0 && parsed.iter().all(Option::is_none) {
             nx = usize::MAX; // header skipped; the next row sets the width
             continue;

@@ -1,13 +1,18 @@
 //! Reading and writing files. Every output goes to a temporary file in the target's directory
 //! and is renamed into place, so a failed run never leaves a half-written file.
 
+pub mod content;
+pub mod csv_dialect;
 #[cfg(all(feature = "io-vtk", feature = "io-npz"))]
 pub mod export;
 pub mod grid;
 #[cfg(feature = "io-vtk")]
 pub mod mesh;
+pub mod npy_input;
 pub mod npz;
 pub mod series_csv;
+pub mod series_output;
+pub mod timestamps;
 #[cfg(feature = "io-vtk")]
 pub mod vtk;
 

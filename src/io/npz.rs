@@ -78,6 +78,9 @@ pub fn stage_npz(path: &Path, ny: usize, nx: usize, arrays: &[(&str, &[f64])]) -
 /// One array of an `.npz` archive: its name, shape `[ny, nx]` and values in C order.
 pub type NpzArray = (String, [usize; 2], Vec<f64>);
 
+/// One array of a NumPy file of any number of dimensions: its name, shape and values in C order.
+pub type NdArray = (String, Vec<usize>, Vec<f64>);
+
 #[cfg(feature = "io-npz")]
 /// Reads every array of an `.npz` archive: `(name, [ny, nx], values)` in archive order, with
 /// values converted to f64 and Fortran-ordered arrays rearranged to C order (row by row).
@@ -88,45 +91,63 @@ pub type NpzArray = (String, [usize; 2], Vec<f64>);
 /// member, an array that is not 2D, an unsupported dtype, an archive with no arrays. I/O
 /// errors for an unreadable file.
 pub fn read_npz(path: &Path) -> Result<Vec<NpzArray>> {
-    let file = std::fs::File::open(path).map_err(|source| Error::Io { path: path.to_path_buf(), source })?;
-    let mut archive = zip::ZipArchive::new(std::io::BufReader::new(file))
-        .map_err(|e| input(path, format!("not a readable .npz (zip) archive: {e}")))?;
-    let mut out = Vec::new();
-    for i in 0..archive.len() {
-        let mut member = archive
-            .by_index(i)
-            .map_err(|e| input(path, format!("cannot read member {} of the archive: {e}", i + 1)))?;
-        let Some(name) = npyz::npz::array_name_from_file_name(member.name()).map(str::to_string) else {
-            continue;
-        };
-        let mut bytes = Vec::with_capacity(member.size().min(1 << 30) as usize);
-        std::io::Read::read_to_end(&mut member, &mut bytes)
-            .map_err(|e| input(path, format!("array `{name}`: cannot read it: {e}")))?;
-        let (shape, values) = decode_npy(&bytes).map_err(|m| input(path, format!("array `{name}`: {m}")))?;
-        out.push((name, shape, values));
-    }
-    if out.is_empty() {
-        return Err(input(path, "the archive holds no .npy arrays"));
-    }
-    Ok(out)
+    read_npz_nd(path)?
+        .into_iter()
+        .map(|(name, shape, values)| match shape.as_slice() {
+            &[ny, nx] => Ok((name, [ny, nx], values)),
+            _ => Err(input(
+                path,
+                format!("array `{name}`: expected a 2D array (rows, columns), found shape {}", shape_text(&shape)),
+            )),
+        })
+        .collect()
 }
 
 /// Decodes a whole `.npy` file held in memory: a 2D numeric or boolean array as
 /// `([ny, nx], values in C order)`.
+///
+/// # Errors
+/// As [`decode_npy_nd`]; an array that is not 2D.
 pub fn decode_npy(bytes: &[u8]) -> Result<([usize; 2], Vec<f64>)> {
+    let (shape, values) = decode_npy_nd(bytes)?;
+    match shape.as_slice() {
+        &[ny, nx] => Ok(([ny, nx], values)),
+        _ => Err(Error::input(format!("expected a 2D array (rows, columns), found shape {}", shape_text(&shape)))),
+    }
+}
+
+/// A shape as numpy prints it: `(3, 4)`, `(8,)`, `()`.
+pub fn shape_text(shape: &[usize]) -> String {
+    match shape {
+        [n] => format!("({n},)"),
+        _ => format!("({})", shape.iter().map(usize::to_string).collect::<Vec<_>>().join(", ")),
+    }
+}
+
+/// Decodes a whole `.npy` file held in memory, of any number of dimensions: its shape and its
+/// values in C order (Fortran-ordered arrays rearranged). Floats (16 bits excepted), integers
+/// and booleans of either byte order, as `numpy.save` writes them.
+///
+/// # Errors
+/// Input errors: not an .npy file, a dtype that holds no real numbers (complex, strings,
+/// dates, objects), truncated data or bytes after it.
+pub fn decode_npy_nd(bytes: &[u8]) -> Result<(Vec<usize>, Vec<f64>)> {
     use npyz::{DType, Order, TypeChar};
     let npy = npyz::NpyFile::new(bytes).map_err(|e| Error::input(format!("not a readable .npy array: {e}")))?;
-    let shape = npy.shape().to_vec();
-    if shape.len() != 2 {
-        return Err(Error::input(format!("expected a 2D array (rows, columns), found shape {shape:?}")));
-    }
-    let (ny, nx) = (shape[0] as usize, shape[1] as usize);
+    let shape: Vec<usize> = npy.shape().iter().map(|&d| d as usize).collect();
     let order = npy.order();
     let dtype = npy.dtype();
+    let unsupported = |why: &str| {
+        Error::input(format!(
+            "unsupported dtype {}{why}: toposmooth reads real numbers (float, int, bool)",
+            dtype.descr()
+        ))
+    };
     let DType::Plain(ts) = &dtype else {
-        return Err(Error::input(format!("unsupported dtype {}", dtype.descr())));
+        return Err(unsupported(" (a structured array)"));
     };
     let bad = |e: std::io::Error| Error::input(format!("cannot read the data (truncated?): {e}"));
+    let count = shape.iter().try_fold(1usize, |a, &d| a.checked_mul(d));
     // the data must end where the file ends: trailing bytes mean a wrong header or a
     // concatenated file
     let data_start = match bytes.get(6) {
@@ -134,12 +155,13 @@ pub fn decode_npy(bytes: &[u8]) -> Result<([usize; 2], Vec<f64>)> {
         Some(_) => bytes.get(8..12).map(|h| 12 + u32::from_le_bytes([h[0], h[1], h[2], h[3]]) as usize),
         None => None,
     };
-    let expected = ny.checked_mul(nx).and_then(|k| k.checked_mul(ts.size_field() as usize));
+    let expected = count.and_then(|k| k.checked_mul(ts.size_field() as usize));
     if let (Some(start), Some(len)) = (data_start, expected) {
         if bytes.len() > start.saturating_add(len) {
             return Err(Error::input(format!(
-                "{} bytes after the {len} bytes of data the header describes (shape ({ny}, {nx}), dtype {})",
+                "{} bytes after the {len} bytes of data the header describes (shape {}, dtype {})",
                 bytes.len() - start - len,
+                shape_text(&shape),
                 dtype.descr()
             )));
         }
@@ -156,17 +178,75 @@ pub fn decode_npy(bytes: &[u8]) -> Result<([usize; 2], Vec<f64>)> {
         (TypeChar::Uint, 4) => npy.into_vec::<u32>().map_err(bad)?.into_iter().map(f64::from).collect(),
         (TypeChar::Uint, 8) => npy.into_vec::<u64>().map_err(bad)?.into_iter().map(|v| v as f64).collect(),
         (TypeChar::Bool, 1) => npy.into_vec::<bool>().map_err(bad)?.into_iter().map(|b| b as u8 as f64).collect(),
-        _ => return Err(Error::input(format!("unsupported dtype {}", dtype.descr()))),
+        (TypeChar::Complex, _) => return Err(unsupported(" (complex)")),
+        (TypeChar::DateTime | TypeChar::TimeDelta, _) => return Err(unsupported(" (dates or durations)")),
+        (TypeChar::ByteStr | TypeChar::UnicodeStr, _) => return Err(unsupported(" (strings)")),
+        _ => return Err(unsupported("")),
     };
-    if Some(values.len()) != ny.checked_mul(nx) {
-        return Err(Error::input(format!("{} values for shape ({ny}, {nx})", values.len())));
+    if Some(values.len()) != count {
+        return Err(Error::input(format!("{} values for shape {}", values.len(), shape_text(&shape))));
     }
     let values = match order {
         Order::C => values,
-        // Fortran order stores column by column: element (r, c) sits at c·ny + r
-        Order::Fortran => (0..ny * nx).map(|k| values[(k % nx) * ny + k / nx]).collect(),
+        Order::Fortran => fortran_to_c(&shape, &values),
     };
-    Ok(([ny, nx], values))
+    Ok((shape, values))
+}
+
+/// Rearranges values stored with the first index fastest (Fortran order) to C order.
+fn fortran_to_c(shape: &[usize], values: &[f64]) -> Vec<f64> {
+    let mut out = Vec::with_capacity(values.len());
+    let mut index = vec![0usize; shape.len()];
+    for _ in 0..values.len() {
+        // the Fortran position of the C multi-index
+        let (mut at, mut stride) = (0, 1);
+        for (k, &i) in index.iter().enumerate() {
+            at += i * stride;
+            stride *= shape[k];
+        }
+        out.push(values[at]);
+        // the next C multi-index: last index fastest
+        for k in (0..shape.len()).rev() {
+            index[k] += 1;
+            if index[k] < shape[k] {
+                break;
+            }
+            index[k] = 0;
+        }
+    }
+    out
+}
+
+#[cfg(feature = "io-npz")]
+/// Reads every array of an `.npz` archive, of any number of dimensions: `(name, shape,
+/// values in C order)` in archive order. Members whose names do not end in `.npy` are
+/// skipped, as `numpy.load` does.
+///
+/// # Errors
+/// Input errors naming the file (and the array): not a zip archive, a truncated or corrupt
+/// member, an unsupported dtype, an archive with no arrays. I/O errors for an unreadable file.
+pub fn read_npz_nd(path: &Path) -> Result<Vec<NdArray>> {
+    let file = std::fs::File::open(path).map_err(|source| Error::Io { path: path.to_path_buf(), source })?;
+    let mut archive = zip::ZipArchive::new(std::io::BufReader::new(file))
+        .map_err(|e| input(path, format!("not a readable .npz (zip) archive: {e}")))?;
+    let mut out = Vec::new();
+    for i in 0..archive.len() {
+        let mut member = archive
+            .by_index(i)
+            .map_err(|e| input(path, format!("cannot read member {} of the archive: {e}", i + 1)))?;
+        let Some(name) = npyz::npz::array_name_from_file_name(member.name()).map(str::to_string) else {
+            continue;
+        };
+        let mut bytes = Vec::with_capacity(member.size().min(1 << 30) as usize);
+        std::io::Read::read_to_end(&mut member, &mut bytes)
+            .map_err(|e| input(path, format!("array `{name}`: cannot read it: {e}")))?;
+        let (shape, values) = decode_npy_nd(&bytes).map_err(|m| input(path, format!("array `{name}`: {m}")))?;
+        out.push((name, shape, values));
+    }
+    if out.is_empty() {
+        return Err(input(path, "the archive holds no .npy arrays"));
+    }
+    Ok(out)
 }
 
 #[cfg(all(test, feature = "io-npz"))]
@@ -266,6 +346,30 @@ mod tests {
             z.write_all(bytes).unwrap();
         }
         z.finish().unwrap();
+    }
+
+    #[test]
+    fn any_dimension_and_fortran_order_in_three() {
+        // shape (2, 3, 2): C-order value = 100 i + 10 j + k, stored with i fastest
+        let mut fortran = Vec::new();
+        for k in 0..2 {
+            for j in 0..3 {
+                for i in 0..2 {
+                    fortran.extend((100.0 * i as f64 + 10.0 * j as f64 + k as f64).to_le_bytes());
+                }
+            }
+        }
+        let (shape, v) = decode_npy_nd(&npy_bytes("<f8", true, "(2, 3, 2)", &fortran)).unwrap();
+        assert_eq!(shape, [2, 3, 2]);
+        let want: Vec<f64> = (0..12).map(|f| (100 * (f / 6) + 10 * (f / 2 % 3) + f % 2) as f64).collect();
+        assert_eq!(v, want);
+        let one: Vec<u8> = [1.0f64, 2.0].iter().flat_map(|x| x.to_be_bytes()).collect();
+        assert_eq!(decode_npy_nd(&npy_bytes(">f8", false, "(2,)", &one)).unwrap(), (vec![2], vec![1.0, 2.0]));
+        let e = decode_npy(&npy_bytes(">f8", false, "(2,)", &one)).unwrap_err().to_string();
+        assert!(e.contains("2D") && e.contains("(2,)"), "{e}");
+        let c = decode_npy_nd(&npy_bytes("<c16", false, "(1,)", &[0; 16])).unwrap_err().to_string();
+        assert!(c.contains("complex"), "{c}");
+        assert_eq!(shape_text(&[]), "()");
     }
 
     #[test]

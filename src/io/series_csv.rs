@@ -1,10 +1,14 @@
-//! Series as CSV: the input (header optional, value column by name or index, optional x
-//! column of numbers or ISO dates) and the verifiable output `x,input,output,u,role`.
+//! Series as CSV: the input (header optional; `,`, `;` or tab separated, decimal commas with
+//! `;` or tab; value column by name or index; optional x column of numbers, ISO dates or
+//! date-times, with or without a UTC offset) and the verifiable output
+//! `X,input,output,u,role[,filled]`.
 
-use super::format_f64;
-use crate::error::{Error, Result};
-use crate::topology::Role;
-use chrono::{NaiveDate, NaiveDateTime};
+use super::csv_dialect::{sniff, Dialect};
+pub use super::series_output::{read_series_output, stage_series_output, write_series_output, SeriesOutput};
+pub use super::timestamps::parse_date_days;
+use super::timestamps::parse_stamp;
+use crate::error::{Error, Location, Result};
+use chrono::NaiveDate;
 use std::path::Path;
 
 /// How the x coordinate was obtained.
@@ -23,12 +27,16 @@ pub enum XSource {
 pub struct SeriesCsv {
     /// Name of the value column (or its index as text when the file has no header).
     pub column: String,
-    /// The values, in file order.
+    /// The values, in file order (NaN where a value is missing, with
+    /// [`SeriesCsvOptions::allow_missing`]).
     pub values: Vec<f64>,
     /// x coordinates (days for dates, index without an x column).
     pub x: Vec<f64>,
-    /// The x column's original text per row (index without an x column), written back out.
+    /// The x column's original text per row (index without an x column; numbers written
+    /// with a decimal comma get a point), written back out.
     pub x_text: Vec<String>,
+    /// The x column's header, written back out (`x` without a header, a name or an x column).
+    pub x_name: String,
     /// Where x came from.
     pub x_source: XSource,
 }
@@ -41,30 +49,8 @@ pub struct SeriesCsvOptions {
     /// x column: a header name or index, or `none`. Default: the first column if it holds
     /// dates or is named x, t, time or date.
     pub x_column: Option<String>,
-}
-
-fn parse_number(s: &str) -> Option<f64> {
-    let t = s.trim();
-    if t.is_empty() {
-        return None;
-    }
-    t.parse::<f64>().ok()
-}
-
-/// Days since 1970-01-01 of an ISO date or date-time (`2010-03-01`, `2010-03-01T12:00:00`).
-pub fn parse_date_days(s: &str) -> Option<f64> {
-    let t = s.trim();
-    let epoch = NaiveDate::from_ymd_opt(1970, 1, 1)?;
-    if let Ok(d) = NaiveDate::parse_from_str(t, "%Y-%m-%d") {
-        return Some((d - epoch).num_days() as f64);
-    }
-    for fmt in ["%Y-%m-%dT%H:%M:%S", "%Y-%m-%d %H:%M:%S", "%Y-%m-%dT%H:%M", "%Y-%m-%d %H:%M"] {
-        if let Ok(dt) = NaiveDateTime::parse_from_str(t, fmt) {
-            let secs = (dt - epoch.and_hms_opt(0, 0, 0)?).num_seconds();
-            return Some(secs as f64 / 86400.0);
-        }
-    }
-    None
+    /// Missing values (empty cells, NaN) are read as NaN, to be filled, instead of refused.
+    pub allow_missing: bool,
 }
 
 #[derive(Clone, Copy, PartialEq)]
@@ -75,17 +61,31 @@ enum Kind {
     Empty,
 }
 
-fn kind(s: &str) -> Kind {
+fn kind(s: &str, dialect: &Dialect) -> Kind {
     let t = s.trim();
     if t.is_empty() {
         Kind::Empty
-    } else if parse_number(t).is_some() {
+    } else if dialect.number(t).is_some() {
         Kind::Number
-    } else if parse_date_days(t).is_some() {
+    } else if parse_stamp(t).is_some() {
         Kind::Date
     } else {
         Kind::Text
     }
+}
+
+/// The kind of column `c` of the data rows: the one kind of its non-empty cells, else text.
+fn column_kind(data: &[Row], c: usize, dialect: &Dialect) -> Kind {
+    let mut k = Kind::Empty;
+    for (_, r) in data {
+        match (k, kind(&r[c], dialect)) {
+            (_, Kind::Empty) => {}
+            (Kind::Empty, x) => k = x,
+            (a, b) if a == b => {}
+            _ => return Kind::Text,
+        }
+    }
+    k
 }
 
 /// Reads a series from a CSV file.
@@ -93,37 +93,24 @@ fn kind(s: &str) -> Kind {
 /// # Errors
 /// Input errors naming the file and the line: unreadable file, empty file, ragged rows, an
 /// unknown column, no numeric column, a missing or non-numeric value, NaN or infinity, x
-/// values that do not strictly increase, fewer than 2 samples.
+/// values that do not strictly increase or mix times with and without a UTC offset, fewer
+/// than 2 samples.
 pub fn read_series(path: &Path, options: &SeriesCsvOptions) -> Result<SeriesCsv> {
     let err = |msg: String| Error::input(msg).in_file(path);
-    let rows = read_rows(path)?;
+    let (rows, dialect) = read_rows(path)?;
     let ncols = rows[0].1.len();
-    // a header: a cell that is text where the next row holds a number or a date
+    // a header: a cell that is text where the first non-empty cell below is a number or a date
+    let below = |c: usize| rows[1..].iter().map(|(_, r)| kind(&r[c], &dialect)).find(|k| *k != Kind::Empty);
     let has_header = rows.len() >= 2
-        && (0..ncols)
-            .any(|c| kind(&rows[0].1[c]) == Kind::Text && matches!(kind(&rows[1].1[c]), Kind::Number | Kind::Date));
+        && (0..ncols).any(|c| {
+            kind(&rows[0].1[c], &dialect) == Kind::Text && matches!(below(c), Some(Kind::Number | Kind::Date))
+        });
     let names: Vec<String> = if has_header { rows[0].1.clone() } else { (0..ncols).map(|c| c.to_string()).collect() };
     let data = if has_header { &rows[1..] } else { &rows[..] };
     if data.is_empty() {
         return Err(err("the file has a header but no data rows".into()));
     }
-    let column_kind = |c: usize| -> Kind {
-        let mut k = Kind::Empty;
-        for (_, r) in data {
-            match (k, kind(&r[c])) {
-                (_, Kind::Empty) => {}
-                (Kind::Empty, x) => k = x,
-                (a, b) if a == b => {}
-                (Kind::Number, Kind::Text) | (Kind::Text, Kind::Number) => {
-                    // NaN / inf spelled as text count as numbers; anything else makes it text
-                    return Kind::Text;
-                }
-                _ => return Kind::Text,
-            }
-        }
-        k
-    };
-    let kinds: Vec<Kind> = (0..ncols).map(column_kind).collect();
+    let kinds: Vec<Kind> = (0..ncols).map(|c| column_kind(data, c, &dialect)).collect();
     let find = |spec: &str| -> Result<usize> {
         if let Some(c) = names.iter().position(|n| n == spec) {
             return Ok(c);
@@ -140,7 +127,11 @@ pub fn read_series(path: &Path, options: &SeriesCsvOptions) -> Result<SeriesCsv>
     let value_col = match &options.column {
         Some(spec) => find(spec)?,
         None => (0..ncols).rev().find(|&c| kinds[c] == Kind::Number && Some(c) != explicit_x).ok_or_else(|| {
-            err(format!("no numeric column (columns: {}); choose the value column by name or index", names.join(", ")))
+            err(format!(
+                "no numeric column (columns: {}; read as {}); choose the value column by name or index",
+                names.join(", "),
+                dialect.describe()
+            ))
         })?,
     };
     let x_col = match options.x_column.as_deref() {
@@ -154,35 +145,47 @@ pub fn read_series(path: &Path, options: &SeriesCsvOptions) -> Result<SeriesCsv>
     if x_col == Some(value_col) {
         return Err(err(format!("the x column and the value column are both `{}`", names[value_col])));
     }
-    let values = values_of(path, data, value_col, &names[value_col])?;
+    let read = Cells { path, data, dialect };
+    let values = read.values(value_col, &names[value_col], options.allow_missing)?;
     let (x, x_text, x_source) = match x_col {
         None => (
             (0..values.len()).map(|i| i as f64).collect(),
             (0..values.len()).map(|i| i.to_string()).collect(),
             XSource::Index,
         ),
-        Some(c) => x_of(path, data, &names[c], c, kinds[c] == Kind::Date)?,
+        Some(c) => read.x(&names[c], c, kinds[c] == Kind::Date)?,
     };
     if values.len() < 2 {
         return Err(err(format!("a series needs at least 2 samples, found {}", values.len())));
     }
-    Ok(SeriesCsv { column: names[value_col].clone(), values, x, x_text, x_source })
+    let x_name = match x_col {
+        Some(c) if has_header && !names[c].trim().is_empty() => names[c].clone(),
+        _ => "x".to_string(),
+    };
+    Ok(SeriesCsv { column: names[value_col].clone(), values, x, x_text, x_name, x_source })
 }
 
 /// One CSV row: its line in the file and its cells.
 type Row = (u64, Vec<String>);
 
-/// The non-empty rows of a CSV file (UTF-8, a byte-order mark dropped), with their lines.
-fn read_rows(path: &Path) -> Result<Vec<Row>> {
+/// The non-empty rows of a CSV file (UTF-8, a byte-order mark dropped), with their lines,
+/// and the file's dialect.
+fn read_rows(path: &Path) -> Result<(Vec<Row>, Dialect)> {
     let err = |msg: String| Error::input(msg).in_file(path);
     let bytes = std::fs::read(path).map_err(|source| Error::Io { path: path.to_path_buf(), source })?;
+    super::content::expect_text(path, &bytes, "CSV text")?;
     let text =
         String::from_utf8(bytes).map_err(|e| err(format!("not UTF-8 text (byte {})", e.utf8_error().valid_up_to())))?;
     let text = text.strip_prefix('\u{feff}').unwrap_or(&text);
-    let mut reader = csv::ReaderBuilder::new().has_headers(false).trim(csv::Trim::All).from_reader(text.as_bytes());
+    let dialect = sniff(text);
+    let mut reader = csv::ReaderBuilder::new()
+        .has_headers(false)
+        .delimiter(dialect.delimiter)
+        .trim(csv::Trim::All)
+        .from_reader(text.as_bytes());
     let mut rows: Vec<Row> = Vec::new();
     for rec in reader.records() {
-        let rec = rec.map_err(|e| err(format!("malformed CSV: {e}")))?;
+        let rec = rec.map_err(|e| err(format!("malformed CSV ({}): {e}", dialect.describe())))?;
         let line = rec.position().map(|p| p.line()).unwrap_or(0);
         if rec.iter().all(|c| c.is_empty()) {
             continue;
@@ -192,158 +195,97 @@ fn read_rows(path: &Path) -> Result<Vec<Row>> {
     if rows.is_empty() {
         return Err(err("the file is empty".into()));
     }
-    Ok(rows)
+    Ok((rows, dialect))
 }
 
-/// The values of column `col` (named `name`): numbers, finite.
-fn values_of(path: &Path, data: &[Row], col: usize, name: &str) -> Result<Vec<f64>> {
-    let err = |msg: String| Error::input(msg).in_file(path);
-    let mut values = Vec::with_capacity(data.len());
-    for (line, r) in data {
-        let cell = &r[col];
-        let v = parse_number(cell).ok_or_else(|| {
-            if cell.trim().is_empty() {
-                err(format!("line {line}: missing value in column `{}`", name))
-                    .at(crate::error::Location::Line(*line as usize))
-            } else {
-                err(format!("line {line}: `{cell}` in column `{}` is not a number", name))
-                    .at(crate::error::Location::Line(*line as usize))
+/// The data rows of a file, read column by column.
+struct Cells<'a> {
+    path: &'a Path,
+    data: &'a [Row],
+    dialect: Dialect,
+}
+
+impl Cells<'_> {
+    fn error(&self, line: u64, msg: String) -> Error {
+        Error::input(format!("line {line}: {msg}")).at(Location::Line(line as usize)).in_file(self.path)
+    }
+
+    /// The values of column `col` (named `name`): finite numbers, or NaN where one is
+    /// missing (an empty cell or NaN) when `allow_missing`.
+    fn values(&self, col: usize, name: &str, allow_missing: bool) -> Result<Vec<f64>> {
+        let hint = "; --fill-missing fills missing values linearly in x";
+        let mut values = Vec::with_capacity(self.data.len());
+        for (line, r) in self.data {
+            let cell = &r[col];
+            let v = match self.dialect.number(cell) {
+                Some(v) => v,
+                None if cell.trim().is_empty() && allow_missing => f64::NAN,
+                None if cell.trim().is_empty() => {
+                    return Err(self.error(*line, format!("missing value in column `{name}`{hint}")))
+                }
+                None => return Err(self.error(*line, format!("`{cell}` in column `{name}` is not a number"))),
+            };
+            if v.is_infinite() || (v.is_nan() && !allow_missing) {
+                let why = if v.is_nan() { hint } else { "" };
+                return Err(self.error(*line, format!("value {v} in column `{name}` is not finite{why}")));
             }
-        })?;
-        if !v.is_finite() {
-            return Err(err(format!("line {line}: value {v} in column `{}` is not finite", name))
-                .at(crate::error::Location::Line(*line as usize)));
+            values.push(v);
         }
-        values.push(v);
+        Ok(values)
     }
-    Ok(values)
-}
 
-/// The x axis from column `c` (named `name`): dates (days since 1970) or numbers, strictly
-/// increasing, with their text.
-fn x_of(path: &Path, data: &[Row], name: &str, c: usize, dates: bool) -> Result<(Vec<f64>, Vec<String>, XSource)> {
-    let err = |msg: String| Error::input(msg).in_file(path);
-    let mut x = Vec::with_capacity(data.len());
-    let mut text = Vec::with_capacity(data.len());
-    for (line, r) in data {
-        let cell = r[c].trim();
-        let v = if dates { parse_date_days(cell) } else { parse_number(cell) }.filter(|v| v.is_finite());
-        let v = v.ok_or_else(|| {
-            err(format!(
-                "line {line}: `{cell}` in x column `{}` is not a {}",
-                name,
-                if dates { "date" } else { "finite number" }
-            ))
-        })?;
-        x.push(v);
-        text.push(cell.to_string());
-    }
-    if let Some(i) = (1..x.len()).find(|&i| x[i] <= x[i - 1]) {
-        return Err(err(format!(
-            "line {}: x column `{}` must strictly increase, but `{}` follows `{}`",
-            data[i].0,
-            name,
-            text[i],
-            text[i - 1]
-        )));
-    }
-    let source = if dates {
-        let first = NaiveDate::from_ymd_opt(1970, 1, 1).expect("valid") + chrono::Duration::days(x[0].floor() as i64);
-        XSource::Dates(name.to_string(), first)
-    } else {
-        XSource::Numeric(name.to_string())
-    };
-    Ok((x, text, source))
-}
-
-/// The verifiable output of `smooth` on a series.
-#[derive(Clone, Debug, PartialEq)]
-pub struct SeriesOutput {
-    /// x as text (dates stay dates).
-    pub x_text: Vec<String>,
-    /// The input values actually smoothed.
-    pub input: Vec<f64>,
-    /// The certified output.
-    pub output: Vec<f64>,
-    /// The representative function.
-    pub u: Vec<f64>,
-    /// Role per sample.
-    pub roles: Vec<Role>,
-}
-
-/// Writes `x,input,output,u,role` atomically, doubles in shortest round-trip form.
-pub fn write_series_output(path: &Path, out: &SeriesOutput) -> Result<()> {
-    stage_series_output(path, out)?.commit()
-}
-
-/// Stages the file of [`write_series_output`] (see [`super::Staged`]).
-pub fn stage_series_output(path: &Path, out: &SeriesOutput) -> Result<super::Staged> {
-    super::stage(path, |w| {
-        writeln!(w, "x,input,output,u,role")?;
-        for i in 0..out.input.len() {
-            writeln!(
-                w,
-                "{},{},{},{},{}",
-                csv_cell(&out.x_text[i]),
-                format_f64(out.input[i]),
-                format_f64(out.output[i]),
-                format_f64(out.u[i]),
-                out.roles[i].label()
-            )?;
+    /// The x axis from column `c` (named `name`): dates (days since 1970, aware ones at their
+    /// instant) or numbers, strictly increasing, with their text.
+    fn x(&self, name: &str, c: usize, dates: bool) -> Result<(Vec<f64>, Vec<String>, XSource)> {
+        let mut x = Vec::with_capacity(self.data.len());
+        let mut text = Vec::with_capacity(self.data.len());
+        let mut first_aware: Option<(bool, u64, String)> = None;
+        for (line, r) in self.data {
+            let cell = r[c].trim();
+            let v = if dates {
+                parse_stamp(cell).map(|s| {
+                    match &first_aware {
+                        None => first_aware = Some((s.aware, *line, cell.to_string())),
+                        Some((aware, at, first)) if *aware != s.aware => {
+                            let (with, without) =
+                                if s.aware { ("has a", "has none") } else { ("has no", "has one") };
+                            return Err(self.error(
+                                *line,
+                                format!(
+                                    "`{cell}` in x column `{name}` {with} UTC offset but `{first}` (line {at}) {without}: \
+                                     a column cannot mix times with and without a time zone"
+                                ),
+                            ));
+                        }
+                        _ => {}
+                    }
+                    Ok(s.days)
+                })
+            } else {
+                self.dialect.number(cell).map(Ok)
+            };
+            let v = v.transpose()?.filter(|v| v.is_finite()).ok_or_else(|| {
+                let what = if dates { "date" } else { "finite number" };
+                self.error(*line, format!("`{cell}` in x column `{name}` is not a {what}"))
+            })?;
+            x.push(v);
+            text.push(if dates || !self.dialect.decimal_comma { cell.to_string() } else { cell.replace(',', ".") });
         }
-        Ok(())
-    })
-}
-
-fn csv_cell(s: &str) -> String {
-    if s.contains([',', '"', '\n']) {
-        format!("\"{}\"", s.replace('"', "\"\""))
-    } else {
-        s.to_string()
-    }
-}
-
-/// Reads a file written by [`write_series_output`].
-///
-/// # Errors
-/// Input errors naming the file and line: missing columns, unparsable numbers, unknown roles.
-pub fn read_series_output(path: &Path) -> Result<SeriesOutput> {
-    let err = |msg: String| Error::input(msg).in_file(path);
-    let file = std::fs::File::open(path).map_err(|source| Error::Io { path: path.to_path_buf(), source })?;
-    let mut reader = csv::ReaderBuilder::new().has_headers(true).trim(csv::Trim::All).from_reader(file);
-    let header = reader.headers().map_err(|e| err(format!("malformed CSV: {e}")))?.clone();
-    let col = |name: &str| {
-        header.iter().position(|h| h == name).ok_or_else(|| {
-            err(format!("no `{name}` column: a verifiable series file has the header x,input,output,u,role"))
-        })
-    };
-    let (ci, co, cu, cr) = (col("input")?, col("output")?, col("u")?, col("role")?);
-    let cx = header.iter().position(|h| h == "x");
-    let mut out = SeriesOutput { x_text: vec![], input: vec![], output: vec![], u: vec![], roles: vec![] };
-    for rec in reader.records() {
-        let rec = rec.map_err(|e| err(format!("malformed CSV: {e}")))?;
-        let line = rec.position().map(|p| p.line()).unwrap_or(0);
-        let num = |c: usize, name: &str| -> Result<f64> {
-            let cell = rec.get(c).unwrap_or("");
-            cell.parse::<f64>().map_err(|_| {
-                err(format!("line {line}: `{cell}` in column `{name}` is not a number"))
-                    .at(crate::error::Location::Line(line as usize))
-            })
+        if let Some(i) = (1..x.len()).find(|&i| x[i] <= x[i - 1]) {
+            return Err(self.error(
+                self.data[i].0,
+                format!("x column `{name}` must strictly increase, but `{}` follows `{}`", text[i], text[i - 1]),
+            ));
+        }
+        let source = if dates {
+            let first =
+                NaiveDate::from_ymd_opt(1970, 1, 1).expect("valid") + chrono::Duration::days(x[0].floor() as i64);
+            XSource::Dates(name.to_string(), first)
+        } else {
+            XSource::Numeric(name.to_string())
         };
-        out.input.push(num(ci, "input")?);
-        out.output.push(num(co, "output")?);
-        out.u.push(num(cu, "u")?);
-        let role = rec.get(cr).unwrap_or("");
-        out.roles.push(Role::from_label(role).ok_or_else(|| {
-            err(format!("line {line}: unknown role `{role}` (min, max, fixed, end or empty)"))
-                .at(crate::error::Location::Line(line as usize))
-        })?);
-        out.x_text.push(cx.and_then(|c| rec.get(c)).unwrap_or("").to_string());
+        Ok((x, text, source))
     }
-    if out.input.len() < 2 {
-        return Err(err(format!("a series needs at least 2 samples, found {}", out.input.len())));
-    }
-    Ok(out)
 }
 
 #[cfg(test)]
@@ -369,7 +311,11 @@ mod tests {
         assert!(matches!(s.x_source, XSource::Dates(_, d) if d == NaiveDate::from_ymd_opt(2010, 3, 1).unwrap()));
         let s = read_series(&p, &SeriesCsvOptions { column: Some("a".into()), ..Default::default() }).unwrap();
         assert_eq!(s.values, vec![1.0, 2.0, 3.0]);
-        let s = read_series(&p, &SeriesCsvOptions { column: Some("1".into()), x_column: Some("none".into()) }).unwrap();
+        let s = read_series(
+            &p,
+            &SeriesCsvOptions { column: Some("1".into()), x_column: Some("none".into()), ..Default::default() },
+        )
+        .unwrap();
         assert_eq!((s.values.clone(), s.x_source), (vec![1.0, 2.0, 3.0], XSource::Index));
     }
 
@@ -408,19 +354,69 @@ mod tests {
     }
 
     #[test]
-    fn output_round_trips_bit_for_bit() {
-        let out = SeriesOutput {
-            x_text: vec!["2010-01-01".into(), "2010-01-04".into(), "a,b".into()],
-            input: vec![0.1, 1.0 / 3.0, -7e-300],
-            output: vec![0.1, 0.2 + 0.1, -7e-300],
-            u: vec![0.1, 0.5, -1.0],
-            roles: vec![Role::Min, Role::Other, Role::End],
-        };
-        let dir = std::env::temp_dir().join(format!("toposmooth-csv-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        let p = dir.join("out.csv");
-        write_series_output(&p, &out).unwrap();
-        let back = read_series_output(&p).unwrap();
-        assert_eq!(back, out);
+    fn separators_decimal_commas_and_x_names() {
+        let opts = SeriesCsvOptions::default();
+        let p = tmp("semi.csv", "depth;temp\n0,5;1,0\n1,5;2,25\n3;-1,5\n");
+        let s = read_series(&p, &opts).unwrap();
+        assert_eq!(
+            (s.column.as_str(), s.x_name.as_str()),
+            ("temp", "x"),
+            "depth is not a name the x column takes by default"
+        );
+        assert_eq!(s.values, vec![1.0, 2.25, -1.5]);
+        let s = read_series(&p, &SeriesCsvOptions { x_column: Some("depth".into()), ..Default::default() }).unwrap();
+        assert_eq!(
+            (s.x.clone(), s.x_text.clone(), s.x_name.as_str()),
+            (vec![0.5, 1.5, 3.0], vec!["0.5".to_string(), "1.5".into(), "3".into()], "depth")
+        );
+        let p = tmp("tab.tsv", "time\tv\n1\t3\n2\t1\n4\t2\n");
+        let s = read_series(&p, &opts).unwrap();
+        assert_eq!(
+            (s.x.clone(), s.values.clone(), s.x_name.as_str()),
+            (vec![1.0, 2.0, 4.0], vec![3.0, 1.0, 2.0], "time")
+        );
+        // pandas' unnamed index column: dates make it x, its empty name becomes `x`
+        let p = tmp("unnamed.csv", ",load\n2015-01-01,1\n2015-01-02,2\n");
+        let s = read_series(&p, &opts).unwrap();
+        assert_eq!((s.x_name.as_str(), s.x[1] - s.x[0]), ("x", 1.0));
+    }
+
+    #[test]
+    fn aware_timestamps_at_their_instant() {
+        let opts = SeriesCsvOptions::default();
+        // the night the clocks go back in Berlin: naive, the fourth row would repeat the third
+        let p = tmp("dst.csv", ",load\n2015-10-25 01:00:00+02:00,1\n2015-10-25 02:00:00+02:00,2\n2015-10-25 02:00:00+01:00,3\n2015-10-25 03:00:00+01:00,4\n");
+        let s = read_series(&p, &opts).unwrap();
+        assert!(matches!(s.x_source, XSource::Dates(..)), "{:?}", s.x_source);
+        for w in s.x.windows(2) {
+            assert!((w[1] - w[0] - 1.0 / 24.0).abs() < 1e-9, "{:?}", s.x);
+        }
+        assert_eq!(s.x_text[2], "2015-10-25 02:00:00+01:00");
+        let p = tmp("z.csv", "t,v\n2015-01-01T00:00:00Z,1\n2015-01-01T12:00:00Z,2\n2015-01-02T00:00:00Z,1\n");
+        let s = read_series(&p, &opts).unwrap();
+        assert_eq!(s.x[1] - s.x[0], 0.5);
+        let p =
+            tmp("mixed.csv", "t,v\n2015-01-01 00:00:00+01:00,1\n2015-01-01 01:00:00+01:00,2\n2015-01-01 03:00:00,1\n");
+        let e = read_series(&p, &opts).unwrap_err();
+        let msg = e.to_string();
+        assert!(
+            msg.contains("mixed.csv") && msg.contains("line 4") && msg.contains("line 2") && msg.contains("time zone"),
+            "{msg}"
+        );
+        assert_eq!(e.location(), Some(crate::error::Location::Line(4)));
+    }
+
+    #[test]
+    fn missing_values_kept_as_nan_when_allowed() {
+        let p = tmp("gaps.csv", "t,v\n0,1\n1,\n2,NaN\n3,4\n");
+        let e = read_series(&p, &SeriesCsvOptions::default()).unwrap_err().to_string();
+        assert!(e.contains("line 3") && e.contains("--fill-missing"), "{e}");
+        let s = read_series(&p, &SeriesCsvOptions { allow_missing: true, ..Default::default() }).unwrap();
+        assert_eq!(s.values[0], 1.0);
+        assert!(s.values[1].is_nan() && s.values[2].is_nan());
+        let p = tmp("inf.csv", "t,v\n0,1\n1,inf\n2,3\n");
+        let e =
+            read_series(&p, &SeriesCsvOptions { allow_missing: true, ..Default::default() }).unwrap_err().to_string();
+        assert!(e.contains("line 3") && e.contains("not finite"), "{e}");
     }
 }

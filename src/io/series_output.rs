@@ -1,0 +1,200 @@
+//! The verifiable output of `smooth` on a series (SPEC.md "Formats"): the CSV
+//! `X,input,output,u,role`, X the input's x column name (`x` when it has none), plus a last
+//! column `filled` when missing samples were filled; and reading it back for `verify`.
+
+use super::format_f64;
+use crate::error::{Error, Location, Result};
+use crate::topology::Role;
+use std::path::Path;
+
+/// The verifiable output of `smooth` on a series.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SeriesOutput {
+    /// The x column's header.
+    pub x_name: String,
+    /// x as text (dates stay dates).
+    pub x_text: Vec<String>,
+    /// The input values actually smoothed (after filling).
+    pub input: Vec<f64>,
+    /// The certified output.
+    pub output: Vec<f64>,
+    /// The representative function.
+    pub u: Vec<f64>,
+    /// Role per sample.
+    pub roles: Vec<Role>,
+    /// Samples filled by `--fill-missing` (true), when any were.
+    pub filled: Option<Vec<bool>>,
+}
+
+/// The columns after X.
+const COLUMNS: [&str; 4] = ["input", "output", "u", "role"];
+
+/// Writes `X,input,output,u,role[,filled]` atomically, doubles in shortest round-trip form.
+pub fn write_series_output(path: &Path, out: &SeriesOutput) -> Result<()> {
+    stage_series_output(path, out)?.commit()
+}
+
+/// Stages the file of [`write_series_output`] (see [`super::Staged`]).
+pub fn stage_series_output(path: &Path, out: &SeriesOutput) -> Result<super::Staged> {
+    let filled = out.filled.as_ref().filter(|f| f.iter().any(|&b| b));
+    super::stage(path, |w| {
+        writeln!(
+            w,
+            "{},{}{}",
+            csv_cell(&out.x_name),
+            COLUMNS.join(","),
+            if filled.is_some() { ",filled" } else { "" }
+        )?;
+        for i in 0..out.input.len() {
+            write!(
+                w,
+                "{},{},{},{},{}",
+                csv_cell(&out.x_text[i]),
+                format_f64(out.input[i]),
+                format_f64(out.output[i]),
+                format_f64(out.u[i]),
+                out.roles[i].label()
+            )?;
+            match filled {
+                Some(f) => writeln!(w, ",{}", u8::from(f[i]))?,
+                None => writeln!(w)?,
+            }
+        }
+        Ok(())
+    })
+}
+
+fn csv_cell(s: &str) -> String {
+    if s.contains([',', '"', '\n', '\r']) || s.trim() != s {
+        format!("\"{}\"", s.replace('"', "\"\""))
+    } else {
+        s.to_string()
+    }
+}
+
+/// The positions of X (if any), input, output, u, role and filled (if any) in a header:
+/// X first and the others after it in SPEC's order, else by name (X then the column `x`).
+fn positions(header: &csv::StringRecord) -> Option<(Option<usize>, [usize; 4], Option<usize>)> {
+    let cells: Vec<&str> = header.iter().collect();
+    if cells.len() >= 5 && cells[1..5] == COLUMNS {
+        let filled = (cells.get(5) == Some(&"filled")).then_some(5);
+        return Some((Some(0), [1, 2, 3, 4], filled));
+    }
+    let at = |name: &str| cells.iter().position(|h| *h == name);
+    let [i, o, u, r] = COLUMNS.map(at);
+    Some((at("x"), [i?, o?, u?, r?], at("filled")))
+}
+
+/// Reads a file written by [`write_series_output`].
+///
+/// # Errors
+/// Input errors naming the file and line: missing columns, unparsable numbers, unknown roles,
+/// a `filled` cell that is not 0 or 1.
+pub fn read_series_output(path: &Path) -> Result<SeriesOutput> {
+    let err = |msg: String| Error::input(msg).in_file(path);
+    let bytes = std::fs::read(path).map_err(|source| Error::Io { path: path.to_path_buf(), source })?;
+    super::content::expect_text(path, &bytes, "a series CSV (X,input,output,u,role)")?;
+    let mut reader = csv::ReaderBuilder::new().has_headers(true).trim(csv::Trim::All).from_reader(bytes.as_slice());
+    let header = reader.headers().map_err(|e| err(format!("malformed CSV: {e}")))?.clone();
+    let (cx, [ci, co, cu, cr], cf) = positions(&header).ok_or_else(|| {
+        err(format!(
+            "the header `{}` is not a verifiable series file's X,input,output,u,role",
+            header.iter().collect::<Vec<_>>().join(",")
+        ))
+    })?;
+    let x_name = cx.and_then(|c| header.get(c)).unwrap_or("x").to_string();
+    let mut out =
+        SeriesOutput { x_name, x_text: vec![], input: vec![], output: vec![], u: vec![], roles: vec![], filled: None };
+    let mut filled = Vec::new();
+    for rec in reader.records() {
+        let rec = rec.map_err(|e| err(format!("malformed CSV: {e}")))?;
+        let line = rec.position().map(|p| p.line()).unwrap_or(0);
+        let bad = |msg: String| err(format!("line {line}: {msg}")).at(Location::Line(line as usize));
+        let num = |c: usize, name: &str| -> Result<f64> {
+            let cell = rec.get(c).unwrap_or("");
+            cell.parse::<f64>().map_err(|_| bad(format!("`{cell}` in column `{name}` is not a number")))
+        };
+        out.input.push(num(ci, "input")?);
+        out.output.push(num(co, "output")?);
+        out.u.push(num(cu, "u")?);
+        let role = rec.get(cr).unwrap_or("");
+        out.roles.push(
+            Role::from_label(role)
+                .ok_or_else(|| bad(format!("unknown role `{role}` (min, max, fixed, end or empty)")))?,
+        );
+        out.x_text.push(cx.and_then(|c| rec.get(c)).unwrap_or("").to_string());
+        if let Some(c) = cf {
+            filled.push(match rec.get(c).unwrap_or("") {
+                "1" => true,
+                "0" => false,
+                other => return Err(bad(format!("`{other}` in column `filled` is not 0 or 1"))),
+            });
+        }
+    }
+    if out.input.len() < 2 {
+        return Err(err(format!("a series needs at least 2 samples, found {}", out.input.len())));
+    }
+    out.filled = cf.map(|_| filled);
+    Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn dir() -> std::path::PathBuf {
+        let d = std::env::temp_dir().join(format!("toposmooth-series-out-{}", std::process::id()));
+        std::fs::create_dir_all(&d).unwrap();
+        d
+    }
+
+    fn sample(x_name: &str, filled: Option<Vec<bool>>) -> SeriesOutput {
+        SeriesOutput {
+            x_name: x_name.into(),
+            x_text: vec!["2010-01-01".into(), "2010-01-04".into(), "a,b".into()],
+            input: vec![0.1, 1.0 / 3.0, -7e-300],
+            output: vec![0.1, 0.2 + 0.1, -7e-300],
+            u: vec![0.1, 0.5, -1.0],
+            roles: vec![Role::Min, Role::Other, Role::End],
+            filled,
+        }
+    }
+
+    #[test]
+    fn output_round_trips_bit_for_bit() {
+        let p = dir().join("out.csv");
+        for out in [
+            sample("date", None),
+            sample("x", Some(vec![false, true, false])),
+            sample("u", None),
+            sample("a \"b\", c", None),
+        ] {
+            write_series_output(&p, &out).unwrap();
+            assert_eq!(read_series_output(&p).unwrap(), out);
+        }
+        let text = std::fs::read_to_string(&p).unwrap();
+        assert!(text.starts_with("\"a \"\"b\"\", c\",input,output,u,role\n"), "{text}");
+        write_series_output(&p, &sample("when", Some(vec![false, true, false]))).unwrap();
+        let text = std::fs::read_to_string(&p).unwrap();
+        assert!(text.starts_with("when,input,output,u,role,filled\n2010-01-01,0.1,0.1,0.1,min,0\n"), "{text}");
+        // nothing filled: no column
+        write_series_output(&p, &sample("when", Some(vec![false; 3]))).unwrap();
+        let back = read_series_output(&p).unwrap();
+        assert_eq!(back.filled, None);
+        assert!(std::fs::read_to_string(&p).unwrap().starts_with("when,input,output,u,role\n"));
+    }
+
+    #[test]
+    fn older_and_bad_files() {
+        let p = dir().join("old.csv");
+        std::fs::write(&p, "input,output,u,role\n0,0,0,min\n1,1,1,max\n").unwrap();
+        let back = read_series_output(&p).unwrap();
+        assert_eq!((back.x_name.as_str(), back.x_text.clone()), ("x", vec![String::new(), String::new()]));
+        std::fs::write(&p, "t,input,output,u,role,filled\n0,0,0,0,min,0\n1,1,1,1,max,2\n").unwrap();
+        let e = read_series_output(&p).unwrap_err().to_string();
+        assert!(e.contains("old.csv") && e.contains("line 3") && e.contains("not 0 or 1"), "{e}");
+        std::fs::write(&p, "a,b\n1,2\n").unwrap();
+        let e = read_series_output(&p).unwrap_err().to_string();
+        assert!(e.contains("old.csv") && e.contains("X,input,output,u,role"), "{e}");
+    }
+}

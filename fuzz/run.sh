@@ -31,8 +31,8 @@ seed vtk_legacy $F/*.vtk
 seed obj $ROOT/datasets/horse_silhouette_2d.obj
 seed off
 seed ply
-seed npy
-seed npz
+seed npy $ROOT/tests/fixtures/pandas/*.npy
+seed npz $ROOT/tests/fixtures/pandas/*.npz
 seed grid_csv $ROOT/datasets/soapfilm_piv_vorticity_63x63.csv
 seed series_csv $ROOT/datasets/seattle_weather_daily_2012_2015.csv
 seed png $ROOT/datasets/horse_mask.png
@@ -44,6 +44,8 @@ printf 'OFF\n4 2 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n3 0 1 2\n3 0 2 3\n' > corpus/off
 printf 'ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nproperty float f\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0 1\n1 0 0 2\n0 1 0 3\n3 0 1 2\n' > corpus/ply/seed-tri.ply
 printf '<svg xmlns="http://www.w3.org/2000/svg" width="100" height="100"><rect x="10" y="10" width="80" height="60"/><circle cx="50" cy="40" r="10" fill="white"/></svg>\n' > corpus/svg/seed-rect.svg
 printf '1,2,3\n4,5,6\n7,8,0\n' > corpus/grid_csv/seed-small.csv
+# a 4 x 3 8-bit grayscale TIFF, uncompressed
+printf 'II*\0\010\0\0\0\011\0\0\001\003\0\001\0\0\0\004\0\0\0\001\001\003\0\001\0\0\0\003\0\0\0\002\001\003\0\001\0\0\0\010\0\0\0\003\001\003\0\001\0\0\0\001\0\0\0\006\001\003\0\001\0\0\0\001\0\0\0\021\001\004\0\001\0\0\0\172\0\0\0\025\001\003\0\001\0\0\0\001\0\0\0\026\001\003\0\001\0\0\0\003\0\0\0\027\001\004\0\001\0\0\0\014\0\0\0\0\0\0\0\0\001\002\003\004\005\006\007\010\011\012\013' > corpus/tiff/seed-4x3.tif
 export TOPOSMOOTH_FUZZ_DIR="${TOPOSMOOTH_FUZZ_DIR:-/dev/shm}"
 : > last-run.txt
 for t in $TARGETS; do

@@ -54,7 +54,7 @@ for t in $TARGETS; do
     # -rss_limit_mb: a run whose memory grows past it is a crash (inputs are at most 64 kB);
     # under AddressSanitizer -malloc_limit_mb also catches any single allocation above it
     cargo +nightly fuzz run "$t" --release -s "${FUZZ_SANITIZER:-none}" -- -max_total_time="$SECONDS_EACH" -max_len=65536 \
-        -rss_limit_mb=4096 -malloc_limit_mb=512 -print_final_stats=1 >"$log" 2>&1 || true
+        -rss_limit_mb=4096 -malloc_limit_mb=512 -timeout=10 -print_final_stats=1 >"$log" 2>&1 || true
     runs=$(grep -a -o 'stat::number_of_executed_units: *[0-9]*' "$log" | grep -o '[0-9]*$' | tail -1)
     crashes=$(find "artifacts/$t" -type f \( -name 'crash-*' -o -name 'oom-*' -o -name 'leak-*' -o -name 'timeout-*' \) | wc -l)
     if [ "$crashes" -gt 0 ]; then

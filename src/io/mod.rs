@@ -8,6 +8,7 @@ pub mod export;
 pub mod grid;
 #[cfg(feature = "io-vtk")]
 pub mod mesh;
+mod npy_header;
 pub mod npy_input;
 pub mod npz;
 pub mod series_csv;

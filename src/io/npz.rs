@@ -133,6 +133,7 @@ pub fn shape_text(shape: &[usize]) -> String {
 /// dates, objects), truncated data or bytes after it.
 pub fn decode_npy_nd(bytes: &[u8]) -> Result<(Vec<usize>, Vec<f64>)> {
     use npyz::{DType, Order, TypeChar};
+    super::npy_header::check(bytes)?;
     let npy = npyz::NpyFile::new(bytes).map_err(|e| Error::input(format!("not a readable .npy array: {e}")))?;
     let shape: Vec<usize> = npy.shape().iter().map(|&d| d as usize).collect();
     let order = npy.order();

@@ -188,60 +188,57 @@ impl Numbers {
 /// when `count` is `None`). Integers are parsed as integers (exact beyond 2⁵³); `nan`, `inf`
 /// and `-inf` are accepted for floats, as VTK writes them.
 pub(crate) fn parse_ascii(ty: Scalar, text: &[u8], count: Option<usize>, what: &str) -> Result<Numbers> {
-    let (count, fixed) = match count {
-        Some(c) => (c, true),
-        None => (usize::MAX, false),
-    };
     let text = std::str::from_utf8(text).map_err(|_| Error::input(format!("{what}: the ascii data is not text")))?;
+    let (numbers, end) = parse_tokens(ty, text, count.unwrap_or(usize::MAX), what)?;
+    if let Some(count) = count {
+        let found = numbers.len() + text[end..].split_ascii_whitespace().count();
+        if found != count {
+            return Err(Error::input(format!("{what} holds {found} values, {count} are needed")));
+        }
+    }
+    Ok(numbers)
+}
+
+/// Parses at most `limit` numbers of type `ty` from the start of `text`; returns them and the
+/// byte offset after the last one read (fewer than `limit` if the text ends first).
+pub(crate) fn parse_tokens(ty: Scalar, text: &str, limit: usize, what: &str) -> Result<(Numbers, usize)> {
     // a number takes at least 2 bytes with its separator: never reserve more than that allows
-    let cap = count.min(text.len() / 2 + 1);
+    let cap = limit.min(text.len() / 2 + 1);
     let bad = |k: usize, tok: &str| Error::input(format!("{what}: value {} (`{tok}`) is not a number", k + 1));
     let range = |k: usize, tok: &str| {
         Error::input(format!("{what}: value {} (`{tok}`) is out of range for the array's type", k + 1))
     };
-    let mut tokens = text.split_ascii_whitespace();
-    let numbers = if ty.is_float() {
-        let mut out = Vec::with_capacity(cap);
-        for (k, tok) in tokens.by_ref().take(count).enumerate() {
-            // a Float32 array holds the float nearest the text, as VTK reads it
-            let v = if ty == Scalar::F32 {
-                f64::from(tok.parse::<f32>().map_err(|_| bad(k, tok))?)
-            } else {
-                tok.parse::<f64>().map_err(|_| bad(k, tok))?
-            };
-            out.push(v);
-        }
-        Numbers::Float(out)
+    let bits = 8 * ty.size() as u32;
+    let (lo, hi) =
+        if ty.is_signed() { (-(1i128 << (bits - 1)), (1i128 << (bits - 1)) - 1) } else { (0, (1i128 << bits) - 1) };
+    let mut numbers = if ty.is_float() {
+        Numbers::Float(Vec::with_capacity(cap))
     } else if ty.is_signed() {
-        let bits = 8 * ty.size() as u32;
-        let (lo, hi) = (-(1i128 << (bits - 1)), (1i128 << (bits - 1)) - 1);
-        let mut out = Vec::with_capacity(cap);
-        for (k, tok) in tokens.by_ref().take(count).enumerate() {
-            let v = tok.parse::<i128>().map_err(|_| bad(k, tok))?;
-            if v < lo || v > hi {
-                return Err(range(k, tok));
-            }
-            out.push(v as i64);
-        }
-        Numbers::Int(out)
+        Numbers::Int(Vec::with_capacity(cap))
     } else {
-        let bits = 8 * ty.size() as u32;
-        let hi = if bits == 64 { u64::MAX } else { (1u64 << bits) - 1 };
-        let mut out = Vec::with_capacity(cap);
-        for (k, tok) in tokens.by_ref().take(count).enumerate() {
-            let v = tok.parse::<u64>().map_err(|_| bad(k, tok))?;
-            if v > hi {
-                return Err(range(k, tok));
-            }
-            out.push(v);
-        }
-        Numbers::UInt(out)
+        Numbers::UInt(Vec::with_capacity(cap))
     };
-    let found = numbers.len() + tokens.count();
-    if fixed && found != count {
-        return Err(Error::input(format!("{what} holds {found} values, {count} are needed")));
+    let mut end = 0;
+    for (k, tok) in text.split_ascii_whitespace().take(limit).enumerate() {
+        match &mut numbers {
+            // a Float32 array holds the float nearest the text, as VTK reads it
+            Numbers::Float(v) if ty == Scalar::F32 => v.push(f64::from(tok.parse::<f32>().map_err(|_| bad(k, tok))?)),
+            Numbers::Float(v) => v.push(tok.parse::<f64>().map_err(|_| bad(k, tok))?),
+            ints => {
+                let x = tok.parse::<i128>().map_err(|_| bad(k, tok))?;
+                if x < lo || x > hi {
+                    return Err(range(k, tok));
+                }
+                match ints {
+                    Numbers::Int(v) => v.push(x as i64),
+                    Numbers::UInt(v) => v.push(x as u64),
+                    Numbers::Float(_) => {}
+                }
+            }
+        }
+        end = tok.as_ptr() as usize - text.as_ptr() as usize + tok.len();
     }
-    Ok(numbers)
+    Ok((numbers, end))
 }
 
 /// The compressor of a VTK XML file's binary data.

@@ -7,7 +7,7 @@
 //! Every count is checked against the bytes left before anything of its size is allocated.
 
 use super::data::{CellTypes, Dataset, ImageGeometry, PointArray, PolySection};
-use super::decode::{parse_ascii, Numbers, Scalar, MAX_VALUES};
+use super::decode::{parse_tokens, Numbers, Scalar, MAX_VALUES};
 use crate::error::{Error, Location, Result};
 
 /// A cursor over the file: keywords and ascii numbers as tokens, binary data as bytes.
@@ -94,14 +94,17 @@ impl<'a> Cursor<'a> {
             if count > (self.bytes.len() - start) / 2 + 1 {
                 return Err(self.err(format!("truncated: {what} needs {count} values, the file is too short")));
             }
-            let mut end = start;
-            for _ in 0..count {
-                if self.token().is_none() {
-                    break;
-                }
-                end = self.pos;
+            // the values are read where they stand, once: up to the first byte that is not text
+            let rest = &self.bytes[start..];
+            let text = std::str::from_utf8(rest)
+                .unwrap_or_else(|e| std::str::from_utf8(&rest[..e.valid_up_to()]).unwrap_or_default());
+            let (numbers, end) = parse_tokens(ty, text, count, what).map_err(|e| self.located(e, start))?;
+            if numbers.len() != count {
+                let e = Error::input(format!("{what} holds {} values, {count} are needed", numbers.len()));
+                return Err(self.located(e, start));
             }
-            parse_ascii(ty, &self.bytes[start..end], Some(count), what).map_err(|e| self.located(e, start))
+            self.pos = start + end;
+            Ok(numbers)
         }
     }
 

@@ -361,8 +361,8 @@ struct SmoothCli {
     /// Mesh plot: camera azimuth and elevation in degrees (y up).
     #[arg(long, value_name = "AZ,EL", allow_hyphen_values = true)]
     view: Option<String>,
-    /// Grid plot: number of isolines (0: none).
-    #[arg(long, default_value_t = 0)]
+    /// Grid plot: number of isolines, 0 to 1000 (0: none; grids only).
+    #[arg(long, default_value_t = 0, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(0..=1000))]
     isolines: usize,
     /// Keep extrema of persistence ≥ T: `5%` of the range or an absolute value. [default: 5%]
     #[arg(long, value_name = "T", conflicts_with_all = ["pairs", "minima", "keep_min", "keep_max"])]
@@ -563,12 +563,7 @@ fn run(cli: Cli) -> Result<String> {
 
 fn main() {
     commands::install_panic_hook();
+    commands::install_interrupt_handler();
     let cli = Cli::parse();
-    match commands::catch_panics(|| run(cli)) {
-        Ok(text) => print!("{text}"),
-        Err(e) => {
-            eprintln!("error: {}", commands::cli_message(&e));
-            std::process::exit(e.exit_code());
-        }
-    }
+    std::process::exit(commands::finish(commands::catch_panics(|| run(cli))));
 }

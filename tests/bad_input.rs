@@ -216,7 +216,7 @@ fn other_reader_cases() -> Vec<Case> {
 fn npy_3x3() -> Vec<u8> {
     let header = "{'descr': '<f8', 'fortran_order': False, 'shape': (3, 3), }";
     let mut h = header.to_string();
-    while (10 + h.len() + 1) % 64 != 0 {
+    while !(10 + h.len() + 1).is_multiple_of(64) {
         h.push(' ');
     }
     h.push('\n');

@@ -97,10 +97,14 @@ fn plots_are_written_as_png() {
         "--report",
         report.to_str().unwrap(),
     ]);
-    assert_eq!(o.status.code(), Some(3), "{}", text(&o));
+    // checked before any work: a usage error
+    assert_eq!(o.status.code(), Some(2), "{}", text(&o));
+    assert!(text(&o).contains("no-such-dir does not exist"), "{}", text(&o));
     assert!(!out3.exists() && !fig3.exists(), "nothing committed");
-    let tmp_left =
-        std::fs::read_dir(&dir).unwrap().flatten().any(|e| e.file_name().to_string_lossy().ends_with(".tmp"));
+    let tmp_left = std::fs::read_dir(&dir).unwrap().flatten().any(|e| {
+        let n = e.file_name().to_string_lossy().into_owned();
+        n.ends_with(".tmp") || n.starts_with(".toposmooth-")
+    });
     assert!(!tmp_left);
     // outputs that collide with each other or with the input are usage errors
     let same = dir.join("same.png");
@@ -161,7 +165,7 @@ fn assert_input_error(args: &[&str], needles: &[&str], out: Option<&PathBuf>) {
         let leftovers: Vec<_> = std::fs::read_dir(p.parent().unwrap())
             .unwrap()
             .flatten()
-            .filter(|e| e.file_name().to_string_lossy().ends_with(".tmp"))
+            .filter(|e| e.file_name().to_string_lossy().starts_with(".toposmooth-"))
             .collect();
         assert!(leftovers.is_empty());
     }

@@ -29,7 +29,7 @@ fn values() -> impl Strategy<Value = Vec<f64>> {
 }
 
 fn coordinates(n: usize, seed: u64) -> Series {
-    if seed % 2 == 0 {
+    if seed.is_multiple_of(2) {
         return Series::uniform(n);
     }
     let r = common::uniform(seed, n);

@@ -115,8 +115,15 @@ pub enum BenchCase {
     Mesh(String, usize),
 }
 
+/// The largest bench case, in vertices: ten times the 1000 × 1000 grid that takes minutes.
+pub const MAX_BENCH_VERTICES: usize = 10_000_000;
+
 impl BenchCase {
     /// Parses `N`, `NXxNY`, or a mesh path with an optional `@LEVELS` of subdivision.
+    ///
+    /// # Errors
+    /// [`Error::Usage`] for a case that is not one, too small, or above
+    /// [`MAX_BENCH_VERTICES`].
     pub fn parse(s: &str) -> Result<BenchCase> {
         let (file, levels) = match s.rsplit_once('@') {
             Some((f, l)) => (f, Some(l)),
@@ -139,6 +146,12 @@ impl BenchCase {
             None => BenchCase::Series(s.trim().parse().map_err(|_| bad())?),
         };
         match case {
+            BenchCase::Series(n) if n > MAX_BENCH_VERTICES => Err(Error::Usage(format!(
+                "bench series of {n} samples: at most {MAX_BENCH_VERTICES} (a run of that size takes hours)"
+            ))),
+            BenchCase::Grid(a, b) if a.checked_mul(b).is_none_or(|n| n > MAX_BENCH_VERTICES) => Err(Error::Usage(
+                format!("bench grid {a} × {b}: at most {MAX_BENCH_VERTICES} vertices (a run of that size takes hours)"),
+            )),
             BenchCase::Series(n) if n < 2 => {
                 Err(Error::Usage(format!("bench series need at least 2 samples, got {n}")))
             }

@@ -111,9 +111,7 @@ pub fn deform(args: &DeformArgs) -> Result<String> {
     if let Some(path) = &args.plot {
         staged.push(stage_picture(path, args, &mesh, &posed, &w, &transforms, &names)?);
     }
-    for s in staged {
-        s.commit()?;
-    }
+    crate::io::commit_all(staged)?;
     let max_move = mesh
         .positions()
         .iter()

@@ -129,9 +129,7 @@ pub fn diffuse(args: &DiffuseArgs) -> Result<String> {
         staged.push(stage_json(path, &report)?);
         wrote.push(path.display().to_string());
     }
-    for s in staged {
-        s.commit()?;
-    }
+    crate::io::commit_all(staged)?;
     let certified = w.functions.iter().filter(|f| f.certificate.passed).count();
     let spurious: usize = w.functions.iter().map(|f| f.spurious.exact).sum();
     let mut text = format!(
@@ -276,9 +274,7 @@ fn stage_diffused(args: &DiffuseArgs, d: &Diffused, weights_path: &Path) -> Resu
 }
 
 fn stage_png(path: &Path, img: &image::RgbaImage) -> Result<Staged> {
-    stage_with(path, |tmp| {
-        img.save_with_format(tmp, image::ImageFormat::Png).map_err(|e| std::io::Error::other(e.to_string()))
-    })
+    stage_with(path, |w| img.write_to(w, image::ImageFormat::Png).map_err(|e| std::io::Error::other(e.to_string())))
 }
 
 /// The image enlarged (nearest neighbour, at least 600 pixels wide) on a checkerboard, with

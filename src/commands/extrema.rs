@@ -1,7 +1,7 @@
 //! `toposmooth extrema`: list the extrema with persistence and strictness; draw the diagram.
 
 use super::input::{read_field, DomainKind, Field, GridOptions};
-use super::{check_png_name, sig6, stage_plot};
+use super::{check_distinct, check_png_name, sig6, stage_plot};
 use crate::domain::{AnyDomain, Domain};
 use crate::error::{Error, Result};
 use crate::io::series_csv::SeriesCsvOptions;
@@ -55,6 +55,8 @@ struct Row<'a> {
 /// Runs `extrema`; returns the text printed on standard output.
 pub fn extrema(args: &ExtremaArgs) -> Result<String> {
     check_png_name(args.plot.as_deref())?;
+    let inputs: Vec<&Path> = args.input.iter().map(PathBuf::as_path).collect();
+    check_distinct(&inputs, &[("--plot", args.plot.as_deref())])?;
     let path = args.input.clone().unwrap_or_default();
     let field = read_field(args.input.as_deref(), args.kind, &args.csv, &args.grid)?.into_field(&path)?;
     let text = match &field.domain {

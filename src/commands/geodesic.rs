@@ -70,9 +70,7 @@ pub fn geodesic(args: &GeodesicArgs) -> Result<String> {
         };
         staged.push(stage_json(path, &report)?);
     }
-    for s in staged {
-        s.commit()?;
-    }
+    crate::io::commit_all(staged)?;
     let warning = mesh.sliver_warning().map(|w| format!("warning: {w}\n")).unwrap_or_default();
     Ok(format!(
         "{warning}{}: heat-method geodesic distance on a mesh of {} from {} source{} (vertex {}); largest {} at vertex {farthest}\n\

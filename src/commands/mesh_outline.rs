@@ -68,9 +68,7 @@ pub fn mesh_outline(args: &MeshOutlineArgs) -> Result<String> {
         staged.push(stage_plot(plot, |tmp| plot_triangulation(tmp, positions, faces, &title))?);
     }
     let write_seconds = t.elapsed().as_secs_f64();
-    for s in staged {
-        s.commit()?;
-    }
+    crate::io::commit_all(staged)?;
     let holes = outline.loops.len() - 1;
     let sharp = if smallest < args.min_angle { " (below the limit: a corner of the outline is sharper)" } else { "" };
     let max_area = args.max_area.map(sig6).unwrap_or_else(|| {

@@ -60,6 +60,60 @@ pub fn install_panic_hook() {
     }));
 }
 
+/// On SIGINT, SIGTERM or SIGHUP the tool removes its temporaries (waiting for outputs being
+/// renamed into place, so a command's outputs are never left half old, half new) and ends as
+/// the signal would have ended it.
+pub fn install_interrupt_handler() {
+    #[cfg(unix)]
+    {
+        use signal_hook::consts::{SIGHUP, SIGINT, SIGTERM};
+        if let Ok(mut signals) = signal_hook::iterator::Signals::new([SIGINT, SIGTERM, SIGHUP]) {
+            std::thread::spawn(move || {
+                if let Some(signal) = signals.forever().next() {
+                    crate::io::staging::remove_temporaries();
+                    let _ = signal_hook::low_level::emulate_default_handler(signal);
+                    std::process::exit(128 + signal);
+                }
+            });
+        }
+    }
+}
+
+/// The exit status of a process ended by SIGPIPE, which the tool returns when its standard
+/// output is closed early (`toposmooth extrema f.csv | head -1`).
+pub const BROKEN_PIPE_STATUS: i32 = 141;
+
+/// Ends a run: removes any temporary still held, prints the summary on standard output or the
+/// error on standard error, and returns the exit status. A closed standard output (or a
+/// closed FIFO given as an output) ends quietly with [`BROKEN_PIPE_STATUS`].
+pub fn finish(result: Result<String>) -> i32 {
+    use std::io::Write;
+    crate::io::staging::remove_temporaries();
+    match result {
+        Ok(text) if crate::io::staging::writes_stdout() => {
+            // an output went to the standard output: the summary goes beside it, to standard error
+            let _ = std::io::stderr().write_all(text.as_bytes());
+            0
+        }
+        Ok(text) => {
+            let mut out = std::io::stdout().lock();
+            match out.write_all(text.as_bytes()).and_then(|()| out.flush()) {
+                Ok(()) => 0,
+                Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => BROKEN_PIPE_STATUS,
+                Err(e) => {
+                    let _ = writeln!(std::io::stderr(), "error: writing the standard output: {e}");
+                    crate::error::ErrorKind::Io.exit_code()
+                }
+            }
+        }
+        Err(Error::Io { source, .. }) if source.kind() == std::io::ErrorKind::BrokenPipe => BROKEN_PIPE_STATUS,
+        Err(e) => {
+            let _ = writeln!(std::io::stderr(), "error: {}", cli_message(&e));
+            e.exit_code()
+        }
+    }
+}
+
 /// Runs the tool, turning a panic into an internal error (exit 1) carrying
 /// [`INTERNAL_FAILURE`].
 ///
@@ -126,9 +180,11 @@ fn x_axis(source: &XSource, x: &[f64]) -> (XAxis, Vec<f64>) {
     }
 }
 
-/// Plots are PNG files: checked before any work so that a bad name writes nothing.
+/// Plots are PNG files: checked before any work so that a bad name writes nothing. A stream
+/// without an extension (`-`, a FIFO, `/dev/null`) takes PNG.
 fn check_png_name(path: Option<&Path>) -> Result<()> {
     match path {
+        Some(p) if p.extension().is_none() && crate::io::staging::is_stream(p) => Ok(()),
         Some(p) if !p.extension().and_then(|e| e.to_str()).is_some_and(|e| e.eq_ignore_ascii_case("png")) => {
             Err(Error::Usage(format!("{}: plots are written as PNG; use a .png name", p.display())))
         }
@@ -139,10 +195,10 @@ fn check_png_name(path: Option<&Path>) -> Result<()> {
 /// Draws a plot into a staged temporary file (see [`crate::io::Staged`]).
 fn stage_plot(
     path: &Path,
-    draw: impl FnOnce(&Path) -> std::result::Result<(), crate::plot::PlotError>,
+    draw: impl FnOnce(&mut dyn std::io::Write) -> std::result::Result<(), crate::plot::PlotError>,
 ) -> Result<crate::io::Staged> {
     check_png_name(Some(path))?;
-    crate::io::stage_with(path, |tmp| draw(tmp).map_err(|e| std::io::Error::other(e.to_string())))
+    crate::io::stage(path, |w| draw(w).map_err(|e| std::io::Error::other(e.to_string())))
 }
 
 /// The line listing the files written (the given paths, skipping `None`).
@@ -151,8 +207,10 @@ fn wrote_line<'a>(paths: impl IntoIterator<Item = Option<&'a std::path::PathBuf>
     format!("wrote {}\n", names.join(", "))
 }
 
-/// Output paths must differ from each other and from the inputs (symbolic links resolved),
-/// and none may be a directory: checked before any work, so that no output is half written.
+/// Output paths must differ from each other and from the inputs (symbolic links resolved; a
+/// character device such as `/dev/null` may take several outputs), and each must be writable:
+/// checked, and each output's temporary reserved ([`crate::io::reserve`]), before any work, so
+/// that a typo costs nothing and no output is half written.
 fn check_distinct(inputs: &[&Path], outputs: &[(&str, Option<&Path>)]) -> Result<()> {
     let key = |p: &Path| {
         std::fs::canonicalize(p)
@@ -164,6 +222,7 @@ fn check_distinct(inputs: &[&Path], outputs: &[(&str, Option<&Path>)]) -> Result
             .unwrap_or_else(|_| std::path::absolute(p).unwrap_or_else(|_| p.to_path_buf()))
     };
     let mut seen: Vec<(&str, std::path::PathBuf)> = inputs.iter().map(|p| ("an input", key(p))).collect();
+    let mut reserve = Vec::new();
     for (name, p) in outputs {
         if let Some(p) = p {
             if p.is_dir() {
@@ -171,12 +230,29 @@ fn check_distinct(inputs: &[&Path], outputs: &[(&str, Option<&Path>)]) -> Result
             }
             let k = key(p);
             if let Some((other, _)) = seen.iter().find(|(_, s)| *s == k) {
-                return Err(Error::Usage(format!("{name} {} is also {other}", p.display())));
+                if !is_char_device(p) {
+                    return Err(Error::Usage(format!("{name} {} is also {other}", p.display())));
+                }
             }
             seen.push((name, k));
+            reserve.push(*p);
         }
     }
-    Ok(())
+    crate::io::reserve(&reserve)
+}
+
+/// Whether `path` is a character device (`/dev/null`): it can take several outputs.
+fn is_char_device(path: &Path) -> bool {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::FileTypeExt;
+        std::fs::metadata(path).is_ok_and(|m| m.file_type().is_char_device())
+    }
+    #[cfg(not(unix))]
+    {
+        let _ = path;
+        false
+    }
 }
 
 #[cfg(test)]

@@ -6,7 +6,7 @@ use super::smooth_args::{fit_and_solver_lines, seconds_line, SmoothArgs};
 use super::{check_distinct, check_png_name, sig6, stage_plot, x_axis};
 use crate::domain::AnyDomain;
 use crate::error::{Error, Result};
-use crate::io::export::{check_complex_output, check_output, stage_complex, stage_results, Results};
+use crate::io::export::{check_complex_output, check_output, check_written, stage_complex, stage_results, Results};
 use crate::io::{stage_json, Staged};
 use crate::pipeline::{smooth_any, Report, Smoothed};
 use crate::plot::{plot_grid_fields, plot_mesh_fields, plot_series, GridMarker, GridPanel, GridPlotOptions, Marker};
@@ -83,6 +83,9 @@ pub fn smooth(args: &SmoothArgs) -> Result<String> {
         check_complex_output(c, &field.domain)?;
     }
     check_output(&args.output, &field.domain)?;
+    if args.isolines > 0 && !matches!(field.domain, AnyDomain::Grid(_)) {
+        return Err(Error::setting("isolines", "draws on a grid's figure only; this input is not a grid"));
+    }
     let read_seconds = start.elapsed().as_secs_f64();
     let filled_samples: Vec<usize> =
         field.filled.as_ref().map(|m| (0..m.len()).filter(|&i| m[i]).collect()).unwrap_or_default();
@@ -107,7 +110,9 @@ pub fn smooth(args: &SmoothArgs) -> Result<String> {
         filled: field.filled.as_deref(),
     };
     let x_axis = field.axis.as_ref().map(|a| (a.x_name.as_str(), a.x_text.as_slice()));
-    let mut staged = vec![stage_results(&args.output, &field.domain, x_axis, &results)?];
+    let output = stage_results(&args.output, &field.domain, x_axis, &results)?;
+    check_written(&output, &field.domain, &results).map_err(|e| e.in_file(&field.path))?;
+    let mut staged = vec![output];
     if let Some(path) = &args.complex {
         let Some(ms) = &result.complex else {
             return Err(Error::Internal {
@@ -146,9 +151,7 @@ pub fn smooth(args: &SmoothArgs) -> Result<String> {
         };
         staged.push(stage_json(path, &run)?);
     }
-    for s in staged {
-        s.commit()?;
-    }
+    crate::io::commit_all(staged)?;
 
     Ok(summary(
         args,

@@ -242,9 +242,7 @@ fn run_cage(args: &WeightsArgs, shape: &TriMesh, cage: &[[f64; 2]], start: Insta
             },
         )?);
     }
-    for s in staged {
-        s.commit()?;
-    }
+    crate::io::commit_all(staged)?;
     let w = &c.weights;
     let certified = w.functions.iter().filter(|f| f.certificate.passed).count();
     let spurious: usize = w.functions.iter().map(|f| f.spurious.exact).sum();
@@ -363,9 +361,7 @@ fn finish(
     staged: Vec<Staged>,
     start: Instant,
 ) -> Result<String> {
-    for s in staged {
-        s.commit()?;
-    }
+    crate::io::commit_all(staged)?;
     let method = format!("{:?}", args.settings.method).to_lowercase();
     let mut text = format!(
         "{}: {} handles on a mesh of {}; {method} weights of order {}\n",

@@ -26,6 +26,21 @@ fn extension(path: &Path) -> String {
     path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase()
 }
 
+/// The format an output of `domain` at `path` is written in: its extension; for a stream
+/// (`-`, a FIFO or a device such as `/dev/stdout`) without one, the domain's streamable
+/// format: CSV for a series, NPY for a grid (a mesh has none: its name must say).
+fn format_of(path: &Path, domain: &AnyDomain) -> String {
+    let e = extension(path);
+    if !e.is_empty() || !super::staging::is_stream(path) {
+        return e;
+    }
+    match domain {
+        AnyDomain::Series(_) => "csv".into(),
+        AnyDomain::Grid(_) => "npy".into(),
+        AnyDomain::Mesh(_) => e,
+    }
+}
+
 /// The output extensions of a domain, and how to name the domain in a message.
 fn formats(domain: &AnyDomain) -> (&'static [&'static str], &'static str) {
     match domain {
@@ -61,7 +76,10 @@ fn mesh_format_error(path: &Path) -> Error {
 /// [`Error::Usage`] naming the path and the formats there are.
 pub fn check_output(path: &Path, domain: &AnyDomain) -> Result<()> {
     let (allowed, what) = formats(domain);
-    check_extension(path, allowed, what)
+    if allowed.contains(&format_of(path, domain).as_str()) {
+        return Ok(());
+    }
+    Err(format_error(path, allowed, what))
 }
 
 /// Checks before any work that `path` names a mesh output format (`.vtu`, `.vtp`, `.ply`).
@@ -141,7 +159,7 @@ pub fn stage_results(
             };
             stage_series_output(path, &out)
         }
-        AnyDomain::Grid(g) => match extension(path).as_str() {
+        AnyDomain::Grid(g) => match format_of(path, domain).as_str() {
             "vti" => stage_vti(path, g.nx(), g.ny(), g.spacing(), g.origin(), &arrays),
             "npz" => stage_npz(path, g.ny(), g.nx(), &arrays),
             "npy" => stage_npy(path, g.ny(), g.nx(), r.smoothed),
@@ -149,6 +167,62 @@ pub fn stage_results(
         },
         AnyDomain::Mesh(m) => stage_mesh(path, m, &arrays),
     }
+}
+
+/// Certificate item 5 (SPEC.md): the staged output, read back from its temporary with the
+/// format's own reader, holds the certified arrays bit for bit (`smoothed` always; `input`,
+/// `representative` and the roles where the format holds them). Run before committing, so a
+/// file that would not read back as certified is never put in place.
+///
+/// # Errors
+/// [`Error::Uncertified`] naming the target and the first vertex that reads back differently;
+/// the reader's errors.
+pub fn check_written(staged: &Staged, domain: &AnyDomain, r: &Results) -> Result<()> {
+    let target = staged.target();
+    let tmp = staged.temp_path();
+    let fail = |what: &str, i: Option<usize>| Error::Uncertified {
+        path: Some(target.to_path_buf()),
+        message: format!(
+            "certificate item 5: the file as written reads back with {what}{}",
+            i.map(|i| format!(" (first at {})", domain.describe_vertex(i))).unwrap_or_default()
+        ),
+    };
+    let differs = |a: &[f64], b: &[f64]| -> Option<Option<usize>> {
+        if a.len() != b.len() {
+            return Some(None);
+        }
+        a.iter().zip(b).position(|(x, y)| x.to_bits() != y.to_bits()).map(Some)
+    };
+    let reread = |e: Error| match e {
+        Error::Io { source, .. } => Error::Io { path: target.to_path_buf(), source },
+        other => fail(&format!("an error: {other}"), None),
+    };
+    let smoothed_only = match (domain, format_of(target, domain).as_str()) {
+        (AnyDomain::Grid(_), "npy") => Some(super::grid::read_npy(tmp).map_err(reread)?.values),
+        (AnyDomain::Grid(_), "csv") => Some(super::grid::read_grid_csv(tmp).map_err(reread)?.values),
+        _ => None,
+    };
+    if let Some(values) = smoothed_only {
+        return match differs(&values, r.smoothed) {
+            Some(i) => Err(fail("other smoothed values", i)),
+            None => Ok(()),
+        };
+    }
+    let stored = read_results(tmp).map_err(reread)?;
+    for (what, read, certified) in [
+        ("other smoothed values", &stored.smoothed, r.smoothed),
+        ("another input", &stored.input, r.input),
+        ("another representative", &stored.representative, r.representative),
+    ] {
+        if let Some(i) = differs(read, certified) {
+            return Err(fail(what, i));
+        }
+    }
+    if stored.roles != r.roles {
+        let i = stored.roles.iter().zip(r.roles).position(|(a, b)| a != b);
+        return Err(fail("other roles", i));
+    }
+    Ok(())
 }
 
 /// Stages a mesh with per-vertex arrays as `.vtu`, `.vtp` or `.ply`.

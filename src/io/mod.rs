@@ -1,5 +1,5 @@
-//! Reading and writing files. Every output goes to a temporary file in the target's directory
-//! and is renamed into place, so a failed run never leaves a half-written file.
+//! Reading and writing files. Every output is written to a locked temporary file and put in
+//! place only when complete ([`staging`]), so a failed run never leaves a half-written file.
 
 pub mod content;
 pub mod csv_dialect;
@@ -13,13 +13,14 @@ pub mod npy_input;
 pub mod npz;
 pub mod series_csv;
 pub mod series_output;
+pub mod staging;
 pub mod timestamps;
 #[cfg(feature = "io-vtk")]
 pub mod vtk;
 
 use crate::error::{Error, Result};
-use std::io::Write;
-use std::path::{Path, PathBuf};
+pub use staging::{commit_all, reserve, stage, stage_with, write_atomic, Staged};
+use std::path::Path;
 
 /// The marker in the message of a reader that failed internally (a panic caught while
 /// reading a file): the file is reported as bad input, the message says it is our bug.
@@ -60,62 +61,6 @@ pub fn panic_text(payload: &(dyn std::any::Any + Send)) -> String {
         .unwrap_or_else(|| "no message".into())
 }
 
-/// A complete file waiting under a temporary sibling name: [`Staged::commit`] renames it into
-/// place; dropped uncommitted, it is removed. Staging every output of a command before
-/// committing any means a failure leaves no output behind.
-#[must_use = "a staged file is removed unless committed"]
-pub struct Staged {
-    tmp: PathBuf,
-    path: PathBuf,
-    committed: bool,
-}
-
-impl Staged {
-    /// Renames the temporary file over the target.
-    pub fn commit(mut self) -> Result<()> {
-        std::fs::rename(&self.tmp, &self.path).map_err(|source| Error::Io { path: self.path.clone(), source })?;
-        self.committed = true;
-        Ok(())
-    }
-}
-
-impl Drop for Staged {
-    fn drop(&mut self) {
-        if !self.committed {
-            let _ = std::fs::remove_file(&self.tmp);
-        }
-    }
-}
-
-/// Stages `path`: `create` writes the complete temporary file at the path it is given.
-pub fn stage_with(path: &Path, create: impl FnOnce(&Path) -> std::io::Result<()>) -> Result<Staged> {
-    let staged = Staged { tmp: temp_sibling(path), path: path.to_path_buf(), committed: false };
-    create(&staged.tmp).map_err(|source| Error::Io { path: path.to_path_buf(), source })?;
-    Ok(staged)
-}
-
-/// Stages `path`: `fill` writes the content, which is flushed and synced.
-pub fn stage(path: &Path, fill: impl FnOnce(&mut dyn Write) -> std::io::Result<()>) -> Result<Staged> {
-    stage_with(path, |tmp| {
-        let file = std::fs::File::create(tmp)?;
-        let mut w = std::io::BufWriter::new(file);
-        fill(&mut w)?;
-        let file = w.into_inner().map_err(|e| e.into_error())?;
-        file.sync_all()
-    })
-}
-
-/// Writes `path` atomically: [`stage`] then [`Staged::commit`].
-pub fn write_atomic(path: &Path, fill: impl FnOnce(&mut dyn Write) -> std::io::Result<()>) -> Result<()> {
-    stage(path, fill)?.commit()
-}
-
-/// A temporary name next to `path` (same directory, so the rename is atomic).
-pub fn temp_sibling(path: &Path) -> PathBuf {
-    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_else(|| "out".into());
-    path.with_file_name(format!(".{name}.{}.tmp", std::process::id()))
-}
-
 #[cfg(feature = "serde")]
 /// Stages a value as pretty JSON.
 pub fn stage_json<T: serde::Serialize>(path: &Path, value: &T) -> Result<Staged> {
@@ -140,22 +85,5 @@ mod tests {
             let s = format_f64(v);
             assert_eq!(s.parse::<f64>().unwrap().to_bits(), v.to_bits(), "{s}");
         }
-    }
-
-    #[test]
-    fn atomic_write_leaves_nothing_on_failure() {
-        let dir = std::env::temp_dir().join(format!("toposmooth-io-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        let target = dir.join("x.txt");
-        let r = write_atomic(&target, |w| {
-            w.write_all(b"partial")?;
-            Err(std::io::Error::other("boom"))
-        });
-        assert!(r.is_err());
-        assert!(!target.exists());
-        assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 0);
-        write_atomic(&target, |w| w.write_all(b"ok")).unwrap();
-        assert_eq!(std::fs::read_to_string(&target).unwrap(), "ok");
-        std::fs::remove_dir_all(&dir).unwrap();
     }
 }

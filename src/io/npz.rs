@@ -58,10 +58,9 @@ pub fn stage_npz(path: &Path, ny: usize, nx: usize, arrays: &[(&str, &[f64])]) -
         seen.push(name);
         check_shape(path, &format!("array `{name}`"), ny, nx, values.len())?;
     }
-    super::stage_with(path, |tmp| {
+    super::stage_with(path, |w| {
         use zip::write::SimpleFileOptions;
-        let file = std::fs::File::create(tmp)?;
-        let mut zip = zip::ZipWriter::new(std::io::BufWriter::new(file));
+        let mut zip = zip::ZipWriter::new(w);
         for (name, values) in arrays {
             let options = SimpleFileOptions::default()
                 .compression_method(zip::CompressionMethod::Deflated)
@@ -69,9 +68,8 @@ pub fn stage_npz(path: &Path, ny: usize, nx: usize, arrays: &[(&str, &[f64])]) -
             zip.start_file(npyz::npz::file_name_from_array_name(name), options)?;
             write_npy(&mut zip, ny, nx, values)?;
         }
-        let buffered = zip.finish()?;
-        let file = buffered.into_inner().map_err(|e| e.into_error())?;
-        file.sync_all()
+        zip.finish()?;
+        Ok(())
     })
 }
 

@@ -11,7 +11,6 @@ use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 use std::error::Error;
-use std::path::Path;
 
 /// One panel of a grid plot.
 #[derive(Clone, Debug, PartialEq)]
@@ -279,7 +278,7 @@ fn contour_segments(
     segs
 }
 
-/// Plots `panels` of an `nx × ny` grid as heat maps into a PNG at `path`: side by side (stacked
+/// Plots `panels` of an `nx × ny` grid as heat maps into a PNG written to `out`: side by side (stacked
 /// for wide grids), each with its title, under the overall `title`, with one colour scale shared by
 /// all panels' finite values and shown by a colour bar with tick labels on the right (plus a
 /// "missing" swatch if some value is NaN). NaN cells are grey; `markers` are drawn on every panel
@@ -292,7 +291,7 @@ fn contour_segments(
 /// 64) panels, a panel with other than `nx * ny` values, a non-positive or non-finite aspect, or a
 /// drawing/writing failure.
 pub fn plot_grid_fields(
-    path: &Path,
+    out: &mut dyn std::io::Write,
     nx: usize,
     ny: usize,
     panels: &[GridPanel],
@@ -300,7 +299,7 @@ pub fn plot_grid_fields(
     title: &str,
     options: &GridPlotOptions,
 ) -> Result<(), PlotError> {
-    let fail = |m: &str| PlotError(format!("plot {}: {m}", path.display()));
+    let fail = |m: &str| PlotError(format!("plot: {m}"));
     let len = nx.checked_mul(ny).filter(|&l| l > 0).ok_or_else(|| fail(&format!("bad grid size {nx}x{ny}")))?;
     if panels.is_empty() || panels.len() > MAX_PANELS {
         return Err(fail(&format!("{} panels, expected 1..={MAX_PANELS}", panels.len())));
@@ -318,7 +317,7 @@ pub fn plot_grid_fields(
         (1..=n_lev).map(|k| scale.lo + (scale.hi - scale.lo) * k as f64 / (n_lev + 1) as f64).collect();
     let missing = panels.iter().any(|p| p.values.iter().any(|v| v.is_nan()));
     let dots: Vec<GridMarker> = markers.iter().copied().filter(|m| m.index < len).collect();
-    render(path, layout.size, |root, _| {
+    render(out, layout.size, |root, _| {
         let centred = |size: f64| TextStyle::from((FONT, size).into_font()).pos(Pos::new(HPos::Center, VPos::Center));
         root.draw(&Text::new(title, (layout.size.0 as i32 / 2, TITLE_H as i32 / 2 + 2), centred(24.0)))?;
         let (pw, ph) = layout.panel;

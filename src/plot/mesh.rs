@@ -13,7 +13,6 @@ use crate::domain::vec3::{cross, dot, sub, unit};
 use crate::plot::{GridMarker, GridPanel};
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
-use std::path::Path;
 
 /// Camera of [`plot_mesh_fields`], in degrees.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -137,7 +136,7 @@ fn raster(
 /// A panel of the wrong length, no panel, or a drawing or writing failure.
 #[allow(clippy::too_many_arguments)]
 pub fn plot_mesh_fields(
-    path: &Path,
+    out: &mut dyn std::io::Write,
     positions: &[[f64; 3]],
     triangles: &[[usize; 3]],
     panels: &[GridPanel],
@@ -146,7 +145,7 @@ pub fn plot_mesh_fields(
     view: MeshView,
     diverging: bool,
 ) -> Result<usize, PlotError> {
-    let fail = |m: &str| PlotError(format!("plot {}: {m}", path.display()));
+    let fail = |m: &str| PlotError(format!("plot: {m}"));
     let n = positions.len();
     if panels.is_empty() || panels.len() > 4 {
         return Err(fail(&format!("{} panels, expected 1..=4", panels.len())));
@@ -162,7 +161,7 @@ pub fn plot_mesh_fields(
     let k = panels.len() as u32;
     let size = (2 * MARGIN + k * PANEL + (k - 1) * GAP + BAR_ROOM, TITLE_H + PANEL_TITLE_H + PANEL + MARGIN);
     let mut hidden = 0;
-    render(path, size, |root, _| {
+    render(out, size, |root, _| {
         let centred = |s: f64| TextStyle::from((FONT, s).into_font()).pos(Pos::new(HPos::Center, VPos::Center));
         root.draw(&Text::new(title, (size.0 as i32 / 2, TITLE_H as i32 / 2 + 2), centred(22.0)))?;
         let tolerance = 0.01 * PANEL as f64;
@@ -223,7 +222,7 @@ pub fn plot_mesh_fields(
 /// # Errors
 /// A colour array of the wrong length, or a drawing or writing failure.
 pub fn plot_mesh_colours(
-    path: &Path,
+    out: &mut dyn std::io::Write,
     positions: &[[f64; 3]],
     triangles: &[[usize; 3]],
     colours: &[[u8; 3]],
@@ -231,16 +230,11 @@ pub fn plot_mesh_colours(
     view: MeshView,
 ) -> Result<(), PlotError> {
     if colours.len() != positions.len() {
-        return Err(PlotError(format!(
-            "plot {}: {} colours for {} vertices",
-            path.display(),
-            colours.len(),
-            positions.len()
-        )));
+        return Err(PlotError(format!("plot: {} colours for {} vertices", colours.len(), positions.len())));
     }
     let (screen, towards) = project(positions, view);
     let size = (2 * MARGIN + PANEL, TITLE_H + PANEL + MARGIN);
-    render(path, size, |root, _| {
+    render(out, size, |root, _| {
         let centred = TextStyle::from((FONT, 20.0).into_font()).pos(Pos::new(HPos::Center, VPos::Center));
         root.draw(&Text::new(title, (size.0 as i32 / 2, TITLE_H as i32 / 2 + 2), centred))?;
         let colour_at = |t: &[usize; 3], w: [f64; 3]| {
@@ -283,7 +277,17 @@ mod tests {
             GridMarker { index: back, is_max: true },
         ];
         let view = MeshView { azimuth: 0.0, elevation: 0.0 };
-        let hidden = plot_mesh_fields(&path, p, m.faces(), &panels, &markers, "sphere", view, false).unwrap();
+        let hidden = plot_mesh_fields(
+            &mut std::fs::File::create(&path).unwrap(),
+            p,
+            m.faces(),
+            &panels,
+            &markers,
+            "sphere",
+            view,
+            false,
+        )
+        .unwrap();
         assert_eq!(hidden, 1, "the vertex at the back is hidden");
         let img = image::open(&path).unwrap().to_rgb8();
         let (x0, y0) = (MARGIN, TITLE_H + PANEL_TITLE_H);
@@ -296,7 +300,7 @@ mod tests {
         // the corner is background
         assert_eq!(at(2, 2), [255, 255, 255]);
         let bad = plot_mesh_fields(
-            &path,
+            &mut std::fs::File::create(&path).unwrap(),
             p,
             m.faces(),
             &[GridPanel { title: "x".into(), values: &[1.0] }],

@@ -11,7 +11,6 @@ use plotters::element::DashedPathElement;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 use std::error::Error;
-use std::path::Path;
 use std::sync::OnceLock;
 
 mod grid;
@@ -71,12 +70,12 @@ fn ensure_font() -> Result<(), PlotError> {
     ok.then_some(()).ok_or_else(|| PlotError("cannot register the DejaVu Sans font".into()))
 }
 
-/// Validates the size, draws with `draw` on a white RGB canvas and writes it as PNG to `path`.
-fn render<F>(path: &Path, (w, h): (u32, u32), draw: F) -> Result<(), PlotError>
+/// Validates the size, draws with `draw` on a white RGB canvas and writes it as PNG to `out`.
+fn render<F>(out: &mut dyn std::io::Write, (w, h): (u32, u32), draw: F) -> Result<(), PlotError>
 where
     F: FnOnce(&Area<'_>, f64) -> Result<(), Box<dyn Error>>,
 {
-    let fail = |e: &dyn std::fmt::Display| PlotError(format!("plot {}: {e}", path.display()));
+    let fail = |e: &dyn std::fmt::Display| PlotError(format!("plot: {e}"));
     if !(100..=16384).contains(&w) || !(100..=16384).contains(&h) {
         return Err(fail(&format!("image size {w}x{h} outside 100..=16384")));
     }
@@ -89,7 +88,9 @@ where
         draw(&root, scale).map_err(|e| fail(&e))?;
         root.present().map_err(|e| fail(&e))?;
     }
-    image::save_buffer_with_format(path, &buf, w, h, image::ExtendedColorType::Rgb8, image::ImageFormat::Png)
+    use image::ImageEncoder;
+    image::codecs::png::PngEncoder::new(out)
+        .write_image(&buf, w, h, image::ExtendedColorType::Rgb8)
         .map_err(|e| fail(&e))
 }
 
@@ -206,13 +207,13 @@ fn date_ticks(origin: NaiveDate, lo: f64, hi: f64, max: usize) -> Option<(Vec<f6
 
 /// Plots `input` (grey, thin) and `output` (orange, thicker) against `x`, with the kept minima
 /// (blue) and maxima (red) drawn as dots at `(x, output)`, a legend, `title` and axis labels,
-/// into a PNG of `size` pixels at `path`. Non-finite points are skipped, markers whose index is
+/// into a PNG of `size` pixels written to `out`. Non-finite points are skipped, markers whose index is
 /// out of range are ignored, and long series are decimated to the min/max of each pixel column.
 /// Errors on empty or mismatched arrays, no finite point, a size outside 100..=16384 or a
 /// drawing/writing failure.
 #[allow(clippy::too_many_arguments)]
 pub fn plot_series(
-    path: &Path,
+    out: &mut dyn std::io::Write,
     x: &[f64],
     axis: &XAxis,
     y_label: &str,
@@ -222,7 +223,7 @@ pub fn plot_series(
     title: &str,
     size: (u32, u32),
 ) -> Result<(), PlotError> {
-    let fail = |m: &str| PlotError(format!("plot {}: {m}", path.display()));
+    let fail = |m: &str| PlotError(format!("plot: {m}"));
     if x.len() != input.len() || x.len() != output.len() {
         let (a, b, c) = (x.len(), input.len(), output.len());
         return Err(fail(&format!("mismatched lengths: x {a}, input {b}, output {c}")));
@@ -234,13 +235,13 @@ pub fn plot_series(
     }
     let (xr, yr) = (nice_range(xs.0, xs.1, 0.0), nice_range(ys.0, ys.1, 0.05));
     let cols = size.0 as usize;
-    let (inp, out) = (decimate(x, input, xr, cols), decimate(x, output, xr, cols));
+    let (inp, smoothed) = (decimate(x, input, xr, cols), decimate(x, output, xr, cols));
     let dots: Vec<_> = markers
         .iter()
         .filter(|m| m.index < x.len() && ok(x[m.index]) && ok(output[m.index]))
         .map(|m| ((x[m.index], output[m.index]), m.is_max))
         .collect();
-    render(path, size, |root, s| {
+    render(out, size, |root, s| {
         let px = |v: f64| (v * s).round() as u32;
         let (ticks, with_day) = match axis {
             XAxis::DaysSince(o) => date_ticks(*o, xr.0, xr.1, (size.0 as usize / 130).clamp(2, 12)).unzip(),
@@ -260,7 +261,7 @@ pub fn plot_series(
         let mut chart = make_chart(&root, s, ax, yr, (x_desc, y_label), &*xfmt)?;
         let (thin, thick) = (GREY.stroke_width(px(1.0).max(1)), ORANGE.stroke_width(px(2.5)));
         // one path per segment: a thick polyline gets miter spikes at sharp turns
-        chart.draw_series(out.windows(2).map(|w| PathElement::new(vec![w[0], w[1]], thick)))?;
+        chart.draw_series(smoothed.windows(2).map(|w| PathElement::new(vec![w[0], w[1]], thick)))?;
         // the input on top, thin, so that its noise shows over the smooth band
         chart.draw_series(LineSeries::new(inp, thin))?;
         let mut legend = vec![(Mark::Line(thin), "input"), (Mark::Line(thick), "smoothed")];
@@ -364,7 +365,7 @@ fn draw_legend<S: AsRef<str>>(
 /// (bottom edge for −∞), 5% of the range beyond the finite values. The legend sits on the right.
 /// Points with a non-finite birth or NaN death are skipped; an empty diagram is still drawn.
 pub fn plot_persistence_diagram(
-    path: &Path,
+    out: &mut dyn std::io::Write,
     points: &[DiagramPoint],
     threshold: Option<f64>,
     title: &str,
@@ -384,7 +385,7 @@ pub fn plot_persistence_diagram(
             lo - 0.05 * r
         }
     };
-    render(path, size, |root, s| {
+    render(out, size, |root, s| {
         let px = |v: f64| (v * s).round() as u32;
         let root = root.margin(px(8.0), 0, 0, 0).titled(title, (FONT, 24.0 * s))?;
         let (plot, panel) = root.split_horizontally(size.0 - px(250.0).min(size.0 / 2));
@@ -441,7 +442,7 @@ mod tests {
     }
 
     /// Asserts that `path` holds a PNG (signature and IHDR of the given size), then removes it.
-    fn check_png(path: &Path, (w, h): (u32, u32)) {
+    fn check_png(path: &std::path::Path, (w, h): (u32, u32)) {
         let bytes = std::fs::read(path).expect("PNG written");
         std::fs::remove_file(path).ok();
         assert_eq!(&bytes[..8], b"\x89PNG\r\n\x1a\n");
@@ -458,7 +459,7 @@ mod tests {
         size: (u32, u32),
     ) -> Result<(), PlotError> {
         let path = tmp(name);
-        plot_series(&path, x, axis, "y", y, y, markers, name, size)?;
+        plot_series(&mut std::fs::File::create(&path).unwrap(), x, axis, "y", y, y, markers, name, size)?;
         check_png(&path, size);
         Ok(())
     }
@@ -484,16 +485,13 @@ mod tests {
 
     #[test]
     fn series_errors() {
-        let p = tmp("err");
         let a = XAxis::Numeric("x".into());
-        assert!(plot_series(&p, &[], &a, "y", &[], &[], &[], "t", (600, 300)).is_err());
-        assert!(plot_series(&p, &[1.0, 2.0], &a, "y", &[1.0], &[1.0, 2.0], &[], "t", (600, 300)).is_err());
-        assert!(plot_series(&p, &[f64::NAN], &a, "y", &[1.0], &[1.0], &[], "t", (600, 300)).is_err());
-        assert!(plot_series(&p, &[1.0], &a, "y", &[1.0], &[1.0], &[], "t", (0, 300)).is_err());
-        let bad = Path::new("/nonexistent_dir_toposmooth/x.png");
-        let e = plot_series(bad, &[1.0], &a, "y", &[1.0], &[1.0], &[], "t", (600, 300)).unwrap_err();
-        assert!(e.0.contains("nonexistent_dir_toposmooth"), "{e}");
-        assert!(!p.exists());
+        let mut out = Vec::new();
+        assert!(plot_series(&mut out, &[], &a, "y", &[], &[], &[], "t", (600, 300)).is_err());
+        assert!(plot_series(&mut out, &[1.0, 2.0], &a, "y", &[1.0], &[1.0, 2.0], &[], "t", (600, 300)).is_err());
+        assert!(plot_series(&mut out, &[f64::NAN], &a, "y", &[1.0], &[1.0], &[], "t", (600, 300)).is_err());
+        assert!(plot_series(&mut out, &[1.0], &a, "y", &[1.0], &[1.0], &[], "t", (0, 300)).is_err());
+        assert!(out.is_empty(), "nothing is written before the checks pass");
     }
 
     #[test]
@@ -516,7 +514,7 @@ mod tests {
             ),
         ] {
             let path = tmp(name);
-            plot_persistence_diagram(&path, pts, t, name, (700, 600)).unwrap();
+            plot_persistence_diagram(&mut std::fs::File::create(&path).unwrap(), pts, t, name, (700, 600)).unwrap();
             check_png(&path, (700, 600));
         }
     }

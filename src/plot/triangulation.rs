@@ -4,7 +4,6 @@
 use super::{render, PlotError, FONT};
 use plotters::prelude::*;
 use std::collections::HashMap;
-use std::path::Path;
 
 const FILL: RGBColor = RGBColor(198, 219, 239);
 const EDGE: RGBColor = RGBColor(49, 99, 160);
@@ -17,12 +16,12 @@ const SIDE: f64 = 900.0;
 /// No triangle, a vertex index out of range, non-finite coordinates, or a drawing or writing
 /// failure.
 pub fn plot_triangulation(
-    path: &Path,
+    out: &mut dyn std::io::Write,
     positions: &[[f64; 3]],
     triangles: &[[usize; 3]],
     title: &str,
 ) -> Result<(), PlotError> {
-    let fail = |m: &str| PlotError(format!("plot {}: {m}", path.display()));
+    let fail = |m: &str| PlotError(format!("plot: {m}"));
     if triangles.is_empty() {
         return Err(fail("no triangle to draw"));
     }
@@ -56,7 +55,7 @@ pub fn plot_triangulation(
     }
     let xy = |v: usize| (positions[v][0], positions[v][1]);
     let thin = if triangles.len() > 20_000 { 0.5 } else { 1.0 };
-    render(path, canvas, |root, s| {
+    render(out, canvas, |root, s| {
         let mut chart = ChartBuilder::on(root)
             .caption(title, (FONT, 22.0 * s))
             .margin(15)
@@ -101,12 +100,13 @@ mod tests {
         std::fs::create_dir_all(&dir).unwrap();
         let path = dir.join("square.png");
         let p = [[0.0, 0.0, 0.0], [2.0, 0.0, 0.0], [2.0, 1.0, 0.0], [0.0, 1.0, 0.0]];
-        plot_triangulation(&path, &p, &[[0, 1, 2], [0, 2, 3]], "a rectangle").unwrap();
+        plot_triangulation(&mut std::fs::File::create(&path).unwrap(), &p, &[[0, 1, 2], [0, 2, 3]], "a rectangle")
+            .unwrap();
         let img = image::open(&path).unwrap().to_rgb8();
         // twice as wide as high, give or take the labels
         assert!(img.width() > img.height(), "{}x{}", img.width(), img.height());
         let filled = img.pixels().filter(|q| q.0 == [FILL.0, FILL.1, FILL.2]).count();
         assert!(filled > 100_000, "{filled}");
-        assert!(plot_triangulation(&path, &p, &[[0, 1, 7]], "t").is_err());
+        assert!(plot_triangulation(&mut std::fs::File::create(&path).unwrap(), &p, &[[0, 1, 7]], "t").is_err());
     }
 }

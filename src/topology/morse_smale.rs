@@ -145,7 +145,7 @@ mod tests {
                 select(&g, &h, &Selection::Count { minima: 1 + (seed % 4) as usize, maxima: 1 + (seed % 3) as usize })
                     .unwrap();
             let ms = MorseSmale::new(&g, &h, &kept).unwrap();
-            let on_boundary = |v: usize| v % nx == 0 || v % nx == nx - 1 || v / nx == 0 || v / nx == ny - 1;
+            let on_boundary = |v: usize| v.is_multiple_of(nx) || v % nx == nx - 1 || v / nx == 0 || v / nx == ny - 1;
             for (down, sep) in &ms.one_sided {
                 if on_boundary(sep.saddle) {
                     outer += 1;

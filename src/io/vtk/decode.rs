@@ -296,7 +296,7 @@ impl Shape<'_> {
             )));
         }
         let need = self.count(what)?.map(|c| c * self.ty.size());
-        if need.is_some_and(|n| n != got) || got % elem != 0 {
+        if need.is_some_and(|n| n != got) || !got.is_multiple_of(elem) {
             let need = match (need, self.tuples) {
                 (Some(n), Some(t)) => format!("{t} {} × {} components need {n} bytes", self.of, self.components),
                 _ => format!("{}-byte tuples need a multiple of {elem}", self.components),

@@ -1,0 +1,243 @@
+//! How the tool writes its outputs (issue 18): FIFOs and device nodes written in place,
+//! never replaced; the standard output (`-`); a closed pipe; interrupts; temporaries that
+//! cannot be turned against the user and are cleaned up. Device nodes and FIFOs are made in
+//! scratch directories, never in the machine's `/dev`.
+#![cfg(unix)]
+
+mod common;
+
+use common::{dataset, scratch, text, toposmooth};
+use std::os::unix::fs::FileTypeExt;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+
+fn bin() -> &'static str {
+    env!("CARGO_BIN_EXE_toposmooth")
+}
+
+/// The names in `dir` that are the tool's temporaries.
+fn temporaries(dir: &Path) -> Vec<String> {
+    std::fs::read_dir(dir)
+        .unwrap()
+        .flatten()
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .filter(|n| n.starts_with(".toposmooth-"))
+        .collect()
+}
+
+fn c_path(p: &Path) -> std::ffi::CString {
+    std::ffi::CString::new(p.as_os_str().as_encoded_bytes()).unwrap()
+}
+
+fn mkfifo(p: &Path) {
+    // SAFETY: a valid NUL-terminated path
+    assert_eq!(unsafe { libc::mkfifo(c_path(p).as_ptr(), 0o600) }, 0, "mkfifo {}", p.display());
+}
+
+/// A character device like `/dev/null` (1, 3) made at `p`; `false` where this process may not
+/// make device nodes (no CAP_MKNOD).
+fn mknod_null(p: &Path) -> bool {
+    // SAFETY: a valid NUL-terminated path
+    unsafe { libc::mknod(c_path(p).as_ptr(), libc::S_IFCHR | 0o666, libc::makedev(1, 3)) == 0 }
+}
+
+fn fx() -> String {
+    dataset("fx_eur_per_usd_daily_1999_2017.csv")
+}
+
+#[test]
+fn a_fifo_output_is_written_through_and_stays_a_fifo() {
+    let dir = scratch("fifo-out");
+    let fifo = dir.join("smoothed.csv");
+    mkfifo(&fifo);
+    let reader = {
+        let fifo = fifo.clone();
+        std::thread::spawn(move || std::fs::read_to_string(fifo).unwrap())
+    };
+    let o = toposmooth(&["smooth", &fx(), "-o", fifo.to_str().unwrap(), "--persistence", "2%"]);
+    assert!(o.status.success(), "{}", text(&o));
+    let csv = reader.join().unwrap();
+    assert!(csv.starts_with("date,input,output,u,role\n1999-01-04,0.8466,0.8466,"), "{}", &csv[..60.min(csv.len())]);
+    assert_eq!(csv.lines().count(), 4755, "header and 4754 samples");
+    assert!(std::fs::symlink_metadata(&fifo).unwrap().file_type().is_fifo(), "the FIFO is not replaced");
+    assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 1, "nothing beside the FIFO");
+}
+
+#[test]
+fn a_device_node_given_for_every_output_stays_a_device() {
+    let dir = scratch("device");
+    let null = dir.join("null");
+    if !mknod_null(&null) {
+        eprintln!("note: this process may not make device nodes; checked with a FIFO only");
+        return;
+    }
+    let n = null.to_str().unwrap();
+    // the report, the figure and the output all go to the device; no extension says the
+    // format, so the output takes the series' streamable one (CSV) and the figure PNG
+    let o = toposmooth(&["smooth", &fx(), "-o", n, "--report", n, "--plot", n, "--persistence", "2%"]);
+    assert!(o.status.success(), "{}", text(&o));
+    let m = std::fs::symlink_metadata(&null).unwrap();
+    assert!(m.file_type().is_char_device(), "the device is not replaced by a regular file");
+    assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 1, "nothing beside the device");
+}
+
+#[test]
+fn dash_writes_the_output_on_stdout_and_the_summary_on_stderr() {
+    let o = toposmooth(&["smooth", &fx(), "-o", "-", "--persistence", "2%"]);
+    assert!(o.status.success(), "{}", text(&o));
+    let out = String::from_utf8(o.stdout.clone()).unwrap();
+    assert!(out.starts_with("date,input,output,u,role\n"), "{}", &out[..40.min(out.len())]);
+    assert_eq!(out.lines().count(), 4755);
+    let err = String::from_utf8(o.stderr.clone()).unwrap();
+    assert!(err.contains("certified"), "{err}");
+    // two outputs on one standard output are refused before any work
+    let o = toposmooth(&["smooth", &fx(), "-o", "-", "--report", "-"]);
+    assert_eq!(o.status.code(), Some(2), "{}", text(&o));
+}
+
+#[test]
+fn a_closed_pipe_ends_quietly_with_status_141() {
+    let mut child =
+        Command::new(bin()).args(["extrema", &fx()]).stdout(Stdio::piped()).stderr(Stdio::piped()).spawn().unwrap();
+    let mut stdout = child.stdout.take().unwrap();
+    let mut first = [0u8; 16];
+    std::io::Read::read_exact(&mut stdout, &mut first).unwrap();
+    drop(stdout); // as `| head -c 16` does
+    let o = child.wait_with_output().unwrap();
+    assert_eq!(o.status.code(), Some(141), "{}", text(&o));
+    assert!(o.stderr.is_empty(), "no message, no panic: {}", String::from_utf8_lossy(&o.stderr));
+}
+
+/// A 300 × 300 noisy grid: a run that lasts long enough to be interrupted.
+fn long_grid(dir: &Path) -> PathBuf {
+    let v = common::uniform(7, 300 * 300);
+    let rows: Vec<String> =
+        v.chunks(300).map(|r| r.iter().map(|x| format!("{x}")).collect::<Vec<_>>().join(",")).collect();
+    let p = dir.join("noise.csv");
+    std::fs::write(&p, rows.join("\n") + "\n").unwrap();
+    p
+}
+
+#[test]
+fn an_interrupted_run_removes_its_temporaries_and_writes_nothing() {
+    for signal in [libc::SIGINT, libc::SIGTERM] {
+        let dir = scratch(&format!("interrupt-{signal}"));
+        let input = long_grid(&dir);
+        let out = dir.join("out").join("smoothed.vti");
+        std::fs::create_dir(out.parent().unwrap()).unwrap();
+        let report = out.with_file_name("run.json");
+        let mut child = Command::new(bin())
+            .args(["smooth", input.to_str().unwrap(), "-o", out.to_str().unwrap(), "--persistence", "1%"])
+            .args(["--report", report.to_str().unwrap()])
+            .stdout(Stdio::null())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
+        // the temporaries are reserved before any work: wait for both
+        let t = std::time::Instant::now();
+        while temporaries(out.parent().unwrap()).len() < 2 {
+            assert!(t.elapsed().as_secs() < 60, "no temporaries reserved");
+            assert!(child.try_wait().unwrap().is_none(), "the run ended before it could be interrupted");
+            std::thread::sleep(std::time::Duration::from_millis(5));
+        }
+        // SAFETY: signalling our own child
+        assert_eq!(unsafe { libc::kill(child.id() as libc::pid_t, signal) }, 0);
+        let status = child.wait().unwrap();
+        use std::os::unix::process::ExitStatusExt;
+        assert_eq!(status.signal(), Some(signal), "ends as the signal ends a process: {status:?}");
+        assert!(temporaries(out.parent().unwrap()).is_empty(), "{:?}", temporaries(out.parent().unwrap()));
+        assert!(!out.exists() && !report.exists());
+    }
+}
+
+#[test]
+fn stale_temporaries_are_removed_only_when_no_run_holds_them() {
+    let dir = scratch("stale");
+    let stale = dir.join(".toposmooth-999999-0123456789abcdef.tmp.csv");
+    let held = dir.join(".toposmooth-999998-0123456789abcdef.tmp");
+    std::fs::write(&stale, "left by a run killed with SIGKILL").unwrap();
+    std::fs::write(&held, "a live run's").unwrap();
+    let lock = std::fs::File::open(&held).unwrap();
+    lock.lock().unwrap();
+    // a link with a temporary's name is never followed nor removed
+    let victim = dir.join("victim.txt");
+    std::fs::write(&victim, "precious").unwrap();
+    let link = dir.join(".toposmooth-999997-0123456789abcdef.tmp");
+    std::os::unix::fs::symlink(&victim, &link).unwrap();
+    let out = dir.join("fx.csv");
+    let o = toposmooth(&["smooth", &fx(), "-o", out.to_str().unwrap(), "--persistence", "2%"]);
+    assert!(o.status.success(), "{}", text(&o));
+    assert!(!stale.exists(), "a temporary whose lock is free is removed");
+    assert!(held.exists(), "a locked temporary is kept");
+    assert!(std::fs::symlink_metadata(&link).is_ok());
+    assert_eq!(std::fs::read_to_string(&victim).unwrap(), "precious");
+    drop(lock);
+}
+
+#[test]
+fn a_link_at_the_target_is_replaced_not_written_through() {
+    let dir = scratch("target-link");
+    let victim = dir.join("victim.csv");
+    std::fs::write(&victim, "precious").unwrap();
+    let out = dir.join("fx.csv");
+    std::os::unix::fs::symlink(&victim, &out).unwrap();
+    let o = toposmooth(&["smooth", &fx(), "-o", out.to_str().unwrap(), "--persistence", "2%"]);
+    assert!(o.status.success(), "{}", text(&o));
+    assert!(std::fs::symlink_metadata(&out).unwrap().is_file());
+    assert_eq!(std::fs::read_to_string(&victim).unwrap(), "precious");
+}
+
+#[test]
+fn long_and_non_utf8_output_names_work() {
+    use std::os::unix::ffi::OsStrExt;
+    let dir = scratch("names");
+    let long = dir.join(format!("{}.csv", "x".repeat(251)));
+    let a = dir.join(std::ffi::OsStr::from_bytes(b"r\xff.json"));
+    let b = dir.join(std::ffi::OsStr::from_bytes(b"r\xfe.json"));
+    let o = Command::new(bin())
+        .args(["smooth", &fx(), "--persistence", "2%", "-o"])
+        .arg(&long)
+        .arg("--report")
+        .arg(&a)
+        .arg("--plot")
+        .arg(dir.join(std::ffi::OsStr::from_bytes(b"p\xfe.png")))
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", text(&o));
+    assert!(std::fs::read_to_string(&long).unwrap().starts_with("date,"));
+    assert!(std::fs::read_to_string(&a).unwrap().contains("\"certificate\""));
+    assert!(!b.exists());
+    assert!(temporaries(&dir).is_empty());
+}
+
+#[test]
+fn outputs_that_cannot_be_written_are_refused_before_any_work() {
+    let dir = scratch("before-work");
+    let fx = fx();
+    let out = dir.join("fx.csv");
+    let o_ = out.to_str().unwrap();
+    let (jpg, vti) = (dir.join("f.jpg"), dir.join("fx.vti"));
+    let cases: [(&[&str], &str); 5] = [
+        (&["-o", dir.to_str().unwrap()], "is a directory"),
+        (&["-o", o_, "--report", "/nonexistent-toposmooth/r.json"], "does not exist"),
+        (&["-o", o_, "--plot", jpg.to_str().unwrap()], "PNG"),
+        (&["-o", vti.to_str().unwrap()], "written as .csv"),
+        (&["-o", o_, "--isolines", "1000000000"], "0..=1000"),
+    ];
+    for (args, needle) in cases {
+        let mut all = vec!["smooth", fx.as_str()];
+        all.extend_from_slice(args);
+        let o = toposmooth(&all);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {}", text(&o));
+        assert!(text(&o).contains(needle), "{args:?}: `{needle}` not in {}", text(&o));
+        assert!(!text(&o).contains("seconds:"), "{args:?}: refused before the work: {}", text(&o));
+        assert!(!out.exists());
+        assert!(temporaries(&dir).is_empty(), "{args:?}: {:?}", temporaries(&dir));
+    }
+    let o = toposmooth(&["smooth", &fx, "-o", o_, "--isolines", "5"]);
+    assert_eq!(o.status.code(), Some(2), "a series has no isolines: {}", text(&o));
+    let o = toposmooth(&["bench", "--sizes", "1000000000000"]);
+    assert_eq!(o.status.code(), Some(2), "{}", text(&o));
+    let o = toposmooth(&["bench", "--sizes", "100000x100000"]);
+    assert_eq!(o.status.code(), Some(2), "{}", text(&o));
+}

@@ -237,3 +237,44 @@ fn usage_errors_exit_2() {
         assert_eq!(out.status.code(), Some(2), "{args:?}: {}", text(&out));
     }
 }
+
+#[test]
+fn reports_carry_the_version_the_command_line_and_a_structured_selection() {
+    let dir = scratch("provenance");
+    let out = dir.join("v.vti").display().to_string();
+    let report = dir.join("run.json").display().to_string();
+    let piv = dataset("soapfilm_piv_vorticity_63x63.csv");
+    let args = ["smooth", &piv, "--fill-missing", "-o", &out, "--persistence", "5%", "--report", &report];
+    let o = toposmooth(&args);
+    assert!(o.status.success(), "{}", text(&o));
+    let r: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    assert_eq!(r["tool"], "toposmooth");
+    assert_eq!(r["version"], env!("CARGO_PKG_VERSION"));
+    let line: Vec<&str> = r["command_line"].as_array().unwrap().iter().map(|v| v.as_str().unwrap()).collect();
+    assert_eq!(&line[1..], &args[..], "the arguments as given");
+    assert_eq!(r["settings"]["selection"], serde_json::json!({"rule": "relative", "fraction_of_range": 0.05}));
+    // each kept extremum with its position: grid vertex index = row · 63 + column, spacing 1
+    let kept = r["kept"].as_array().unwrap();
+    assert!(!kept.is_empty());
+    for k in kept {
+        let i = k["index"].as_u64().unwrap();
+        let p: Vec<f64> = k["point"].as_array().unwrap().iter().map(|v| v.as_f64().unwrap()).collect();
+        assert_eq!(p, [(i % 63) as f64, (i / 63) as f64, 0.0], "{k}");
+    }
+    let o = toposmooth(&[
+        "smooth",
+        &piv,
+        "--fill-missing",
+        "-o",
+        &out,
+        "--minima",
+        "2",
+        "--maxima",
+        "3",
+        "--report",
+        &report,
+    ]);
+    assert!(o.status.success(), "{}", text(&o));
+    let r: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    assert_eq!(r["settings"]["selection"], serde_json::json!({"rule": "count", "minima": 2, "maxima": 3}));
+}

@@ -11,7 +11,7 @@ use crate::apps::handles::{resolve, Handle, HandleShape};
 use crate::apps::weights::{weights, WeightMethod, WeightSettings};
 use crate::domain::{Domain, TriMesh};
 use crate::error::{Error, Result};
-use crate::io::{stage_json, stage_with, Staged};
+use crate::io::{stage_with, Staged};
 use crate::plot::{plot_mesh_colours, MeshView};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -126,7 +126,7 @@ pub fn diffuse(args: &DiffuseArgs) -> Result<String> {
             max_normalisation_change: w.max_normalisation_change,
             seconds: start.elapsed().as_secs_f64(),
         };
-        staged.push(stage_json(path, &report)?);
+        staged.push(super::stage_report(path, &report)?);
         wrote.push(path.display().to_string());
     }
     crate::io::commit_all(staged)?;

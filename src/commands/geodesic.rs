@@ -6,7 +6,6 @@ use crate::apps::geodesic::{heat_geodesic, GeodesicSeconds};
 use crate::domain::Domain;
 use crate::error::{Error, Result};
 use crate::io::export::stage_mesh;
-use crate::io::stage_json;
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -68,7 +67,7 @@ pub fn geodesic(args: &GeodesicArgs) -> Result<String> {
             write_seconds,
             total_seconds: start.elapsed().as_secs_f64(),
         };
-        staged.push(stage_json(path, &report)?);
+        staged.push(super::stage_report(path, &report)?);
     }
     crate::io::commit_all(staged)?;
     let warning = mesh.sliver_warning().map(|w| format!("warning: {w}\n")).unwrap_or_default();

@@ -201,6 +201,26 @@ fn stage_plot(
     crate::io::stage(path, |w| draw(w).map_err(|e| std::io::Error::other(e.to_string())))
 }
 
+/// A JSON report with what reproduces it first: the tool, its version and the full command
+/// line (arguments as given; bytes that are not UTF-8 replaced).
+#[derive(serde::Serialize)]
+struct WithProvenance<'a, T: serde::Serialize> {
+    tool: &'static str,
+    version: &'static str,
+    command_line: Vec<String>,
+    #[serde(flatten)]
+    report: &'a T,
+}
+
+/// Stages a command's JSON report (see [`WithProvenance`]).
+fn stage_report<T: serde::Serialize>(path: &Path, report: &T) -> Result<crate::io::Staged> {
+    let command_line = std::env::args_os().map(|a| a.to_string_lossy().into_owned()).collect();
+    crate::io::stage_json(
+        path,
+        &WithProvenance { tool: "toposmooth", version: env!("CARGO_PKG_VERSION"), command_line, report },
+    )
+}
+
 /// The line listing the files written (the given paths, skipping `None`).
 fn wrote_line<'a>(paths: impl IntoIterator<Item = Option<&'a std::path::PathBuf>>) -> String {
     let names: Vec<String> = paths.into_iter().flatten().map(|p| p.display().to_string()).collect();

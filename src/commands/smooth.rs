@@ -7,7 +7,7 @@ use super::{check_distinct, check_png_name, sig6, stage_plot, x_axis};
 use crate::domain::AnyDomain;
 use crate::error::{Error, Result};
 use crate::io::export::{check_complex_output, check_output, check_written, stage_complex, stage_results, Results};
-use crate::io::{stage_json, Staged};
+use crate::io::Staged;
 use crate::pipeline::{smooth_any, Report, Smoothed};
 use crate::plot::{plot_grid_fields, plot_mesh_fields, plot_series, GridMarker, GridPanel, GridPlotOptions, Marker};
 use crate::topology::Role;
@@ -149,7 +149,7 @@ pub fn smooth(args: &SmoothArgs) -> Result<String> {
             separatrices: result.complex.as_ref().map(|c| c.descending.len() + c.ascending.len()),
             report: &result.report,
         };
-        staged.push(stage_json(path, &run)?);
+        staged.push(super::stage_report(path, &run)?);
     }
     crate::io::commit_all(staged)?;
 

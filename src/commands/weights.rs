@@ -8,7 +8,7 @@ use crate::apps::handles::{parse_handles, resolve, HandleFile};
 use crate::apps::weights::{weights as compute, WeightMethod, WeightSettings, Weights};
 use crate::domain::{Domain, TriMesh};
 use crate::error::{Error, Result};
-use crate::io::{stage_json, Staged};
+use crate::io::Staged;
 use crate::plot::{plot_mesh_fields, GridMarker, GridPanel, MeshView};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -226,7 +226,7 @@ fn run_cage(args: &WeightsArgs, shape: &TriMesh, cage: &[[f64; 2]], start: Insta
             linear_reproduction_error: f64,
             total_seconds: f64,
         }
-        staged.push(stage_json(
+        staged.push(super::stage_report(
             path,
             &CageReport {
                 input_file: args.input.display().to_string(),
@@ -345,7 +345,7 @@ pub fn run_weights(
             total_seconds: start.elapsed().as_secs_f64(),
             comparison,
         };
-        staged.push(stage_json(path, &report)?);
+        staged.push(super::stage_report(path, &report)?);
     }
     finish(args, mesh, names, sets, &w, &others, staged, start)
 }

@@ -55,7 +55,7 @@ pub struct EnergyReport {
 #[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct RunSettings {
     /// The selection as given.
-    pub selection: String,
+    pub selection: crate::topology::Selection,
     /// Absolute persistence threshold applied, if any.
     pub threshold: Option<f64>,
     /// Smoothness energy: orders, weights, sharp vertices.

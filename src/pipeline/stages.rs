@@ -329,7 +329,7 @@ impl Run<'_> {
             input_minima: self.extrema.0,
             input_maxima: self.extrema.1,
             settings: RunSettings {
-                selection: format!("{:?}", settings.selection),
+                selection: settings.selection.clone(),
                 threshold: kept.threshold,
                 energy: settings.energy.clone(),
                 data_weight: gd,

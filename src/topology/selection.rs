@@ -35,6 +35,37 @@ pub enum Selection {
     },
 }
 
+/// In a JSON report: `{"rule": "relative", "fraction_of_range": 0.05}`,
+/// `{"rule": "absolute", "persistence": 0.3}`, `{"rule": "count", "minima": 7, "maxima": 6}`,
+/// `{"rule": "pairs", "pairs": 4}`, `{"rule": "all_maxima"}`, `{"rule": "all_minima"}`,
+/// `{"rule": "explicit", "minima": [..], "maxima": [..]}`.
+#[cfg(feature = "serde")]
+impl serde::Serialize for Selection {
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> std::result::Result<S::Ok, S::Error> {
+        #[derive(serde::Serialize)]
+        #[serde(tag = "rule", rename_all = "snake_case")]
+        enum Record<'a> {
+            Absolute { persistence: f64 },
+            Relative { fraction_of_range: f64 },
+            Count { minima: usize, maxima: usize },
+            Pairs { pairs: usize },
+            AllMaxima,
+            AllMinima,
+            Explicit { minima: &'a [usize], maxima: &'a [usize] },
+        }
+        let record = match self {
+            Selection::Absolute(t) => Record::Absolute { persistence: *t },
+            Selection::Relative(t) => Record::Relative { fraction_of_range: *t },
+            Selection::Count { minima, maxima } => Record::Count { minima: *minima, maxima: *maxima },
+            Selection::Pairs(n) => Record::Pairs { pairs: *n },
+            Selection::AllMaxima => Record::AllMaxima,
+            Selection::AllMinima => Record::AllMinima,
+            Selection::Explicit { minima, maxima } => Record::Explicit { minima, maxima },
+        };
+        record.serialize(serializer)
+    }
+}
+
 impl Selection {
     /// Whether the kept set is chosen by persistence (then it is always realizable and any
     /// failure to certify it is our bug, exit 1).
@@ -120,6 +151,9 @@ pub struct KeptExtremum {
     /// Persistence of its pair; `None` (JSON null) for essential or explicitly listed ones
     /// that have none.
     pub persistence: Option<f64>,
+    /// Its position in the domain's coordinates (a series' x, a grid's x and y, a mesh's
+    /// x, y, z; unused coordinates 0).
+    pub point: [f64; 3],
 }
 
 /// The kept extrema and the role of every vertex.
@@ -231,7 +265,7 @@ pub fn select<D: Domain>(domain: &D, values: &[f64], selection: &Selection) -> R
         }
     };
 
-    let (mut roles, mut kept) = roles_of(n, values, &kept_min, &kept_max);
+    let (mut roles, mut kept) = roles_of(domain, values, &kept_min, &kept_max);
     kept.sort_by_key(|k| k.index);
     if domain.pairing_rule() == PairingRule::Path {
         for end in [0, n - 1] {
@@ -279,8 +313,8 @@ fn check_field<D: Domain>(domain: &D, values: &[f64]) -> Result<(f64, f64)> {
 }
 
 /// The roles and the kept extrema (minima first, then maxima, with their finite persistence).
-fn roles_of(n: usize, values: &[f64], kept_min: &Kept, kept_max: &Kept) -> (Vec<Role>, Vec<KeptExtremum>) {
-    let mut roles = vec![Role::Other; n];
+fn roles_of<D: Domain>(domain: &D, values: &[f64], kept_min: &Kept, kept_max: &Kept) -> (Vec<Role>, Vec<KeptExtremum>) {
+    let mut roles = vec![Role::Other; domain.n_vertices()];
     let mut kept = Vec::new();
     for &(v, p) in kept_min {
         roles[v] = Role::Min;
@@ -289,6 +323,7 @@ fn roles_of(n: usize, values: &[f64], kept_min: &Kept, kept_max: &Kept) -> (Vec<
             role: Role::Min,
             value: values[v],
             persistence: p.filter(|x| x.is_finite()),
+            point: domain.point(v),
         });
     }
     for &(v, p) in kept_max {
@@ -298,6 +333,7 @@ fn roles_of(n: usize, values: &[f64], kept_min: &Kept, kept_max: &Kept) -> (Vec<
             role: Role::Max,
             value: values[v],
             persistence: p.filter(|x| x.is_finite()),
+            point: domain.point(v),
         });
     }
     (roles, kept)
@@ -437,12 +473,19 @@ fn check_explicit<D: Domain>(domain: &D, values: &[f64], minima: &[usize], maxim
     if domain.pairing_rule() == PairingRule::Path {
         let mut kept: Vec<KeptExtremum> = minima
             .iter()
-            .map(|&v| KeptExtremum { index: v, role: Role::Min, value: values[v], persistence: None })
+            .map(|&v| KeptExtremum {
+                index: v,
+                role: Role::Min,
+                value: values[v],
+                persistence: None,
+                point: domain.point(v),
+            })
             .chain(maxima.iter().map(|&v| KeptExtremum {
                 index: v,
                 role: Role::Max,
                 value: values[v],
                 persistence: None,
+                point: domain.point(v),
             }))
             .collect();
         kept.sort_by_key(|k| k.index);

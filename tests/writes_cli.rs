@@ -133,10 +133,8 @@ fn an_interrupted_run_removes_its_temporaries_and_writes_nothing() {
             .stderr(Stdio::piped())
             .spawn()
             .unwrap();
-        // the temporaries are reserved before any work: wait for both
-        let t = std::time::Instant::now();
+        // the temporaries are reserved before any work: wait for both (or fail if the run ends first)
         while temporaries(out.parent().unwrap()).len() < 2 {
-            assert!(t.elapsed().as_secs() < 60, "no temporaries reserved");
             assert!(child.try_wait().unwrap().is_none(), "the run ended before it could be interrupted");
             std::thread::sleep(std::time::Duration::from_millis(5));
         }

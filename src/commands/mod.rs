@@ -245,9 +245,7 @@ fn check_distinct(inputs: &[&Path], outputs: &[(&str, Option<&Path>)]) -> Result
     let mut reserve = Vec::new();
     for (name, p) in outputs {
         if let Some(p) = p {
-            if p.is_dir() {
-                return Err(Error::Usage(format!("{name} {} is a directory", p.display())));
-            }
+            // a directory, socket or missing directory: refused by `reserve` below
             let k = key(p);
             if let Some((other, _)) = seen.iter().find(|(_, s)| *s == k) {
                 if !is_char_device(p) {

@@ -65,6 +65,7 @@ pub(crate) mod linalg;
 pub mod pipeline;
 #[cfg(feature = "plot")]
 pub mod plot;
+pub mod progress;
 pub(crate) mod representative;
 pub mod series_fill;
 pub mod smoother;

@@ -20,6 +20,10 @@ use toposmooth::{Error, Result};
 #[derive(Parser)]
 #[command(name = "toposmooth", version, about, long_about = None)]
 struct Cli {
+    /// No progress on standard error (the stages, the input's summary); errors and warnings
+    /// are still printed.
+    #[arg(long, short, global = true)]
+    quiet: bool,
     #[command(subcommand)]
     command: Command,
 }
@@ -565,5 +569,10 @@ fn main() {
     commands::install_panic_hook();
     commands::install_interrupt_handler();
     let cli = Cli::parse();
-    std::process::exit(commands::finish(commands::catch_panics(|| run(cli))));
+    // a benchmark's table is its progress
+    let quiet = cli.quiet || matches!(cli.command, Command::Bench { .. });
+    let mode = commands::progress::ProgressMode::detect(quiet);
+    std::process::exit(commands::finish(commands::progress::with_progress(mode, || {
+        commands::catch_panics(|| run(cli))
+    })));
 }

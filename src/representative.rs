@@ -205,10 +205,13 @@ pub fn separatrix_representative<D: crate::domain::Domain>(
         hi - lo
     };
     let mut prescribed = prescribed;
-    for _ in 0..MAX_RELEASE_ROUNDS {
+    for round in 1..=MAX_RELEASE_ROUNDS {
         let fixed: Vec<Option<f64>> = (0..n).map(|v| if released[v] { None } else { prescribed[v] }).collect();
         let u = dirichlet.solve(&fixed)?;
         let bad = failing(domain, kept, &u);
+        crate::progress::update("representative", || {
+            format!("separatrix round {round}: {} vertices fail, {count} released so far", bad.len())
+        });
         let repairs = Repairs { released: count, moved: moved.len(), pinned: pinned.len() };
         if bad.is_empty() {
             return Ok((u, repairs));

@@ -239,3 +239,33 @@ fn outputs_that_cannot_be_written_are_refused_before_any_work() {
     let o = toposmooth(&["bench", "--sizes", "100000x100000"]);
     assert_eq!(o.status.code(), Some(2), "{}", text(&o));
 }
+
+#[test]
+fn progress_is_one_line_per_stage_off_a_terminal_and_quiet_silences_it() {
+    let dir = scratch("progress");
+    let out = dir.join("v.csv");
+    let volcano = dataset("volcano_maunga_whau_61x87.csv");
+    let o = toposmooth(&["smooth", &volcano, "-o", out.to_str().unwrap(), "--persistence", "5%"]);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+    let err = String::from_utf8(o.stderr.clone()).unwrap();
+    let stages: Vec<&str> = err.lines().filter_map(|l| l.split_once(": ").map(|(s, _)| s)).collect();
+    // the input's summary first, then each stage once, in the order they run; no spinner frames
+    assert_eq!(stages, ["read", "selection", "complex", "representative", "solve", "certificate", "write"], "{err}");
+    assert!(err.lines().next().unwrap().contains("grid 87 × 61 (5307 vertices)"), "{err}");
+    let solve = err.lines().find(|l| l.starts_with("solve: ")).unwrap();
+    assert!(solve.contains("Solved after") && solve.contains("iterations"), "{solve}");
+    assert!(!err.contains('\r') && !err.contains('\u{1b}'), "no terminal control off a terminal: {err:?}");
+    // the summary on standard output is unchanged by progress
+    assert!(String::from_utf8_lossy(&o.stdout).contains("certified"), "{}", text(&o));
+
+    // --quiet, before or after the command: no stage lines; the summary stays
+    for args in [vec!["--quiet", "smooth"], vec!["smooth", "-q"]] {
+        let mut a = args.clone();
+        a.extend([volcano.as_str(), "-o", out.to_str().unwrap(), "--persistence", "5%"]);
+        let o = toposmooth(&a);
+        assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+        let err = String::from_utf8(o.stderr.clone()).unwrap();
+        assert!(!err.lines().any(|l| l.starts_with("solve: ") || l.starts_with("read: ")), "{err}");
+        assert!(String::from_utf8_lossy(&o.stdout).contains("certified"), "{}", text(&o));
+    }
+}

@@ -378,6 +378,8 @@ pub fn weights_prescribed<D: Smoothable + Sync>(
         bounded(domain, prescribed, &ops, settings)?
     } else {
         let next = AtomicUsize::new(0);
+        let done = AtomicUsize::new(0);
+        let stage = crate::progress::Stage::begin("weights");
         let threads = settings.threads.clamp(1, count);
         let mut results: Vec<Option<Result<WeightFunction>>> = (0..count).map(|_| None).collect();
         std::thread::scope(|s| {
@@ -394,6 +396,8 @@ pub fn weights_prescribed<D: Smoothable + Sync>(
                                 break;
                             }
                             mine.push((h, one_function(domain, &prescribed[h], h, &ops, settings, &mut analyses)));
+                            let d = done.fetch_add(1, Ordering::Relaxed) + 1;
+                            stage.update(|| format!("{d} of {count} functions"));
                         }
                         mine
                     })
@@ -405,7 +409,9 @@ pub fn weights_prescribed<D: Smoothable + Sync>(
                 }
             }
         });
-        results.into_iter().map(|r| r.expect("every handle was computed")).collect::<Result<_>>()?
+        let functions = results.into_iter().map(|r| r.expect("every handle was computed")).collect::<Result<_>>()?;
+        stage.end(|| format!("{count} functions on {threads} threads"));
+        functions
     };
     let function_seconds = t.elapsed().as_secs_f64();
     if settings.method == WeightMethod::Monotone {

@@ -8,6 +8,7 @@ mod extrema;
 mod geodesic;
 pub mod input;
 mod mesh_outline;
+pub mod progress;
 mod smooth;
 mod smooth_args;
 mod verify;

@@ -4,7 +4,7 @@
 use super::input::{read_field, Field};
 use super::smooth_args::{fit_and_solver_lines, seconds_line, SmoothArgs};
 use super::{check_distinct, check_png_name, sig6, stage_plot, x_axis};
-use crate::domain::AnyDomain;
+use crate::domain::{AnyDomain, Domain};
 use crate::error::{Error, Result};
 use crate::io::export::{check_complex_output, check_output, check_written, stage_complex, stage_results, Results};
 use crate::io::Staged;
@@ -87,6 +87,7 @@ pub fn smooth(args: &SmoothArgs) -> Result<String> {
         return Err(Error::setting("isolines", "draws on a grid's figure only; this input is not a grid"));
     }
     let read_seconds = start.elapsed().as_secs_f64();
+    super::progress::line(&format!("read: {:.2} s ({})", read_seconds, read_line(&field)));
     let filled_samples: Vec<usize> =
         field.filled.as_ref().map(|m| (0..m.len()).filter(|&i| m[i]).collect()).unwrap_or_default();
     check_explicit_not_filled(&field, &args.settings.selection, &filled_samples)?;
@@ -101,6 +102,7 @@ pub fn smooth(args: &SmoothArgs) -> Result<String> {
     }
 
     let t = Instant::now();
+    let write_stage = crate::progress::Stage::begin("write");
     // every output is staged first and committed together at the end
     let results = Results {
         input: &field.values,
@@ -151,7 +153,9 @@ pub fn smooth(args: &SmoothArgs) -> Result<String> {
         };
         staged.push(super::stage_report(path, &run)?);
     }
+    let files = staged.len();
     crate::io::commit_all(staged)?;
+    write_stage.end(|| format!("{files} file{}", if files == 1 { "" } else { "s" }));
 
     Ok(summary(
         args,
@@ -235,6 +239,23 @@ fn facts(field: &Field, negative: usize) -> DomainFacts<'_> {
             negative_cotangent_edges: negative,
             reading_notes: &field.notes,
         },
+    }
+}
+
+/// What was read, for the progress line printed before the work starts.
+fn read_line(field: &Field) -> String {
+    let path = field.path.display();
+    match &field.domain {
+        AnyDomain::Series(d) => format!("{path}: {} samples of `{}`", d.n_vertices(), field.description),
+        AnyDomain::Grid(g) => {
+            format!("{path}: grid {} × {} ({} vertices) of `{}`", g.nx(), g.ny(), g.n_vertices(), field.description)
+        }
+        AnyDomain::Mesh(m) => format!(
+            "{path}: mesh of {} vertices and {} triangles, field `{}`",
+            m.n_vertices(),
+            m.faces().len(),
+            field.description
+        ),
     }
 }
 

@@ -20,6 +20,7 @@ use crate::domain::Domain;
 use crate::error::{Error, Result};
 use crate::linalg::Analyses;
 use crate::operators::Sparse;
+use crate::progress::Stage;
 use crate::solve::{solve_monotone_qp_with, Bound, Method, MonotoneQp};
 use crate::topology::morse_smale::MorseSmale;
 use crate::topology::{count_sos_extrema, select, Role};
@@ -129,10 +130,18 @@ pub(crate) fn smooth_on<D: Smoothable + Sync>(
     }
     let mut seconds = StageSeconds::default();
 
-    let t = Instant::now();
+    let stage = Stage::begin("selection");
     let kept = select(domain, h, &settings.selection)?;
     let extrema = count_sos_extrema(domain, h);
-    seconds.persistence = t.elapsed().as_secs_f64();
+    seconds.persistence = stage.end(|| {
+        format!(
+            "{} of {} minima and {} of {} maxima kept",
+            kept.minima().len(),
+            extrema.0,
+            kept.maxima().len(),
+            extrema.1
+        )
+    });
     let length = match settings.smooth_length {
         Some(fraction) => (fraction * domain.diameter(), format!("{fraction} of the diameter, as given")),
         None => default_smooth_length(domain, &kept),
@@ -157,7 +166,11 @@ pub(crate) fn smooth_on<D: Smoothable + Sync>(
             };
             (built, seconds, prepared)
         });
+        let stage = Stage::begin("representative");
         let ordered = order_representative(domain, &problem, settings, ops.fill(), analyses, &mut seconds);
+        if let Ok(o) = &ordered {
+            stage.end(|| format!("{}, {} constraint edges", o.name, o.edges.len()));
+        }
         (ordered, background.join().unwrap_or_else(|e| std::panic::resume_unwind(e)))
     });
     let ordered = ordered?;
@@ -171,17 +184,17 @@ pub(crate) fn smooth_on<D: Smoothable + Sync>(
         ops.own_fill = None;
     }
 
-    let t = Instant::now();
+    let stage = Stage::begin("solve");
     let sol = solve_qp(&problem, &ordered, &operators, settings, analyses, prepared)?;
-    seconds.solve = t.elapsed().as_secs_f64();
+    seconds.solve = stage.end(|| format!("{:?} after {} iterations", sol.status, sol.iterations));
 
     let t = Instant::now();
     let (f, margin_repair, strictness_repair) = output_of(&sol.x, &problem, &ordered);
     seconds.repair = t.elapsed().as_secs_f64();
 
-    let t = Instant::now();
+    let stage = Stage::begin("certificate");
     let certificate = certify(domain, &f, &kept.roles, Some(h));
-    seconds.verify = t.elapsed().as_secs_f64();
+    seconds.verify = stage.end(|| if certificate.passed { "passed".into() } else { "FAILED".into() });
     if !certificate.passed {
         return Err(Error::Uncertified {
             path: None,

@@ -212,9 +212,21 @@ fn surface_representative<D: Domain>(
     let analyses = std::cell::RefCell::new(analyses);
     let mut why: Vec<String> = excluded.iter().map(|(kind, e)| format!("{kind} representative: {e}")).collect();
     let skip = |kind: RepresentativeKind| excluded.iter().any(|(x, _)| *x == kind);
+    let stage = crate::progress::Stage::begin("complex");
     let complex = match MorseSmale::new(domain, h, kept) {
-        Ok(ms) => Some(ms),
+        Ok(ms) => {
+            stage.end(|| {
+                format!(
+                    "{} saddles, {} descending and {} ascending separatrices",
+                    ms.saddles.len(),
+                    ms.descending.len(),
+                    ms.ascending.len()
+                )
+            });
+            Some(ms)
+        }
         Err(e) => {
+            stage.end(|| format!("not built ({e})"));
             why.push(format!("Morse-Smale complex: {e}"));
             None
         }
@@ -259,6 +271,7 @@ fn surface_representative<D: Domain>(
         None
     };
     let harmonic = |why: &mut Vec<String>| -> Option<Vec<f64>> {
+        crate::progress::update("representative", || "harmonic fill".into());
         match harmonic_representative(h, kept, k) {
             Ok(u) => {
                 let c = certify(domain, &u, &kept.roles, None);
@@ -272,6 +285,7 @@ fn surface_representative<D: Domain>(
         None
     };
     let flooded = |why: &mut Vec<String>| -> Option<Vec<f64>> {
+        crate::progress::update("representative", || "flooded".into());
         let u = flooded_representative(domain, h, kept);
         if u.is_none() {
             why.push("flooded representative: the floods did not settle".into());

@@ -78,7 +78,7 @@ impl<'a> Problem<'a> {
 pub(super) struct Ordered {
     pub(super) u: Vec<f64>,
     /// The construction, with its variant.
-    name: String,
+    pub(super) name: String,
     /// Why each construction tried before it was not used.
     fallbacks: Vec<String>,
     pub(super) complex: Option<MorseSmale>,

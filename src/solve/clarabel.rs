@@ -114,6 +114,18 @@ pub(super) fn run(
         .map_err(|e| Error::NoSolution { path: None, status: format!("bad solver settings: {e:?}") })?;
     let mut solver = DefaultSolver::new(p, q, a, b, cones, solver_settings)
         .map_err(|e| Error::NoSolution { path: None, status: format!("solver setup failed: {e}") })?;
+    if let Some(observer) = crate::progress::current() {
+        solver.set_termination_callback(move |info: &clarabel::solver::DefaultInfo<f64>| {
+            observer.update(
+                "solve",
+                &format!(
+                    "Clarabel iteration {}: relative gap {:.1e}, primal residual {:.1e}",
+                    info.iterations, info.gap_rel, info.res_primal
+                ),
+            );
+            false
+        });
+    }
     solver.solve();
     let sol = &solver.solution;
     let status = match sol.status {

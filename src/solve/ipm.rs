@@ -430,6 +430,13 @@ fn verdict_with_data<T: Real>(
         gap
     };
     let target = t.gap_tolerance * data;
+    crate::progress::update("solve", || {
+        format!(
+            "iteration {iteration}: gap {:.1e} of the data (target {:.0e}), primal residual {pres:.1e}",
+            gap / data,
+            t.gap_tolerance
+        )
+    });
     if pres <= t.tol && small_step && gap <= target {
         return (Verdict::Stop(SolveStatus::Solved), Some(polished));
     }
@@ -470,6 +477,14 @@ fn verdict_without_data<T: Real, O: Objective<T>>(
         .flatten()
         .map(|dual| res.slack.iter().zip(&it.z).map(|(s, z)| (max(*s, zero) * *z).to_f64()).sum::<f64>() + dual);
     let target = t.gap_tolerance * energy.abs().max(1e-300);
+    crate::progress::update("solve", || match gap {
+        Some(gap) => format!(
+            "iteration {iteration}: gap {:.1e} of the energy (target {:.0e}), primal residual {pres:.1e}",
+            gap / energy.abs().max(1e-300),
+            t.gap_tolerance
+        ),
+        None => format!("iteration {iteration}: primal residual {pres:.1e}, complementarity {mu:.1e}"),
+    });
     let converged = match gap {
         Some(gap) => pres <= t.tol && small_step && gap <= target,
         None => pres <= t.tol && dres <= t.tol && mu <= t.tol_mu,

@@ -1,0 +1,192 @@
+//! The tool's progress on standard error: on a terminal, a spinner for the stage in progress
+//! (what it does now: the round, the iteration and its gap) above which each finished stage
+//! stays as one line; elsewhere (a log, a pipe) one line per finished stage. `--quiet`
+//! silences both.
+
+use crate::progress::Observer;
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use std::io::{IsTerminal, Write};
+use std::sync::{Arc, Mutex, OnceLock};
+use std::time::Duration;
+
+/// How progress is shown.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ProgressMode {
+    /// Nothing.
+    Quiet,
+    /// One line per finished stage.
+    Lines,
+    /// A spinner and a line per finished stage.
+    Bar,
+}
+
+impl ProgressMode {
+    /// `Quiet` when asked, `Bar` when standard error is a terminal, `Lines` otherwise.
+    pub fn detect(quiet: bool) -> Self {
+        if quiet {
+            ProgressMode::Quiet
+        } else if std::io::stderr().is_terminal() {
+            ProgressMode::Bar
+        } else {
+            ProgressMode::Lines
+        }
+    }
+}
+
+/// The observer the tool installs for a command.
+pub struct Stderr {
+    mode: ProgressMode,
+    /// The spinner and the stages open (nested: the complex inside the representative).
+    state: Mutex<(Option<ProgressBar>, Vec<String>)>,
+}
+
+impl Stderr {
+    /// An observer showing progress in `mode`.
+    pub fn new(mode: ProgressMode) -> Arc<Self> {
+        Arc::new(Stderr { mode, state: Mutex::new((None, Vec::new())) })
+    }
+
+    /// Prints `text` as a line of its own (the input's summary), above the spinner if any.
+    pub fn line(&self, text: &str) {
+        if self.mode == ProgressMode::Quiet {
+            return;
+        }
+        let state = self.state.lock().unwrap_or_else(|e| e.into_inner());
+        match &state.0 {
+            Some(bar) => bar.println(text),
+            None => {
+                let _ = writeln!(std::io::stderr(), "{text}");
+            }
+        }
+    }
+
+    /// Removes the spinner (before an error or the summary is printed).
+    pub fn clear(&self) {
+        let mut state = self.state.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some(bar) = state.0.take() {
+            bar.finish_and_clear();
+        }
+        state.1.clear();
+    }
+}
+
+impl Observer for Stderr {
+    fn begin(&self, stage: &str) {
+        if self.mode != ProgressMode::Bar {
+            return;
+        }
+        let mut state = self.state.lock().unwrap_or_else(|e| e.into_inner());
+        state.1.push(stage.to_string());
+        let bar = state.0.get_or_insert_with(|| {
+            let bar = ProgressBar::with_draw_target(None, ProgressDrawTarget::stderr());
+            bar.set_style(
+                ProgressStyle::with_template("{spinner} {prefix}: {wide_msg} [{elapsed}]")
+                    .unwrap_or_else(|_| ProgressStyle::default_spinner()),
+            );
+            bar.enable_steady_tick(Duration::from_millis(120));
+            bar
+        });
+        bar.set_prefix(stage.to_string());
+        bar.set_message("");
+    }
+
+    fn update(&self, stage: &str, message: &str) {
+        if self.mode != ProgressMode::Bar {
+            return;
+        }
+        let state = self.state.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some(bar) = &state.0 {
+            bar.set_prefix(stage.to_string());
+            bar.set_message(message.to_string());
+        }
+    }
+
+    fn end(&self, stage: &str, seconds: f64, summary: &str) {
+        let text = if summary.is_empty() {
+            format!("{stage}: {}", seconds_text(seconds))
+        } else {
+            format!("{stage}: {} ({summary})", seconds_text(seconds))
+        };
+        match self.mode {
+            ProgressMode::Quiet => {}
+            ProgressMode::Lines => {
+                let _ = writeln!(std::io::stderr(), "{text}");
+            }
+            ProgressMode::Bar => {
+                let mut state = self.state.lock().unwrap_or_else(|e| e.into_inner());
+                if let Some(i) = state.1.iter().rposition(|s| s == stage) {
+                    state.1.remove(i);
+                }
+                let outer = state.1.last().cloned();
+                if let Some(bar) = &state.0 {
+                    bar.println(&text);
+                    if let Some(outer) = outer {
+                        bar.set_prefix(outer);
+                        bar.set_message("");
+                    }
+                }
+                if state.1.is_empty() {
+                    // no spinner between stages
+                    if let Some(bar) = state.0.take() {
+                        bar.finish_and_clear();
+                    }
+                }
+            }
+        }
+    }
+
+    fn abandon(&self, stage: &str) {
+        let mut state = self.state.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some(i) = state.1.iter().rposition(|s| s == stage) {
+            state.1.remove(i);
+        }
+        if state.1.is_empty() {
+            if let Some(bar) = state.0.take() {
+                bar.finish_and_clear();
+            }
+        }
+    }
+}
+
+static INSTALLED: OnceLock<Arc<Stderr>> = OnceLock::new();
+
+/// Runs `work` with progress shown in `mode` (the tool's commands: once per process).
+pub fn with_progress<R>(mode: ProgressMode, work: impl FnOnce() -> R) -> R {
+    let observer = INSTALLED.get_or_init(|| Stderr::new(mode)).clone();
+    let out = crate::progress::observe(observer.clone(), work);
+    observer.clear();
+    out
+}
+
+/// Prints `text` on standard error as progress does (nothing with `--quiet`): the input's
+/// summary before the work starts.
+pub fn line(text: &str) {
+    match INSTALLED.get() {
+        Some(o) => o.line(text),
+        None => eprintln!("{text}"),
+    }
+}
+
+/// Seconds as a person reads them: `0.42 s`, `3.1 s`, `2 min 05 s`.
+fn seconds_text(s: f64) -> String {
+    if s < 10.0 {
+        format!("{s:.2} s")
+    } else if s < 100.0 {
+        format!("{s:.1} s")
+    } else {
+        let whole = s.round() as u64;
+        format!("{} min {:02} s", whole / 60, whole % 60)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn seconds_read_as_a_person_reads_them() {
+        assert_eq!(seconds_text(0.4249), "0.42 s");
+        assert_eq!(seconds_text(31.26), "31.3 s");
+        assert_eq!(seconds_text(125.4), "2 min 05 s");
+    }
+}

@@ -347,9 +347,15 @@ struct SmoothCli {
     input: Option<PathBuf>,
     /// Output: a series CSV (x,input,output,u,role); for grids .vti or .npz (verifiable:
     /// input, smoothed, representative, role) or .npy / CSV (the smoothed array only); for
-    /// meshes .vtu, .vtp or .ply (verifiable, the same arrays).
+    /// meshes .vtu, .vtp or .ply (verifiable, the same arrays). VTK outputs (.vti, .vtu, .vtp)
+    /// also carry every point and cell array of a VTK input, and give the smoothed field the
+    /// input array's name as the active scalars.
     #[arg(short, long)]
     output: PathBuf,
+    /// The name of the smoothed field in VTK outputs, instead of the input array's (which is
+    /// then carried through unchanged).
+    #[arg(long, value_name = "NAME")]
+    output_array: Option<String>,
     #[command(flatten)]
     csv: CsvArgs,
     #[command(flatten)]
@@ -474,6 +480,7 @@ fn smooth_args(c: SmoothCli) -> Result<SmoothArgs> {
         settings,
         plot: c.plot,
         report: c.report,
+        output_array: c.output_array,
     })
 }
 

@@ -258,3 +258,85 @@ fn the_active_scalars_are_the_default_array_as_in_a_vtk_filter() {
         assert!(text.contains("`f`") || text.contains(" f"), "{file}: {text}");
     }
 }
+
+/// Runs the tool; panics with its output unless it exits 0.
+fn smooth_ok(args: &[&str]) {
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_toposmooth")).arg("-q").args(args).output().unwrap();
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{args:?}: {}{}",
+        String::from_utf8_lossy(&o.stdout),
+        String::from_utf8_lossy(&o.stderr)
+    );
+}
+
+fn array<'a>(arrays: &'a [toposmooth::io::vtk::PointArray], name: &str) -> &'a toposmooth::io::vtk::PointArray {
+    arrays
+        .iter()
+        .find(|a| a.name == name)
+        .unwrap_or_else(|| panic!("no array `{name}` among {:?}", arrays.iter().map(|a| &a.name).collect::<Vec<_>>()))
+}
+
+/// The outputs of `smooth` behave like a VTK filter's: every point and cell array of the input
+/// comes through in its own type with its values, the smoothed field takes the input array's
+/// name as the active scalars, the cells are the input's.
+#[test]
+fn vtk_outputs_carry_every_input_array_in_its_type() {
+    let dir = std::env::temp_dir().join(format!("toposmooth-carry-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    for input in ["types.appended-raw-zlib-u64.vti", "types.ascii.vtp", "surf.binary-zlib-u64.vtu"] {
+        let ext = input.rsplit('.').next().unwrap();
+        let path = fixtures().join(input);
+        let out = dir.join(format!("out.{ext}"));
+        smooth_ok(&[
+            "smooth",
+            path.to_str().unwrap(),
+            "--array",
+            "f",
+            "--persistence",
+            "20%",
+            "-o",
+            out.to_str().unwrap(),
+        ]);
+        let (a, b) = (read_dataset(&path).unwrap(), read_dataset(&out).unwrap());
+        assert_eq!(b.active_scalars.as_deref(), Some("f"), "{input}");
+        assert_eq!(array(&b.point_data, "f").values, array(&b.point_data, "smoothed").values, "{input}");
+        assert_eq!(array(&b.point_data, "input").values, array(&a.point_data, "f").values, "{input}");
+        assert_ne!(array(&b.point_data, "f").values, array(&a.point_data, "f").values, "{input}: f was smoothed");
+        assert_eq!(array(&b.point_data, "f").ty, toposmooth::io::vtk::Scalar::F64);
+        for x in a.point_data.iter().filter(|x| x.name != "f") {
+            assert_eq!(array(&b.point_data, &x.name), x, "{input}: point array {}", x.name);
+        }
+        assert!(!a.cell_data.is_empty(), "{input}: the fixture has cell arrays");
+        for x in &a.cell_data {
+            // the cell order of the output is the input's (poly data: already VTK's order)
+            assert_eq!(array(&b.cell_data, &x.name), x, "{input}: cell array {}", x.name);
+        }
+        assert_eq!((a.points, a.cells), (b.points, b.cells), "{input}: geometry and cells unchanged");
+    }
+    // --output-array names the smoothed field; the input's `f` then comes through unchanged,
+    // and smoothing the tool's own output again carries its arrays as `<name>_input`
+    let first = dir.join("out.vti");
+    let again = dir.join("again.vti");
+    smooth_ok(&[
+        "smooth",
+        first.to_str().unwrap(),
+        "--array",
+        "f",
+        "--persistence",
+        "20%",
+        "--output-array",
+        "f_smooth",
+        "-o",
+        again.to_str().unwrap(),
+    ]);
+    let (a, b) = (read_dataset(&first).unwrap(), read_dataset(&again).unwrap());
+    assert_eq!(b.active_scalars.as_deref(), Some("f_smooth"));
+    assert_eq!(array(&b.point_data, "f_smooth").values, array(&b.point_data, "smoothed").values);
+    assert_eq!(array(&b.point_data, "f"), array(&a.point_data, "f"));
+    for own in ["input", "smoothed", "representative", "role"] {
+        assert_eq!(array(&b.point_data, &format!("{own}_input")).values, array(&a.point_data, own).values, "{own}");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}

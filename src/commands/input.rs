@@ -5,6 +5,7 @@
 use crate::derive::{describe_missing, fill_missing, magnitude, vorticity};
 use crate::domain::{Domain, Grid2d, TriMesh};
 use crate::error::{Error, Result};
+use crate::io::export::Carried;
 use crate::io::grid::{read_grid_csv, read_raster, GridField};
 use crate::io::mesh::is_mesh_file;
 pub use crate::io::mesh::read_trimesh;
@@ -72,6 +73,8 @@ pub struct GridInput {
     pub filled: Option<Vec<bool>>,
     /// The file the grid came from (the first velocity file with `--u/--v`).
     pub path: PathBuf,
+    /// A VTK image's arrays, for outputs that carry them through.
+    pub carried: Option<Carried>,
 }
 
 /// A field on a triangle mesh, ready to smooth.
@@ -89,6 +92,8 @@ pub struct MeshInput {
     pub filled: Option<Vec<bool>>,
     /// The mesh file.
     pub path: PathBuf,
+    /// A mesh file's arrays and cells, for VTK outputs that carry them through.
+    pub carried: Option<Carried>,
 }
 
 /// A series ready to smooth.
@@ -205,7 +210,11 @@ pub fn read_mesh_field(path: &Path, opts: &GridOptions) -> Result<MeshInput> {
     let mut notes = data.notes.clone();
     notes.extend(mesh.repairs().iter().cloned());
     notes.extend(mesh.sliver_warning());
-    Ok(MeshInput { mesh, values, description, notes, filled, path: path.to_path_buf() })
+    // the field is the array of that name unless it came from a values file or a coordinate
+    let source =
+        (opts.values.is_none() && data.arrays.iter().any(|a| a.name == description)).then(|| description.clone());
+    let carried = Some(Carried { point: data.arrays, cells: data.cells, cell: data.cell_arrays, source });
+    Ok(MeshInput { mesh, values, description, notes, filled, path: path.to_path_buf(), carried })
 }
 
 fn extension(path: &Path) -> String {
@@ -349,18 +358,26 @@ struct Raw {
     skipped: Vec<String>,
     /// The array a VTK file marks as its active scalars.
     active: Option<String>,
+    /// A VTK image's arrays as read.
+    carried: Option<Carried>,
 }
 
 fn read_raw(path: &Path, array: Option<&str>) -> Result<Raw> {
-    let from_field =
-        |f: GridField| Raw { arrays: vec![(f.array, 1, f.values)], grid: f.grid, skipped: Vec::new(), active: None };
+    let from_field = |f: GridField| Raw {
+        arrays: vec![(f.array, 1, f.values)],
+        grid: f.grid,
+        skipped: Vec::new(),
+        active: None,
+        carried: None,
+    };
     crate::io::content::check_extension(path)?;
     match extension(path).as_str() {
         "vti" | "vtk" => {
             let img = read_image(path)?;
             let grid = Grid2d::with_geometry(img.nx, img.ny, img.spacing, img.origin).map_err(|e| e.in_file(path))?;
-            let arrays = img.arrays.into_iter().map(|a| (a.name, a.components, a.values)).collect();
-            Ok(Raw { grid, arrays, skipped: img.skipped, active: img.active_scalars })
+            let arrays = img.arrays.iter().map(|a| (a.name.clone(), a.components, a.values.clone())).collect();
+            let carried = Carried { point: img.arrays, cells: None, cell: img.cell_arrays, source: None };
+            Ok(Raw { grid, arrays, skipped: img.skipped, active: img.active_scalars, carried: Some(carried) })
         }
         "npy" | "npz" => match read_numpy(path, array, Wanted::Grid)? {
             NumpyField::Grid(f) => Ok(from_field(f)),
@@ -426,6 +443,7 @@ fn pick<'a>(path: &Path, raw: &'a Raw, name: Option<&str>, vector: bool) -> Resu
 /// Input errors naming the file (unreadable, missing array, different grid sizes of `--u`
 /// and `--v`, NaN without `--fill-missing`), usage errors for contradictory options.
 pub fn read_grid(path: &Path, opts: &GridOptions) -> Result<GridInput> {
+    let mut carried = None;
     let (grid, mut values, description, source) = match (&opts.uv, opts.derive) {
         (Some(_), None) => return Err(Error::Usage("--u and --v need --derive vorticity|magnitude".into())),
         (Some((pu, pv)), Some(d)) => {
@@ -461,6 +479,7 @@ pub fn read_grid(path: &Path, opts: &GridOptions) -> Result<GridInput> {
             let v: Vec<f64> = a.2.iter().skip(1).step_by(a.1).copied().collect();
             let grid = with_spacing(path, &raw.grid, opts.spacing)?;
             let values = derive(&grid, d, &u, &v);
+            carried = raw.carried.clone();
             (
                 grid,
                 values,
@@ -479,6 +498,7 @@ pub fn read_grid(path: &Path, opts: &GridOptions) -> Result<GridInput> {
                 .in_file(path));
             }
             let grid = with_spacing(path, &raw.grid, opts.spacing)?;
+            carried = raw.carried.clone().map(|c| Carried { source: Some(a.0.clone()), ..c });
             (grid, a.2.clone(), a.0.clone(), path.to_path_buf())
         }
     };
@@ -500,7 +520,7 @@ pub fn read_grid(path: &Path, opts: &GridOptions) -> Result<GridInput> {
         fill_missing(&grid, &mut values).map_err(|e| e.in_file(&source))?;
         filled = Some(mask);
     }
-    Ok(GridInput { grid, values, description, filled, path: source })
+    Ok(GridInput { grid, values, description, filled, path: source, carried })
 }
 
 fn derive(grid: &Grid2d, d: Derive, u: &[f64], v: &[f64]) -> Vec<f64> {
@@ -540,6 +560,8 @@ pub struct Field {
     pub notes: Vec<String>,
     /// Series: the x axis as read.
     pub axis: Option<SeriesAxis>,
+    /// What the input carries besides the field, for VTK outputs.
+    pub carried: Option<Carried>,
 }
 
 impl FieldInput {
@@ -558,6 +580,7 @@ impl FieldInput {
                 filled,
                 notes: Vec::new(),
                 axis: Some(SeriesAxis { x: data.x, x_text: data.x_text, x_name: data.x_name, source: data.x_source }),
+                carried: None,
             },
             FieldInput::Grid(g) => Field {
                 domain: AnyDomain::Grid(g.grid),
@@ -567,6 +590,7 @@ impl FieldInput {
                 filled: g.filled,
                 notes: Vec::new(),
                 axis: None,
+                carried: g.carried,
             },
             FieldInput::Mesh(m) => Field {
                 domain: AnyDomain::Mesh(m.mesh),
@@ -576,6 +600,7 @@ impl FieldInput {
                 filled: m.filled,
                 notes: m.notes,
                 axis: None,
+                carried: m.carried,
             },
         })
     }

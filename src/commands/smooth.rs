@@ -83,6 +83,7 @@ pub fn smooth(args: &SmoothArgs) -> Result<String> {
         check_complex_output(c, &field.domain)?;
     }
     check_output(&args.output, &field.domain)?;
+    check_output_array(args.output_array.as_deref())?;
     if args.isolines > 0 && !matches!(field.domain, AnyDomain::Grid(_)) {
         return Err(Error::setting("isolines", "draws on a grid's figure only; this input is not a grid"));
     }
@@ -110,6 +111,8 @@ pub fn smooth(args: &SmoothArgs) -> Result<String> {
         representative: &result.u,
         roles: &result.roles,
         filled: field.filled.as_deref(),
+        carried: field.carried.as_ref(),
+        output_array: args.output_array.as_deref(),
     };
     let x_axis = field.axis.as_ref().map(|a| (a.x_name.as_str(), a.x_text.as_slice()));
     let output = stage_results(&args.output, &field.domain, x_axis, &results)?;
@@ -164,6 +167,22 @@ pub fn smooth(args: &SmoothArgs) -> Result<String> {
         [filled, negative, hidden],
         [read_seconds, write_seconds, start.elapsed().as_secs_f64()],
     ))
+}
+
+/// `--output-array` may not take a name of the tool's own arrays, nor be empty.
+fn check_output_array(name: Option<&str>) -> Result<()> {
+    match name {
+        Some(n) if n.is_empty() || n.chars().any(char::is_control) => {
+            Err(Error::setting("output-array", "needs a printable, non-empty name"))
+        }
+        Some(n @ ("input" | "smoothed" | "representative" | "role" | "filled")) => Err(Error::setting(
+            "output-array",
+            format!(
+                "`{n}` is one of the arrays the output always holds (input, smoothed, representative, role, filled)"
+            ),
+        )),
+        _ => Ok(()),
+    }
 }
 
 /// An explicit kept list (`--keep-min`, `--keep-max`) may not name a filled sample: its value

@@ -32,6 +32,8 @@ pub struct SmoothArgs {
     pub plot: Option<PathBuf>,
     /// JSON report.
     pub report: Option<PathBuf>,
+    /// The smoothed field's name in VTK outputs (`--output-array`).
+    pub output_array: Option<String>,
 }
 
 /// The certificate, deviation and solver lines of `smooth`'s summary.

@@ -27,7 +27,8 @@ pub fn verify(args: &VerifyArgs) -> Result<String> {
     let ext = args.file.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
     crate::io::content::check_extension(&args.file)?;
     match ext.as_str() {
-        e if MESH_OUTPUTS.contains(&e) => {
+        // a legacy .vtk is a mesh's output or a grid's
+        e if MESH_OUTPUTS.contains(&e) && (e != "vtk" || crate::io::mesh::is_mesh_file(&args.file)) => {
             let (mesh, data) = read_trimesh(&args.file)?;
             if data.arrays.iter().any(|a| a.name.starts_with("weight_") && a.name.ends_with("_raw")) {
                 return verify_weights(args, &mesh, &data);
@@ -40,7 +41,7 @@ pub fn verify(args: &VerifyArgs) -> Result<String> {
             }
             verify_results(args, results_on_mesh(&args.file, mesh, &data)?)
         }
-        "obj" | "off" | "vtk" if crate::io::mesh::is_mesh_file(&args.file) => Err(Error::Usage(format!(
+        "obj" | "off" if crate::io::mesh::is_mesh_file(&args.file) => Err(Error::Usage(format!(
             "{}: a mesh file holds no smoothing output; verify the .vtu, .vtp or .ply that `smooth` wrote",
             args.file.display()
         ))),

@@ -7,7 +7,10 @@ use super::grid::stage_grid_csv;
 use super::mesh::{read_trimesh, stage_ply, MeshData};
 use super::npz::{read_npz, stage_npy, stage_npz};
 use super::series_csv::{read_series_output, stage_series_output, SeriesOutput};
-use super::vtk::{read_image, stage_vti, stage_vtp, stage_vtu, PolyData};
+use super::vtk::{
+    read_dataset, read_image, stage_legacy, stage_vti_arrays, stage_vtp, stage_vtp_cells, stage_vtu_cells,
+    triangle_cells, Cells, LegacyGeometry, OutArray, PointArray, PolyData,
+};
 use super::Staged;
 use crate::domain::{AnyDomain, Domain, Grid2d, Series, TriMesh};
 use crate::error::{Error, Result};
@@ -18,9 +21,9 @@ use std::path::Path;
 /// Extensions of a series' output.
 pub const SERIES_OUTPUTS: &[&str] = &["csv"];
 /// Extensions of a grid's output (`.npy` and `.csv` hold the smoothed array only).
-pub const GRID_OUTPUTS: &[&str] = &["vti", "npz", "npy", "csv"];
+pub const GRID_OUTPUTS: &[&str] = &["vti", "vtk", "npz", "npy", "csv"];
 /// Extensions of a mesh's output.
-pub const MESH_OUTPUTS: &[&str] = &["vtu", "vtp", "ply"];
+pub const MESH_OUTPUTS: &[&str] = &["vtu", "vtp", "vtk", "ply"];
 
 fn extension(path: &Path) -> String {
     path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase()
@@ -106,6 +109,79 @@ pub fn role_codes(roles: &[Role]) -> Vec<f64> {
     roles.iter().map(|r| f64::from(r.code())).collect()
 }
 
+/// What a VTK input carries besides the field, passed through to VTK outputs as a VTK filter
+/// passes its input's arrays.
+#[derive(Clone, Debug, Default)]
+pub struct Carried {
+    /// Every point array of the input, in file order and type.
+    pub point: Vec<PointArray>,
+    /// The input's cells as the file gives them (meshes); `None` writes the triangles.
+    pub cells: Option<Cells>,
+    /// Every cell array of the input (one tuple per cell of `cells`; images: per pixel).
+    pub cell: Vec<PointArray>,
+    /// The point array the field is (not a derivation of it): the output gives the smoothed
+    /// field that name, in place of the input's array.
+    pub source: Option<String>,
+}
+
+/// The names the tool's own arrays take in a VTK output.
+const OWN_ARRAYS: [&str; 5] = ["input", "smoothed", "representative", "role", "filled"];
+
+/// The point arrays of a VTK output: the smoothed field under the input array's name (or
+/// `output_array`) first, as the active scalars, then `smoothed`, `input`, `representative`,
+/// `role` (and `filled`), then every other input array unchanged, renamed `<name>_input` where
+/// its name is taken. Returns each array's name and where its values come from; the first is
+/// the active scalars.
+fn vtk_point_plan(
+    own: &[(&str, &[f64])],
+    carried: Option<&Carried>,
+    output_array: Option<&str>,
+) -> Vec<(String, Source)> {
+    let source = carried.and_then(|c| c.source.as_deref());
+    let primary = output_array.or(source).filter(|p| !OWN_ARRAYS.contains(p));
+    let mut plan: Vec<(String, Source)> = Vec::new();
+    if let Some(p) = primary {
+        plan.push((p.to_string(), Source::Smoothed));
+    }
+    plan.extend(own.iter().enumerate().map(|(k, (n, _))| (n.to_string(), Source::Own(k))));
+    for (k, a) in carried.map(|c| c.point.as_slice()).unwrap_or_default().iter().enumerate() {
+        if output_array.is_none() && Some(a.name.as_str()) == source {
+            // the smoothed field takes its place
+            continue;
+        }
+        let mut name = a.name.clone();
+        while plan.iter().any(|(n, _)| *n == name) || OWN_ARRAYS.contains(&name.as_str()) {
+            name += "_input";
+        }
+        plan.push((name, Source::Carried(k)));
+    }
+    plan
+}
+
+/// Where a planned output array's values come from.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Source {
+    Smoothed,
+    Own(usize),
+    Carried(usize),
+}
+
+/// The planned arrays.
+fn planned<'a>(
+    plan: &'a [(String, Source)],
+    own: &[(&'a str, &'a [f64])],
+    smoothed: &'a [f64],
+    carried: Option<&'a Carried>,
+) -> Vec<OutArray<'a>> {
+    plan.iter()
+        .map(|(name, src)| match *src {
+            Source::Smoothed => OutArray::float64(name, smoothed),
+            Source::Own(k) => OutArray::float64(name, own[k].1),
+            Source::Carried(k) => OutArray::carried(&carried.expect("planned from it").point[k], name),
+        })
+        .collect()
+}
+
 /// The verifiable arrays of a smoothing result.
 pub struct Results<'a> {
     /// The values smoothed (after deriving and filling).
@@ -118,6 +194,11 @@ pub struct Results<'a> {
     pub roles: &'a [Role],
     /// Vertices whose input was filled (`--fill-missing`), when any were.
     pub filled: Option<&'a [bool]>,
+    /// What the input carries besides the field (VTK inputs), for VTK outputs.
+    pub carried: Option<&'a Carried>,
+    /// The name of the smoothed field in VTK outputs (`--output-array`), instead of the input
+    /// array's.
+    pub output_array: Option<&'a str>,
 }
 
 /// Stages a smoothing result at `path` in the format its extension names: a series as
@@ -160,13 +241,52 @@ pub fn stage_results(
             stage_series_output(path, &out)
         }
         AnyDomain::Grid(g) => match format_of(path, domain).as_str() {
-            "vti" => stage_vti(path, g.nx(), g.ny(), g.spacing(), g.origin(), &arrays),
+            e @ ("vti" | "vtk") => {
+                let plan = vtk_point_plan(&arrays, r.carried, r.output_array);
+                let point = planned(&plan, &arrays, r.smoothed, r.carried);
+                let cells: Vec<OutArray> = carried_cells(r.carried);
+                let (nx, ny, spacing, origin) = (g.nx(), g.ny(), g.spacing(), g.origin());
+                if e == "vti" {
+                    stage_vti_arrays(path, (nx, ny, spacing, origin), &point, &cells, Some(&plan[0].0))
+                } else {
+                    let geometry = LegacyGeometry::Image { nx, ny, spacing, origin };
+                    stage_legacy(path, &geometry, (&point, &cells), Some(&plan[0].0))
+                }
+            }
             "npz" => stage_npz(path, g.ny(), g.nx(), &arrays),
             "npy" => stage_npy(path, g.ny(), g.nx(), r.smoothed),
             _ => stage_grid_csv(path, g.nx(), r.smoothed),
         },
-        AnyDomain::Mesh(m) => stage_mesh(path, m, &arrays),
+        AnyDomain::Mesh(m) => match extension(path).as_str() {
+            e @ ("vtu" | "vtp" | "vtk") => {
+                let plan = vtk_point_plan(&arrays, r.carried, r.output_array);
+                let point = planned(&plan, &arrays, r.smoothed, r.carried);
+                let triangles;
+                let (cells, cell_arrays) = match r.carried.and_then(|c| c.cells.as_ref()) {
+                    Some(cells) => (cells, carried_cells(r.carried)),
+                    None => {
+                        triangles = triangle_cells(m.faces());
+                        (&triangles, Vec::new())
+                    }
+                };
+                let active = Some(plan[0].0.as_str());
+                match e {
+                    "vtu" => stage_vtu_cells(path, m.positions(), cells, (&point, &cell_arrays), active),
+                    "vtp" => stage_vtp_cells(path, m.positions(), cells, (&point, &cell_arrays), active),
+                    _ => {
+                        let geometry = LegacyGeometry::Unstructured { points: m.positions(), cells };
+                        stage_legacy(path, &geometry, (&point, &cell_arrays), active)
+                    }
+                }
+            }
+            _ => stage_mesh(path, m, &arrays),
+        },
     }
+}
+
+/// The input's cell arrays, unchanged.
+fn carried_cells(carried: Option<&Carried>) -> Vec<OutArray<'_>> {
+    carried.map(|c| c.cell.iter().map(|a| OutArray::carried(a, &a.name)).collect()).unwrap_or_default()
 }
 
 /// Certificate item 5 (SPEC.md): the staged output, read back from its temporary with the
@@ -231,7 +351,7 @@ pub fn check_written(staged: &Staged, domain: &AnyDomain, r: &Results) -> Result
 /// Usage errors for another extension; I/O errors naming the file.
 pub fn stage_mesh(path: &Path, mesh: &TriMesh, arrays: &[(&str, &[f64])]) -> Result<Staged> {
     match extension(path).as_str() {
-        "vtu" => stage_vtu(path, mesh.positions(), mesh.faces(), arrays),
+        "vtu" => super::vtk::stage_vtu(path, mesh.positions(), mesh.faces(), arrays),
         "vtp" => stage_vtp(
             path,
             &PolyData {
@@ -242,6 +362,12 @@ pub fn stage_mesh(path: &Path, mesh: &TriMesh, arrays: &[(&str, &[f64])]) -> Res
             },
         ),
         "ply" => stage_ply(path, mesh.positions(), mesh.faces(), arrays),
+        "vtk" => {
+            let cells = triangle_cells(mesh.faces());
+            let geometry = LegacyGeometry::Unstructured { points: mesh.positions(), cells: &cells };
+            let point: Vec<OutArray> = arrays.iter().map(|(n, v)| OutArray::float64(n, v)).collect();
+            stage_legacy(path, &geometry, (&point, &[]), arrays.first().map(|(n, _)| *n))
+        }
         _ => Err(mesh_format_error(path)),
     }
 }
@@ -336,8 +462,9 @@ pub struct Stored {
 /// # Errors
 /// I/O and input errors naming the file: a missing array, a role code that is none of SPEC's.
 pub fn read_results(path: &Path) -> Result<Stored> {
+    let legacy_image = extension(path) == "vtk" && read_dataset(path)?.image.is_some();
     match extension(path).as_str() {
-        "vti" => {
+        "vti" | "vtk" if extension(path) == "vti" || legacy_image => {
             let img = read_image(path)?;
             let grid = Grid2d::with_geometry(img.nx, img.ny, img.spacing, img.origin).map_err(|e| e.in_file(path))?;
             let names = img.arrays.iter().map(|a| a.name.clone()).collect();
@@ -439,7 +566,7 @@ mod tests {
         let series = AnyDomain::Series(Series::uniform(4));
         assert!(check_output(Path::new("a.VTI"), &grid).is_ok());
         let e = check_output(Path::new("a.vtu"), &grid).unwrap_err().to_string();
-        assert!(e.contains("a.vtu: the output of a grid is written as .vti, .npz, .npy, .csv"), "{e}");
+        assert!(e.contains("a.vtu: the output of a grid is written as .vti, .vtk, .npz, .npy, .csv"), "{e}");
         assert!(check_output(Path::new("a.csv"), &series).is_ok());
         assert!(check_output(Path::new("a.vti"), &series).is_err());
         assert!(check_complex_output(Path::new("c.vtp"), &series).is_err());
@@ -455,7 +582,15 @@ mod tests {
         let domain = AnyDomain::Grid(grid);
         let h = [0.0, 1.0, 2.0, 3.0, 4.0, 5.5];
         let roles = [Role::Min, Role::Other, Role::Other, Role::Other, Role::Other, Role::Max];
-        let r = Results { input: &h, smoothed: &h, representative: &h, roles: &roles, filled: None };
+        let r = Results {
+            input: &h,
+            smoothed: &h,
+            representative: &h,
+            roles: &roles,
+            filled: None,
+            carried: None,
+            output_array: None,
+        };
         for ext in ["vti", "npz"] {
             let path = dir.join(format!("r.{ext}"));
             stage_results(&path, &domain, None, &r).unwrap().commit().unwrap();

@@ -23,6 +23,11 @@ pub struct MeshData {
     pub arrays: Vec<PointArray>,
     /// What reading did to the data (fan triangulation of polygons, dropped cells).
     pub notes: Vec<String>,
+    /// A VTK file's cells as the file gives them (quads, polygons, strips, vertex and line
+    /// cells included): outputs write them back with their cell arrays, as a VTK filter does.
+    pub cells: Option<super::vtk::Cells>,
+    /// A VTK file's cell arrays, one tuple per cell of [`MeshData::cells`].
+    pub cell_arrays: Vec<PointArray>,
 }
 
 /// Reads a mesh and validates it.
@@ -56,6 +61,7 @@ impl MeshData {
                 name: name.into(),
                 components: 1,
                 values: self.positions.iter().map(|p| p[k]).collect(),
+                ty: super::vtk::Scalar::F64,
             });
         }
         Err(Error::input(format!("no vertex array `{name}`; there are: {}", self.names().join(", "))))
@@ -368,7 +374,7 @@ fn read_ply(bytes: &[u8]) -> Result<MeshData> {
     let n = data.positions.len();
     for (name, values) in columns {
         if values.len() == n {
-            data.arrays.push(PointArray { name, components: 1, values });
+            data.arrays.push(PointArray { name, components: 1, values, ty: super::vtk::Scalar::F64 });
         }
     }
     let faces = ply.payload.get("face").ok_or_else(|| Error::input("the PLY file has no `face` element"))?;
@@ -445,6 +451,8 @@ fn read_vtk(bytes: &[u8]) -> Result<MeshData> {
     if dropped > 0 {
         data.notes.push(format!("{dropped} vertex and line cells ignored"));
     }
+    data.cells = Some(ds.cells);
+    data.cell_arrays = ds.cell_data;
     Ok(data)
 }
 

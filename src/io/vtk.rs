@@ -16,11 +16,16 @@ mod data;
 mod decode;
 mod image;
 mod legacy;
+mod legacy_write;
 mod write;
 mod xml;
 
-pub use data::{cell, Cells, Dataset, ImageData, ImageGeometry, PointArray};
-pub use write::{stage_vti, stage_vtp, stage_vtu, PolyData};
+pub use data::{cell, Cells, Dataset, ImageData, ImageGeometry, PointArray, Scalar};
+pub use legacy_write::{stage_legacy, LegacyGeometry};
+pub use write::{
+    stage_vti, stage_vti_arrays, stage_vtp, stage_vtp_cells, stage_vtu, stage_vtu_cells, triangle_cells, OutArray,
+    PolyData,
+};
 
 use crate::error::{Error, Result};
 use std::path::Path;

@@ -1,6 +1,7 @@
 //! What the VTK readers return: any data set as read ([`Dataset`]), and a 2D image
 //! ([`ImageData`]) made from one.
 
+pub use super::decode::Scalar;
 use crate::domain::Grid2d;
 use crate::error::{Error, Result};
 use std::path::Path;
@@ -19,6 +20,8 @@ pub struct ImageData {
     pub origin: [f64; 2],
     /// Point data arrays, in file order.
     pub arrays: Vec<PointArray>,
+    /// Cell data arrays, in file order: `(nx − 1) · (ny − 1)` tuples, x fastest.
+    pub cell_arrays: Vec<PointArray>,
     /// What reading did (a Direction matrix turned into flips or a transposition).
     pub notes: Vec<String>,
     /// Point arrays that are not numeric, not read: "`name` (type)".
@@ -38,8 +41,9 @@ pub struct Dataset {
     pub cells: Cells,
     /// Point data arrays, in file order.
     pub point_data: Vec<PointArray>,
-    /// Names of the cell data arrays, in file order.
-    pub cell_data: Vec<String>,
+    /// Cell data arrays, in file order (poly data: VTK's cell order, vertices, lines,
+    /// polygons, strips).
+    pub cell_data: Vec<PointArray>,
     /// Arrays that are not numeric (strings, bits), which are not read: "`name` (type)".
     pub skipped: Vec<String>,
     /// The active scalars (XML `<PointData Scalars=...>`, a legacy file's first `SCALARS`):
@@ -217,7 +221,7 @@ pub mod cell {
     }
 }
 
-/// One point data array, converted to f64.
+/// One point (or cell) data array, converted to f64.
 #[derive(Clone, Debug, PartialEq)]
 pub struct PointArray {
     /// The array's name (`Name` attribute, or the legacy attribute name).
@@ -226,6 +230,9 @@ pub struct PointArray {
     pub components: usize,
     /// `nx · ny · components` values, components interleaved.
     pub values: Vec<f64>,
+    /// The type the file stores it in (every value is exact in it): outputs carry the array
+    /// through in that type.
+    pub ty: Scalar,
 }
 
 impl PointArray {

@@ -9,22 +9,91 @@
 use crate::error::{Error, Result};
 use std::io::Read;
 
-/// A numeric element type of a VTK array.
+/// A numeric element type of a VTK array: arrays are read as f64 and written back in the
+/// type they came in.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(crate) enum Scalar {
+pub enum Scalar {
+    /// `Int8`
     I8,
+    /// `UInt8`
     U8,
+    /// `Int16`
     I16,
+    /// `UInt16`
     U16,
+    /// `Int32`
     I32,
+    /// `UInt32`
     U32,
+    /// `Int64`
     I64,
+    /// `UInt64`
     U64,
+    /// `Float32`
     F32,
+    /// `Float64`
     F64,
 }
 
 impl Scalar {
+    /// The XML name VTK writes (`Float64`, `Int32`, ...).
+    pub fn xml_name(self) -> &'static str {
+        match self {
+            Scalar::I8 => "Int8",
+            Scalar::U8 => "UInt8",
+            Scalar::I16 => "Int16",
+            Scalar::U16 => "UInt16",
+            Scalar::I32 => "Int32",
+            Scalar::U32 => "UInt32",
+            Scalar::I64 => "Int64",
+            Scalar::U64 => "UInt64",
+            Scalar::F32 => "Float32",
+            Scalar::F64 => "Float64",
+        }
+    }
+
+    /// The legacy format's name as VTK's legacy writer gives it (`double`, `int`,
+    /// `vtktypeint64`, ...): the names its reader takes for attributes and field arrays.
+    pub fn legacy_name(self) -> &'static str {
+        match self {
+            Scalar::I8 => "signed_char",
+            Scalar::U8 => "unsigned_char",
+            Scalar::I16 => "short",
+            Scalar::U16 => "unsigned_short",
+            Scalar::I32 => "int",
+            Scalar::U32 => "unsigned_int",
+            Scalar::I64 => "vtktypeint64",
+            Scalar::U64 => "vtktypeuint64",
+            Scalar::F32 => "float",
+            Scalar::F64 => "double",
+        }
+    }
+
+    /// Appends `values` (read from an array of this type, so each is exact in it) as bytes,
+    /// little-endian or big-endian.
+    pub fn encode(self, values: &[f64], big_endian: bool, out: &mut Vec<u8>) {
+        macro_rules! put {
+            ($t:ty) => {
+                for &v in values {
+                    let x = v as $t;
+                    out.extend_from_slice(&if big_endian { x.to_be_bytes() } else { x.to_le_bytes() });
+                }
+            };
+        }
+        match self {
+            Scalar::I8 => put!(i8),
+            Scalar::U8 => put!(u8),
+            Scalar::I16 => put!(i16),
+            Scalar::U16 => put!(u16),
+            Scalar::I32 => put!(i32),
+            Scalar::U32 => put!(u32),
+            Scalar::I64 => put!(i64),
+            Scalar::U64 => put!(u64),
+            Scalar::F32 => put!(f32),
+            Scalar::F64 => put!(f64),
+        }
+    }
+
     /// The type from its XML name (`Float64`, and the old names `Double`, `Int`, ... that
     /// early VTK versions wrote).
     pub(crate) fn from_xml(s: &str) -> Option<Scalar> {

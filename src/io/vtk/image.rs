@@ -38,10 +38,11 @@ pub(super) fn image_of(ds: Dataset) -> Result<ImageData> {
         )));
     }
     let mut arrays = ds.point_data;
+    let mut cell_arrays = ds.cell_data;
     let skipped = &ds.skipped;
     if arrays.is_empty() {
-        return Err(if !ds.cell_data.is_empty() {
-            let names: Vec<&str> = ds.cell_data.iter().map(String::as_str).collect();
+        return Err(if !cell_arrays.is_empty() {
+            let names: Vec<&str> = cell_arrays.iter().map(|a| a.name.as_str()).collect();
             Error::input(format!(
                 "the file has cell data only ({}); point data is needed (ParaView: Cell Data to Point Data)",
                 list_names(&names)
@@ -61,6 +62,9 @@ pub(super) fn image_of(ds: Dataset) -> Result<ImageData> {
     } else {
         for a in &mut arrays {
             *a = transposed(a, nx, ny);
+        }
+        for a in &mut cell_arrays {
+            *a = transposed(a, nx - 1, ny - 1);
         }
         notes.push(format!(
             "the Direction `{}` swaps x and y: the arrays are transposed, so that the grid's x axis is the file's j axis",
@@ -82,6 +86,7 @@ pub(super) fn image_of(ds: Dataset) -> Result<ImageData> {
         spacing,
         origin,
         arrays,
+        cell_arrays,
         notes,
         skipped: ds.skipped,
         active_scalars: ds.active_scalars,
@@ -128,7 +133,7 @@ fn transposed(a: &PointArray, nx: usize, ny: usize) -> PointArray {
             values.extend_from_slice(&a.values[k..k + c]);
         }
     }
-    PointArray { name: a.name.clone(), components: c, values }
+    PointArray { name: a.name.clone(), components: c, values, ty: a.ty }
 }
 
 #[cfg(test)]
@@ -148,6 +153,7 @@ mod tests {
                 name: "f".into(),
                 components: 1,
                 values: vec![0.0, 1.0, 2.0, 10.0, 11.0, 12.0],
+                ty: crate::io::vtk::Scalar::F64,
             }],
             ..Dataset::default()
         }

@@ -362,7 +362,7 @@ fn attributes(cur: &mut Cursor, ds: &mut Dataset) -> Result<()> {
                 if point {
                     ds.point_data.extend(arrays);
                 } else {
-                    ds.cell_data.extend(arrays.into_iter().map(|a| a.name));
+                    ds.cell_data.extend(arrays);
                 }
             }
         }
@@ -381,7 +381,7 @@ fn attribute(cur: &mut Cursor, kw: &str, n: usize) -> Result<Vec<PointArray>> {
         let what = format!("`{kw} {name}`");
         let count = n.checked_mul(comps).ok_or_else(|| cur.err(format!("{what}: too many values")))?;
         let values = cur.values(ty, count, &what)?.into_f64(&what)?;
-        Ok(PointArray { name, components: comps, values })
+        Ok(PointArray { name, components: comps, values, ty })
     };
     Ok(match kw {
         "SCALARS" => {
@@ -477,7 +477,7 @@ fn field(cur: &mut Cursor, tuples: Option<usize>) -> Result<Vec<PointArray>> {
             Some(t) if t.eq_ignore_ascii_case("METADATA") => cur.skip_metadata(),
             _ => cur.pos = save,
         }
-        out.push(PointArray { name, components: comps, values });
+        out.push(PointArray { name, components: comps, values, ty });
     }
     Ok(out)
 }

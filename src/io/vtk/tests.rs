@@ -427,9 +427,11 @@ fn bad_vti_files_give_clear_errors() {
     std::fs::write(&p, text.replace("type=\"Float64\"", "type=\"String\"")).unwrap();
     assert!(error_of(&p).contains("String"));
     let p = d.join("cells.vti");
+    // 3 × 3 points, 4 cells: the array fits the cells
+    let cells = String::from_utf8(vti(s, "0 2 0 2 0 0", &[("Float64", "a", 1, &[1.0, 2.0, 3.0, 4.0])])).unwrap();
     std::fs::write(
         &p,
-        text.replace("<PointData>", "<PointData>\n</PointData>\n<CellData>").replacen(
+        cells.replace("<PointData>", "<PointData>\n</PointData>\n<CellData>").replacen(
             "</PointData>\n<CellData>\n</CellData>",
             "</CellData>",
             1,
@@ -472,7 +474,7 @@ fn vtp_is_valid_poly_data() {
     assert_eq!(ds.cells.connectivity, vec![0, 3, 0, 1, 2, 3, 1]);
     assert_eq!(ds.cells.offsets, vec![0, 1, 2, 5, 7]);
     assert_eq!((ds.point_data[0].name.as_str(), &ds.point_data[0].values), ("value", &poly.point_arrays[0].1));
-    assert_eq!(ds.cell_data, vec!["kind".to_string()]);
+    assert_eq!(ds.cell_data.iter().map(|a| a.name.as_str()).collect::<Vec<_>>(), ["kind"]);
     // empty cell lists are valid too
     let only_points = PolyData { points: poly.points.clone(), ..Default::default() };
     let q = dir().join("points.vtp");

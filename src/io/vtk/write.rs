@@ -1,6 +1,7 @@
-//! The `.vti`, `.vtp` and `.vtu` writers: every array Float64, zlib-compressed, base64 inline.
+//! The `.vti`, `.vtp` and `.vtu` writers: zlib-compressed, base64 inline; the tool's own
+//! arrays Float64, arrays carried through from the input in their own type.
 
-use super::data::input;
+use super::data::{cell, input, Cells, PointArray, Scalar};
 use crate::error::Result;
 use crate::io::{stage, Staged};
 use std::io::Write;
@@ -65,16 +66,69 @@ fn write_array(w: &mut dyn Write, indent: &str, ty: &str, name: &str, comps: usi
     writeln!(w, "{indent}</DataArray>")
 }
 
-/// A `<PointData>` or `<CellData>` section of Float64 arrays, the first one the active scalars.
-fn write_section(w: &mut dyn Write, tag: &str, arrays: &[(&str, &[f64])]) -> std::io::Result<()> {
-    match arrays.first() {
-        Some((first, _)) => writeln!(w, "      <{tag} Scalars=\"{}\">", xml_escape(first))?,
+/// An array to write: its name, the type it is written in (every value exact in it), its
+/// components and its values, components interleaved.
+#[derive(Clone, Copy, Debug)]
+pub struct OutArray<'a> {
+    /// The name.
+    pub name: &'a str,
+    /// The type written.
+    pub ty: Scalar,
+    /// Components per tuple.
+    pub components: usize,
+    /// `tuples · components` values.
+    pub values: &'a [f64],
+}
+
+impl<'a> OutArray<'a> {
+    /// A Float64 scalar array.
+    pub fn float64(name: &'a str, values: &'a [f64]) -> Self {
+        OutArray { name, ty: Scalar::F64, components: 1, values }
+    }
+
+    /// An array as read, under `name`, in its own type.
+    pub fn carried(a: &'a PointArray, name: &'a str) -> Self {
+        OutArray { name, ty: a.ty, components: a.components, values: &a.values }
+    }
+}
+
+/// Checks the names (distinct, printable) and lengths (`tuples` each) of one section.
+fn check_section(path: &Path, what: &str, arrays: &[OutArray], tuples: usize) -> Result<()> {
+    let mut seen = Vec::new();
+    for a in arrays {
+        check_name(path, a.name, &mut seen)?;
+        if a.components == 0 || a.values.len() != tuples * a.components {
+            return Err(input(
+                path,
+                format!(
+                    "{what} array `{}` has {} values for {tuples} tuples of {} components",
+                    a.name,
+                    a.values.len(),
+                    a.components
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// A `<PointData>` or `<CellData>` section; `active` names its active scalars.
+fn write_section(w: &mut dyn Write, tag: &str, arrays: &[OutArray], active: Option<&str>) -> std::io::Result<()> {
+    match active {
+        Some(name) => writeln!(w, "      <{tag} Scalars=\"{}\">", xml_escape(name))?,
         None => writeln!(w, "      <{tag}>")?,
     }
-    for (name, values) in arrays {
-        write_array(w, "        ", "Float64", name, 1, &f64_bytes(values))?;
+    for a in arrays {
+        let mut raw = Vec::with_capacity(a.values.len() * 8);
+        a.ty.encode(a.values, false, &mut raw);
+        write_array(w, "        ", a.ty.xml_name(), a.name, a.components, &raw)?;
     }
     writeln!(w, "      </{tag}>")
+}
+
+/// Float64 scalar arrays, the first of them the active scalars.
+fn float64_arrays<'a>(arrays: &[(&'a str, &'a [f64])]) -> (Vec<OutArray<'a>>, Option<&'a str>) {
+    (arrays.iter().map(|(n, v)| OutArray::float64(n, v)).collect(), arrays.first().map(|(n, _)| *n))
 }
 
 /// The `<Points>` section: Float64 triples.
@@ -121,19 +175,30 @@ pub fn stage_vti(
     origin: [f64; 2],
     arrays: &[(&str, &[f64])],
 ) -> Result<Staged> {
+    let (point, active) = float64_arrays(arrays);
+    stage_vti_arrays(path, (nx, ny, spacing, origin), &point, &[], active)
+}
+
+/// Stages a `.vti` image with point and cell arrays of any type (cells: `(nx − 1)·(ny − 1)`
+/// tuples, x fastest); `active` names the active scalars.
+///
+/// # Errors
+/// As [`stage_vti`].
+pub fn stage_vti_arrays(
+    path: &Path,
+    (nx, ny, spacing, origin): (usize, usize, [f64; 2], [f64; 2]),
+    point: &[OutArray],
+    cells: &[OutArray],
+    active: Option<&str>,
+) -> Result<Staged> {
     if nx == 0 || ny == 0 {
         return Err(input(path, format!("cannot write an image of {nx} × {ny} points")));
     }
     if spacing.iter().chain(&origin).any(|v| !v.is_finite()) {
         return Err(input(path, format!("spacing {spacing:?} and origin {origin:?} must be finite")));
     }
-    let mut seen = Vec::new();
-    for (name, values) in arrays {
-        check_name(path, name, &mut seen)?;
-        if values.len() != nx * ny {
-            return Err(input(path, format!("array `{name}` has {} values for {nx} × {ny} points", values.len())));
-        }
-    }
+    check_section(path, "point", point, nx * ny)?;
+    check_section(path, "cell", cells, nx.saturating_sub(1).max(1) * ny.saturating_sub(1).max(1))?;
     let f = crate::io::format_f64;
     stage(path, |w| {
         writeln!(w, "{XML_HEAD}")?;
@@ -148,16 +213,8 @@ pub fn stage_vti(
             f(spacing[1])
         )?;
         writeln!(w, "    <Piece Extent=\"{extent}\">")?;
-        match arrays.first() {
-            Some((first, _)) => writeln!(w, "      <PointData Scalars=\"{}\">", xml_escape(first))?,
-            None => writeln!(w, "      <PointData>")?,
-        }
-        for (name, values) in arrays {
-            write_array(w, "        ", "Float64", name, 1, &f64_bytes(values))?;
-        }
-        writeln!(w, "      </PointData>")?;
-        writeln!(w, "      <CellData>")?;
-        writeln!(w, "      </CellData>")?;
+        write_section(w, "PointData", point, active)?;
+        write_section(w, "CellData", cells, None)?;
         writeln!(w, "    </Piece>")?;
         writeln!(w, "  </ImageData>")?;
         writeln!(w, "</VTKFile>")
@@ -255,7 +312,8 @@ pub fn stage_vtp(path: &Path, poly: &PolyData) -> Result<Staged> {
         )?;
         for (tag, arrays) in [("PointData", &poly.point_arrays), ("CellData", &poly.cell_arrays)] {
             let arrays: Vec<(&str, &[f64])> = arrays.iter().map(|(n, v)| (n.as_str(), v.as_slice())).collect();
-            write_section(w, tag, &arrays)?;
+            let (arrays, active) = float64_arrays(&arrays);
+            write_section(w, tag, &arrays, active)?;
         }
         write_points(w, &coords)?;
         // empty cell lists are left out (VTK reads that as none; vtkio fails on empty arrays)
@@ -293,38 +351,148 @@ pub fn stage_vtu(
     triangles: &[[usize; 3]],
     arrays: &[(&str, &[f64])],
 ) -> Result<Staged> {
+    let (point, active) = float64_arrays(arrays);
+    stage_vtu_cells(path, points, &triangle_cells(triangles), (&point, &[]), active)
+}
+
+/// Triangles as cells.
+pub fn triangle_cells(triangles: &[[usize; 3]]) -> Cells {
+    Cells {
+        types: vec![cell::TRIANGLE; triangles.len()],
+        offsets: (0..=triangles.len()).map(|k| 3 * k).collect(),
+        connectivity: triangles.iter().flatten().copied().collect(),
+    }
+}
+
+/// Checks the points and the cells' corners.
+fn check_geometry(path: &Path, points: &[[f64; 3]], cells: &Cells) -> Result<()> {
     let n = points.len();
     if let Some(i) = points.iter().position(|p| p.iter().any(|c| !c.is_finite())) {
         return Err(input(path, format!("point {i} has a non-finite coordinate {:?}", points[i])));
     }
-    if let Some((k, t)) = triangles.iter().enumerate().find(|(_, t)| t.iter().any(|&v| v >= n)) {
-        return Err(input(path, format!("triangle {k} = {t:?} refers to a missing point (there are {n} points)")));
+    if let Some(c) = (0..cells.len()).find(|&c| cells.corners(c).iter().any(|&v| v >= n)) {
+        return Err(input(
+            path,
+            format!("cell {c} = {:?} refers to a missing point (there are {n} points)", cells.corners(c)),
+        ));
     }
-    let mut seen = Vec::new();
-    for (name, values) in arrays {
-        check_name(path, name, &mut seen)?;
-        if values.len() != n {
-            return Err(input(path, format!("point array `{name}` has {} values for {n} points", values.len())));
-        }
-    }
+    Ok(())
+}
+
+/// Stages a `.vtu` unstructured grid of any cells with point and cell arrays of any type
+/// (`arrays`: point, cell); `active` names the active point scalars.
+///
+/// # Errors
+/// As [`stage_vtu`].
+pub fn stage_vtu_cells(
+    path: &Path,
+    points: &[[f64; 3]],
+    cells: &Cells,
+    (point, cell_arrays): (&[OutArray], &[OutArray]),
+    active: Option<&str>,
+) -> Result<Staged> {
+    let n = points.len();
+    check_geometry(path, points, cells)?;
+    check_section(path, "point", point, n)?;
+    check_section(path, "cell", cell_arrays, cells.len())?;
     let coords: Vec<f64> = points.iter().flatten().copied().collect();
-    let conn: Vec<usize> = triangles.iter().flatten().copied().collect();
-    let offsets: Vec<usize> = (1..=triangles.len()).map(|k| 3 * k).collect();
-    let types = vec![5u8; triangles.len()];
     stage(path, |w| {
         writeln!(w, "{XML_HEAD}")?;
         writeln!(w, "{}", file_open("UnstructuredGrid"))?;
         writeln!(w, "  <UnstructuredGrid>")?;
-        writeln!(w, "    <Piece NumberOfPoints=\"{n}\" NumberOfCells=\"{}\">", triangles.len())?;
-        write_section(w, "PointData", arrays)?;
+        writeln!(w, "    <Piece NumberOfPoints=\"{n}\" NumberOfCells=\"{}\">", cells.len())?;
+        write_section(w, "PointData", point, active)?;
+        write_section(w, "CellData", cell_arrays, None)?;
         write_points(w, &coords)?;
         writeln!(w, "      <Cells>")?;
-        write_array(w, "        ", "Int64", "connectivity", 1, &i64_bytes(&conn))?;
-        write_array(w, "        ", "Int64", "offsets", 1, &i64_bytes(&offsets))?;
-        write_array(w, "        ", "UInt8", "types", 1, &types)?;
+        write_array(w, "        ", "Int64", "connectivity", 1, &i64_bytes(&cells.connectivity))?;
+        write_array(w, "        ", "Int64", "offsets", 1, &i64_bytes(&cells.offsets[1..]))?;
+        write_array(w, "        ", "UInt8", "types", 1, &cells.types)?;
         writeln!(w, "      </Cells>")?;
         writeln!(w, "    </Piece>")?;
         writeln!(w, "  </UnstructuredGrid>")?;
+        writeln!(w, "</VTKFile>")
+    })
+}
+
+/// Stages a `.vtp` poly data file of surface, line and vertex cells with point and cell
+/// arrays of any type (`arrays`: point, cell). Cells are written in VTK's poly data order
+/// (vertices, lines, polygons, strips; their cell arrays permuted alike), pixels as quads.
+///
+/// # Errors
+/// As [`stage_vtu`]; a volume cell, which poly data cannot hold.
+pub fn stage_vtp_cells(
+    path: &Path,
+    points: &[[f64; 3]],
+    cells: &Cells,
+    (point, cell_arrays): (&[OutArray], &[OutArray]),
+    active: Option<&str>,
+) -> Result<Staged> {
+    let n = points.len();
+    check_geometry(path, points, cells)?;
+    check_section(path, "point", point, n)?;
+    check_section(path, "cell", cell_arrays, cells.len())?;
+    let section = |t: u8| match t {
+        cell::VERTEX | cell::POLY_VERTEX => Some(0),
+        cell::LINE | cell::POLY_LINE => Some(1),
+        cell::TRIANGLE | cell::POLYGON | cell::PIXEL | cell::QUAD => Some(2),
+        cell::TRIANGLE_STRIP => Some(3),
+        _ => None,
+    };
+    if let Some(c) = (0..cells.len()).find(|&c| section(cells.types[c]).is_none()) {
+        return Err(input(
+            path,
+            format!("cell {c} is a {}: poly data (.vtp) holds no volume cells; write .vtu", cell::name(cells.types[c])),
+        ));
+    }
+    let mut order: Vec<usize> = (0..cells.len()).collect();
+    order.sort_by_key(|&c| section(cells.types[c]));
+    let permuted: Vec<Vec<f64>> = cell_arrays
+        .iter()
+        .map(|a| order.iter().flat_map(|&c| &a.values[c * a.components..(c + 1) * a.components]).copied().collect())
+        .collect();
+    let cell_out: Vec<OutArray> =
+        cell_arrays.iter().zip(&permuted).map(|(a, v)| OutArray { values: v, ..*a }).collect();
+    let mut sections: [(Vec<usize>, Vec<usize>); 4] = Default::default();
+    for &c in &order {
+        let corners = cells.corners(c);
+        let (conn, ends) = &mut sections[section(cells.types[c]).unwrap_or(2)];
+        if cells.types[c] == cell::PIXEL && corners.len() == 4 {
+            conn.extend([corners[0], corners[1], corners[3], corners[2]]);
+        } else {
+            conn.extend_from_slice(corners);
+        }
+        ends.push(conn.len());
+    }
+    let coords: Vec<f64> = points.iter().flatten().copied().collect();
+    let count = |k: usize| sections[k].1.len();
+    stage(path, |w| {
+        writeln!(w, "{XML_HEAD}")?;
+        writeln!(w, "{}", file_open("PolyData"))?;
+        writeln!(w, "  <PolyData>")?;
+        writeln!(
+            w,
+            "    <Piece NumberOfPoints=\"{n}\" NumberOfVerts=\"{}\" NumberOfLines=\"{}\" NumberOfStrips=\"{}\" NumberOfPolys=\"{}\">",
+            count(0),
+            count(1),
+            count(3),
+            count(2)
+        )?;
+        write_section(w, "PointData", point, active)?;
+        write_section(w, "CellData", &cell_out, None)?;
+        write_points(w, &coords)?;
+        for (k, tag) in ["Verts", "Lines", "Polys", "Strips"].iter().enumerate() {
+            let (conn, ends) = &sections[k];
+            if ends.is_empty() {
+                continue;
+            }
+            writeln!(w, "      <{tag}>")?;
+            write_array(w, "        ", "Int64", "connectivity", 1, &i64_bytes(conn))?;
+            write_array(w, "        ", "Int64", "offsets", 1, &i64_bytes(ends))?;
+            writeln!(w, "      </{tag}>")?;
+        }
+        writeln!(w, "    </Piece>")?;
+        writeln!(w, "  </PolyData>")?;
         writeln!(w, "</VTKFile>")
     })
 }

@@ -226,7 +226,12 @@ impl Decoder<'_> {
     fn data_array(&self, decl: &ArrayDecl, tuples: usize, of: &str) -> Result<PointArray> {
         let what = format!("{} array `{}`", if of == "cells" { "cell" } else { "point" }, decl.name);
         let values = self.numbers(decl, Some(tuples), of, &what)?.into_f64(&what)?;
-        Ok(PointArray { name: decl.name.clone(), components: decl.components, values })
+        Ok(PointArray {
+            name: decl.name.clone(),
+            components: decl.components,
+            values,
+            ty: decl.ty.unwrap_or(Scalar::F64),
+        })
     }
 
     /// The arrays of a data section that are numeric, and the names of those that are not.
@@ -290,20 +295,17 @@ fn image(m: &Markup, reader: &Decoder) -> Result<Dataset> {
         .ok_or_else(|| Error::input(format!("the extent `{extent_text}` is too large")))?;
     let mut ds = Dataset { image: Some(geometry), ..Dataset::default() };
     ds.point_data = reader.section(piece, Section::PointData, n, "points", &mut ds.skipped)?;
-    ds.cell_data = cell_names(piece);
+    let cells = [nx, ny, nz].iter().map(|&d| d.saturating_sub(1).max(1)).product();
+    ds.cell_data = reader.section(piece, Section::CellData, cells, "cells", &mut ds.skipped)?;
     ds.active_scalars = piece.active_scalars.clone();
     Ok(ds)
-}
-
-/// Names of the cell arrays (their values are not read).
-fn cell_names(piece: &PieceDecl) -> Vec<String> {
-    piece.arrays.iter().filter(|(s, _)| *s == Section::CellData).map(|(_, a)| a.name.clone()).collect()
 }
 
 /// Appends one poly data or unstructured grid piece to `ds`.
 fn mesh_piece(piece: &PieceDecl, poly: bool, reader: &Decoder, ds: &mut Dataset) -> Result<()> {
     let n = piece.count("NumberOfPoints")?;
     let base = ds.points.len();
+    let cells_before = ds.cells.len();
     if n > 0 {
         let decl =
             piece.first(Section::Points).ok_or_else(|| Error::input("the piece has points but no <Points> array"))?;
@@ -341,8 +343,10 @@ fn mesh_piece(piece: &PieceDecl, poly: bool, reader: &Decoder, ds: &mut Dataset)
     }
     let point_data = reader.section(piece, Section::PointData, n, "points", &mut ds.skipped)?;
     merge_arrays(&mut ds.point_data, point_data, base == 0)?;
+    let cell_data =
+        reader.section(piece, Section::CellData, ds.cells.len() - cells_before, "cells", &mut ds.skipped)?;
+    merge_arrays(&mut ds.cell_data, cell_data, base == 0 && cells_before == 0)?;
     if base == 0 {
-        ds.cell_data = cell_names(piece);
         ds.active_scalars = piece.active_scalars.clone();
     }
     Ok(())
@@ -395,12 +399,16 @@ fn merge_arrays(all: &mut Vec<PointArray>, piece: Vec<PointArray>, first: bool) 
     let names = |v: &[PointArray]| v.iter().map(|a| format!("{}({})", a.name, a.components)).collect::<Vec<_>>();
     if names(all) != names(&piece) {
         return Err(Error::input(format!(
-            "the pieces carry different point arrays ({} and {})",
+            "the pieces carry different arrays ({} and {})",
             names(all).join(", "),
             names(&piece).join(", ")
         )));
     }
     for (a, p) in all.iter_mut().zip(piece) {
+        if a.ty != p.ty {
+            // every value is exact in Float64 (larger integers were refused)
+            a.ty = Scalar::F64;
+        }
         a.values.extend(p.values);
     }
     Ok(())

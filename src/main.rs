@@ -46,6 +46,10 @@ enum Command {
         /// Persistence diagram PNG.
         #[arg(long, value_name = "PNG")]
         plot: Option<PathBuf>,
+        /// Persistence diagram in TTK's layout (.vtu): one line cell per pair, threshold on
+        /// `Persistence` in ParaView to select pairs.
+        #[arg(long, value_name = "VTU")]
+        diagram: Option<PathBuf>,
         /// Mark the extrema kept at this persistence: `5%` of the range or an absolute value.
         #[arg(long, default_value = "5%")]
         persistence: String,
@@ -356,6 +360,9 @@ struct SmoothCli {
     /// then carried through unchanged).
     #[arg(long, value_name = "NAME")]
     output_array: Option<String>,
+    /// The input's persistence diagram in TTK's layout (.vtu), pairs marked `Kept`.
+    #[arg(long, value_name = "VTU")]
+    diagram: Option<PathBuf>,
     #[command(flatten)]
     csv: CsvArgs,
     #[command(flatten)]
@@ -481,18 +488,20 @@ fn smooth_args(c: SmoothCli) -> Result<SmoothArgs> {
         plot: c.plot,
         report: c.report,
         output_array: c.output_array,
+        diagram: c.diagram,
     })
 }
 
 fn run(cli: Cli) -> Result<String> {
     match cli.command {
-        Command::Extrema { input, csv, grid, json, plot, persistence } => commands::extrema(&ExtremaArgs {
+        Command::Extrema { input, csv, grid, json, plot, diagram, persistence } => commands::extrema(&ExtremaArgs {
             input,
             kind: grid.domain,
             csv: csv.options(),
             grid: grid.options()?,
             json,
             plot,
+            diagram,
             selection: commands::parse_persistence(&persistence)?,
         }),
         Command::Smooth(c) => commands::smooth(&smooth_args(*c)?),

@@ -340,3 +340,84 @@ fn vtk_outputs_carry_every_input_array_in_its_type() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// `--diagram` writes TTK's persistence diagram: thresholding its `Persistence` at the
+/// selection's threshold (as ParaView's Threshold does, the diagonal left out as TTK's filters
+/// do) gives exactly the kept extrema; `--complex` carries TTK's critical types.
+#[test]
+fn thresholding_the_ttk_diagram_selects_exactly_the_kept_pairs() {
+    let dir = std::env::temp_dir().join(format!("toposmooth-diagram-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let volcano = Path::new(env!("CARGO_MANIFEST_DIR")).join("datasets/volcano_maunga_whau_61x87.csv");
+    let (out, diagram, complex, report) = (dir.join("v.vti"), dir.join("d.vtu"), dir.join("c.vtp"), dir.join("r.json"));
+    smooth_ok(&[
+        "smooth",
+        volcano.to_str().unwrap(),
+        "--persistence",
+        "5%",
+        "-o",
+        out.to_str().unwrap(),
+        "--diagram",
+        diagram.to_str().unwrap(),
+        "--complex",
+        complex.to_str().unwrap(),
+        "--report",
+        report.to_str().unwrap(),
+    ]);
+    let threshold = serde_json::from_str::<Value>(&std::fs::read_to_string(&report).unwrap()).unwrap()["settings"]
+        ["threshold"]
+        .as_f64()
+        .unwrap();
+    let roles = array(&read_dataset(&out).unwrap().point_data, "role").values.clone();
+    let kept: std::collections::BTreeSet<usize> = (0..roles.len()).filter(|&v| roles[v].abs() == 1.0).collect();
+    assert!(kept.len() >= 2, "{kept:?}");
+
+    let d = read_dataset(&diagram).unwrap();
+    let cell = |name: &str| array(&d.cell_data, name).values.clone();
+    let (id, ty, pers, finite, flag) =
+        (cell("PairIdentifier"), cell("PairType"), cell("Persistence"), cell("IsFinite"), cell("Kept"));
+    let vertex = &array(&d.point_data, "ttkVertexScalarField").values;
+    let critical = &array(&d.point_data, "CriticalType").values;
+    assert_eq!(array(&d.cell_data, "IsFinite").ty, toposmooth::io::vtk::Scalar::U8);
+    assert_eq!(array(&d.point_data, "Coordinates").components, 3);
+    // the diagonal last, and one essential pair (one connected grid) first
+    let last = id.len() - 1;
+    assert_eq!((id[last], ty[last]), (-1.0, -1.0));
+    assert_eq!(finite.iter().filter(|&&f| f == 0.0).count(), 2, "the essential pair and the diagonal");
+    assert_eq!((finite[0], id[0]), (0.0, 0.0));
+    let mut selected = std::collections::BTreeSet::new();
+    for c in 0..last {
+        let [b, e] = [d.cells.corners(c)[0], d.cells.corners(c)[1]];
+        // TTK's points: (birth, birth) and (birth, death)
+        assert_eq!(d.points[b][0], d.points[e][0]);
+        assert!((d.points[e][1] - d.points[b][0] - pers[c]).abs() <= 1e-12 * pers[c].abs().max(1.0));
+        let (lo, hi) = (vertex[b] as usize, vertex[e] as usize);
+        match ty[c] as i32 {
+            0 => assert_eq!((critical[b], critical[e]), (0.0, if finite[c] == 1.0 { 1.0 } else { 3.0 })),
+            1 => assert_eq!((critical[b], critical[e]), (1.0, 3.0)),
+            t => panic!("pair type {t}"),
+        }
+        if pers[c] >= threshold {
+            let ends: Vec<usize> = match (ty[c] as i32, finite[c] == 1.0) {
+                (_, false) => vec![lo, hi],
+                (0, true) => vec![lo],
+                _ => vec![hi],
+            };
+            selected.extend(ends);
+            assert_eq!(flag[c], 1.0, "pair {c} above the threshold is marked kept");
+        } else {
+            assert_eq!(flag[c], 0.0, "pair {c} below the threshold is not kept");
+        }
+    }
+    assert_eq!(selected, kept, "threshold {threshold}");
+
+    let c = read_dataset(&complex).unwrap();
+    let pa = |name: &str| array(&c.point_data, name).values.clone();
+    let (ct, vid, k) = (pa("CriticalType"), pa("ttkVertexScalarField"), pa("Kept"));
+    let kept_in_complex: std::collections::BTreeSet<usize> =
+        (0..ct.len()).filter(|&p| k[p] == 1.0 && (ct[p] == 0.0 || ct[p] == 3.0)).map(|p| vid[p] as usize).collect();
+    assert_eq!(kept_in_complex, kept);
+    let sep = array(&c.cell_data, "SeparatrixType").values.clone();
+    assert!(sep.contains(&0.0) && sep.contains(&1.0) && sep.contains(&-1.0), "{sep:?}");
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -24,6 +24,8 @@ pub struct ExtremaArgs {
     pub json: bool,
     /// Persistence diagram PNG.
     pub plot: Option<PathBuf>,
+    /// Persistence diagram in TTK's layout (`.vtu`).
+    pub diagram: Option<PathBuf>,
     /// Selection whose kept extrema are marked (default: SPEC's 5 %).
     pub selection: Selection,
 }
@@ -56,7 +58,10 @@ struct Row<'a> {
 pub fn extrema(args: &ExtremaArgs) -> Result<String> {
     check_png_name(args.plot.as_deref())?;
     let inputs: Vec<&Path> = args.input.iter().map(PathBuf::as_path).collect();
-    check_distinct(&inputs, &[("--plot", args.plot.as_deref())])?;
+    check_distinct(&inputs, &[("--plot", args.plot.as_deref()), ("--diagram", args.diagram.as_deref())])?;
+    if let Some(d) = &args.diagram {
+        crate::io::ttk::check_diagram_output(d)?;
+    }
     let path = args.input.clone().unwrap_or_default();
     let field = read_field(args.input.as_deref(), args.kind, &args.csv, &args.grid)?.into_field(&path)?;
     let text = match &field.domain {
@@ -118,6 +123,10 @@ fn list<D: Domain>(args: &ExtremaArgs, field: &Field, domain: &D) -> Result<Stri
     };
     if let Some(plot_path) = &args.plot {
         stage_diagram(plot_path, path, column, &table, h, &kept, surface)?.commit()?;
+    }
+    if let Some(d) = &args.diagram {
+        let pairs = crate::io::ttk::diagram_pairs(domain, h, &table, surface);
+        crate::io::ttk::stage_diagram(d, &field.domain, &pairs, &kept.roles)?.commit()?;
     }
     if args.json {
         return serde_json::to_string_pretty(&listing).map_err(|e| Error::input(e.to_string()));

@@ -75,8 +75,12 @@ pub fn smooth(args: &SmoothArgs) -> Result<String> {
             ("--plot", args.plot.as_deref()),
             ("--report", args.report.as_deref()),
             ("--complex", args.complex.as_deref()),
+            ("--diagram", args.diagram.as_deref()),
         ],
     )?;
+    if let Some(d) = &args.diagram {
+        crate::io::ttk::check_diagram_output(d)?;
+    }
     let start = Instant::now();
     let field = read_field(args.input.as_deref(), args.kind, &args.csv, &args.grid)?.into_field(&input_path)?;
     if let Some(c) = &args.complex {
@@ -126,6 +130,10 @@ pub fn smooth(args: &SmoothArgs) -> Result<String> {
             });
         };
         staged.push(stage_complex(path, &field.domain, &field.values, &result.roles, ms)?);
+    }
+    if let Some(path) = &args.diagram {
+        let pairs = crate::io::ttk::diagram_of(&field.domain, &field.values);
+        staged.push(crate::io::ttk::stage_diagram(path, &field.domain, &pairs, &result.roles)?);
     }
     let mut hidden = 0;
     if let Some(path) = &args.plot {
@@ -237,7 +245,7 @@ fn summary(args: &SmoothArgs, field: &Field, result: &Smoothed, counts: [usize; 
         text += &format!("plot: {hidden} kept extrema face away from the camera (try --view)\n");
     }
     let mut wrote = vec![args.output.display().to_string()];
-    for p in [&args.complex, &args.plot, &args.report].into_iter().flatten() {
+    for p in [&args.complex, &args.diagram, &args.plot, &args.report].into_iter().flatten() {
         wrote.push(p.display().to_string());
     }
     text += &format!("wrote {}\n", wrote.join(", "));

@@ -32,6 +32,8 @@ pub struct SmoothArgs {
     pub plot: Option<PathBuf>,
     /// JSON report.
     pub report: Option<PathBuf>,
+    /// The input's persistence diagram in TTK's layout (`--diagram`, `.vtu`).
+    pub diagram: Option<PathBuf>,
     /// The smoothed field's name in VTK outputs (`--output-array`).
     pub output_array: Option<String>,
 }

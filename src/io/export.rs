@@ -9,7 +9,7 @@ use super::npz::{read_npz, stage_npy, stage_npz};
 use super::series_csv::{read_series_output, stage_series_output, SeriesOutput};
 use super::vtk::{
     read_dataset, read_image, stage_legacy, stage_vti_arrays, stage_vtp, stage_vtp_cells, stage_vtu_cells,
-    triangle_cells, Cells, LegacyGeometry, OutArray, PointArray, PolyData,
+    triangle_cells, Cells, LegacyGeometry, OutArray, PointArray, PolyData, Scalar,
 };
 use super::Staged;
 use crate::domain::{AnyDomain, Domain, Grid2d, Series, TriMesh};
@@ -380,62 +380,95 @@ fn grid_point(grid: &Grid2d, v: usize) -> [f64; 3] {
     [ox + c as f64 * dx, oy + r as f64 * dy, 0.0]
 }
 
-/// The kept extrema, surviving saddles and separatrices as PolyData: vertex cells first
-/// (cell array `type`: −1 minimum, +1 maximum, 0 saddle), then one polyline per separatrix
-/// (`type` −1 descending to a minimum, +1 ascending to a maximum), with the input `h` as the
-/// point array `input`. Grid points are placed as VTK places ImageData points.
-pub fn complex_polydata(domain: &AnyDomain, h: &[f64], roles: &[Role], ms: &MorseSmale) -> PolyData {
+/// Stages the critical points and the kept complex at `path` as `.vtp` in TTK's layout
+/// ([`super::ttk`]): one vertex cell per critical vertex of the input's persistence pairs
+/// (extrema and merge saddles, cancelled ones included; a series' end maxima, unpaired, are
+/// left out), then one polyline
+/// per separatrix of the kept complex. Point data: `CriticalType`, `ttkVertexScalarField`,
+/// `input` (the value), `Persistence` and `PairIdentifier` of the vertex's diagram pair (the
+/// ids of `--diagram`; NaN and −1 for regular vertices on separatrices), `Kept` (UInt8: a kept
+/// extremum or a saddle of the kept complex). Cell data: `SeparatrixType` (−1 on vertex
+/// cells), `SourceId` and `DestinationId` (the saddle's and the extremum's vertex; the vertex
+/// itself and −1 on vertex cells).
+///
+/// # Errors
+/// As [`check_complex_output`]; I/O errors naming the file.
+pub fn stage_complex(path: &Path, domain: &AnyDomain, h: &[f64], roles: &[Role], ms: &MorseSmale) -> Result<Staged> {
+    use super::ttk::critical;
+    check_complex_output(path, domain)?;
+    let pairs = super::ttk::diagram_of(domain, h);
     let place = |v: usize| match domain {
         AnyDomain::Series(_) => [v as f64, 0.0, 0.0],
         AnyDomain::Grid(g) => grid_point(g, v),
         AnyDomain::Mesh(m) => m.point(v),
     };
+    // each vertex's critical type and diagram pair (the first pair that names it)
+    let mut critical_of: std::collections::BTreeMap<usize, (i32, usize)> = std::collections::BTreeMap::new();
+    for (i, p) in pairs.iter().enumerate() {
+        for k in 0..2 {
+            critical_of.entry(p.vertices[k]).or_insert((p.types[k], i));
+        }
+    }
+    let saddles: std::collections::HashSet<usize> = ms.saddles.iter().copied().collect();
     let mut slot = std::collections::HashMap::new();
-    let mut points = Vec::new();
-    let mut values = Vec::new();
-    let mut id = |v: usize, points: &mut Vec<[f64; 3]>, values: &mut Vec<f64>| -> usize {
+    let mut points: Vec<[f64; 3]> = Vec::new();
+    let mut vertex_of: Vec<usize> = Vec::new();
+    let mut id = |v: usize, points: &mut Vec<[f64; 3]>, vertex_of: &mut Vec<usize>| -> usize {
         *slot.entry(v).or_insert_with(|| {
             points.push(place(v));
-            values.push(h[v]);
+            vertex_of.push(v);
             points.len() - 1
         })
     };
-    let mut verts = Vec::new();
-    let mut types = Vec::new();
-    for (v, r) in roles.iter().enumerate() {
-        if matches!(r, Role::Min | Role::Max) {
-            verts.push(id(v, &mut points, &mut values));
-            types.push(f64::from(r.code()));
-        }
+    let mut cells = Cells::default();
+    let (mut sep_type, mut source, mut destination) = (Vec::new(), Vec::new(), Vec::new());
+    for &v in critical_of.keys() {
+        cells.connectivity.push(id(v, &mut points, &mut vertex_of));
+        cells.offsets.push(cells.connectivity.len());
+        cells.types.push(super::vtk::cell::VERTEX);
+        sep_type.push(-1.0);
+        source.push(v as f64);
+        destination.push(-1.0);
     }
-    for &s in &ms.saddles {
-        verts.push(id(s, &mut points, &mut values));
-        types.push(0.0);
-    }
-    let mut lines = Vec::new();
-    for (list, t) in [(&ms.descending, -1.0), (&ms.ascending, 1.0)] {
+    for (list, t) in [(&ms.descending, 0.0), (&ms.ascending, 1.0)] {
         for sep in list {
-            lines.push(sep.path.iter().map(|&v| id(v, &mut points, &mut values)).collect::<Vec<usize>>());
-            types.push(t);
+            for &v in &sep.path {
+                cells.connectivity.push(id(v, &mut points, &mut vertex_of));
+            }
+            cells.offsets.push(cells.connectivity.len());
+            cells.types.push(super::vtk::cell::POLY_LINE);
+            sep_type.push(t);
+            source.push(sep.saddle as f64);
+            destination.push(sep.path.last().map_or(-1.0, |&v| v as f64));
         }
     }
-    PolyData {
-        points,
-        verts,
-        lines,
-        point_arrays: vec![("input".into(), values)],
-        cell_arrays: vec![("type".into(), types)],
-        ..Default::default()
+    let mut arrays: [Vec<f64>; 6] = Default::default();
+    for &v in &vertex_of {
+        let (t, pair) = critical_of.get(&v).copied().unwrap_or((critical::REGULAR, usize::MAX));
+        let kept = matches!(roles[v], Role::Min | Role::Max) || saddles.contains(&v);
+        arrays[0].push(f64::from(t));
+        arrays[1].push(v as f64);
+        arrays[2].push(h[v]);
+        arrays[3].push(pairs.get(pair).map_or(f64::NAN, |p| p.persistence()));
+        arrays[4].push(if pair == usize::MAX { -1.0 } else { pair as f64 });
+        arrays[5].push(f64::from(u8::from(kept && t != critical::REGULAR)));
     }
-}
-
-/// Stages the complex at `path` as `.vtp` ([`complex_polydata`]).
-///
-/// # Errors
-/// As [`check_complex_output`]; I/O errors naming the file.
-pub fn stage_complex(path: &Path, domain: &AnyDomain, h: &[f64], roles: &[Role], ms: &MorseSmale) -> Result<Staged> {
-    check_complex_output(path, domain)?;
-    stage_vtp(path, &complex_polydata(domain, h, roles, ms))
+    let id_type = if domain.n_vertices() > i32::MAX as usize { Scalar::I64 } else { Scalar::I32 };
+    let typed = |name, ty, values| OutArray { name, ty, components: 1, values };
+    let point = [
+        typed("CriticalType", Scalar::I32, &arrays[0][..]),
+        typed("ttkVertexScalarField", id_type, &arrays[1]),
+        typed("input", Scalar::F64, &arrays[2]),
+        typed("Persistence", Scalar::F64, &arrays[3]),
+        typed("PairIdentifier", id_type, &arrays[4]),
+        typed("Kept", Scalar::U8, &arrays[5]),
+    ];
+    let cell = [
+        typed("SeparatrixType", Scalar::I32, &sep_type[..]),
+        typed("SourceId", id_type, &source),
+        typed("DestinationId", id_type, &destination),
+    ];
+    stage_vtp_cells(path, &points, &cells, (&point, &cell), Some("input"))
 }
 
 /// A smoothing result read back from its file (for `verify`).

@@ -15,6 +15,8 @@ pub mod series_csv;
 pub mod series_output;
 pub mod staging;
 pub mod timestamps;
+#[cfg(all(feature = "io-vtk", feature = "io-npz"))]
+pub mod ttk;
 #[cfg(feature = "io-vtk")]
 pub mod vtk;
 

@@ -158,6 +158,34 @@ w = os.path.join(WORK, "penguin_weights.vtu")
 if run("weights", penguin, "--handles", os.path.join(DATASETS, "penguin_handles.json"), "-o", w):
     check_opens(w, [])
 
+# TTK's diagram: VTK's Threshold on `Persistence` (diagonal excluded, as TTK's filters do)
+# selects exactly the pairs the selection keeps
+volcano = os.path.join(DATASETS, "volcano_maunga_whau_61x87.csv")
+vo, vd, vc = (os.path.join(WORK, n) for n in ["volcano.vti", "volcano_diagram.vtu", "volcano_complex.vtp"])
+if run("smooth", volcano, "--persistence", "5%", "-o", vo, "--diagram", vd, "--complex", vc):
+    check_opens(vd, ["PairIdentifier", "PairType", "Persistence", "Birth", "IsFinite", "CriticalType", "Coordinates"])
+    check_opens(vc, ["CriticalType", "ttkVertexScalarField", "Persistence", "PairIdentifier", "Kept", "SeparatrixType"])
+    diagram, _ = read(vd)
+    lo, hi = float("inf"), float("-inf")
+    field, _ = read(vo)
+    values = vtk_to_numpy(field.GetPointData().GetArray("input"))
+    roles = vtk_to_numpy(field.GetPointData().GetArray("role"))
+    t = 0.05 * (values.max() - values.min())
+    th = vtk.vtkThreshold()
+    th.SetInputData(diagram)
+    th.SetInputArrayToProcess(0, 0, 0, vtk.vtkDataObject.FIELD_ASSOCIATION_CELLS, "Persistence")
+    th.SetThresholdFunction(vtk.vtkThreshold.THRESHOLD_UPPER)
+    th.SetUpperThreshold(t)
+    th.Update()
+    ids = vtk_to_numpy(th.GetOutput().GetCellData().GetArray("PairIdentifier"))
+    pairs = int((ids >= 0).sum())
+    kept = int((abs(roles) == 1).sum())
+    # the essential pair keeps two extrema, every other pair one
+    if pairs + 1 != kept:
+        fail(vd, f"Threshold Persistence >= {t} keeps {pairs} pairs; the output keeps {kept} extrema")
+    else:
+        print(f"ok Threshold on Persistence: {pairs} pairs for {kept} kept extrema")
+
 if failures:
     print(f"{len(failures)} failures", file=sys.stderr)
     sys.exit(1)

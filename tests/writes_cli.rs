@@ -90,6 +90,7 @@ fn dash_writes_the_output_on_stdout_and_the_summary_on_stderr() {
     assert_eq!(out.lines().count(), 4755);
     let err = String::from_utf8(o.stderr.clone()).unwrap();
     assert!(err.contains("certified"), "{err}");
+    assert!(err.contains("wrote standard output"), "{err}");
     // two outputs on one standard output are refused before any work
     let o = toposmooth(&["smooth", &fx(), "-o", "-", "--report", "-"]);
     assert_eq!(o.status.code(), Some(2), "{}", text(&o));

@@ -127,7 +127,7 @@ pub fn diffuse(args: &DiffuseArgs) -> Result<String> {
             seconds: start.elapsed().as_secs_f64(),
         };
         staged.push(super::stage_report(path, &report)?);
-        wrote.push(path.display().to_string());
+        wrote.push(super::shown(path));
     }
     crate::io::commit_all(staged)?;
     let certified = w.functions.iter().filter(|f| f.certificate.passed).count();
@@ -235,7 +235,7 @@ struct Diffused<'a> {
 /// the names written.
 fn stage_diffused(args: &DiffuseArgs, d: &Diffused, weights_path: &Path) -> Result<(Vec<Staged>, Vec<String>)> {
     let mut staged: Vec<Staged> = Vec::new();
-    let mut wrote = vec![args.output.display().to_string()];
+    let mut wrote = vec![super::shown(&args.output)];
     match d.pm {
         Some(pm) => {
             let mut img = image::RgbaImage::new(pm.width as u32, pm.height as u32);
@@ -246,10 +246,10 @@ fn stage_diffused(args: &DiffuseArgs, d: &Diffused, weights_path: &Path) -> Resu
             staged.push(stage_png(&args.output, &img)?);
             let wpath = weights_path.to_path_buf();
             staged.push(stage_weights(&wpath, d.mesh, d.names, d.weights)?);
-            wrote.push(wpath.display().to_string());
+            wrote.push(super::shown(&wpath));
             if let Some(path) = &args.plot {
                 staged.push(stage_png(path, &enlarged(&img, pm, d.sets, d.rgbs))?);
-                wrote.push(path.display().to_string());
+                wrote.push(super::shown(path));
             }
         }
         None => {
@@ -266,7 +266,7 @@ fn stage_diffused(args: &DiffuseArgs, d: &Diffused, weights_path: &Path) -> Resu
                 staged.push(super::stage_plot(path, |p| {
                     plot_mesh_colours(p, d.mesh.positions(), d.mesh.faces(), d.colours, &title, view)
                 })?);
-                wrote.push(path.display().to_string());
+                wrote.push(super::shown(path));
             }
         }
     }

@@ -222,9 +222,18 @@ fn stage_report<T: serde::Serialize>(path: &Path, report: &T) -> Result<crate::i
     )
 }
 
+/// An output's name for the summary: `-` is the standard output.
+pub(crate) fn shown(path: &Path) -> String {
+    if path.as_os_str() == "-" {
+        "standard output".into()
+    } else {
+        path.display().to_string()
+    }
+}
+
 /// The line listing the files written (the given paths, skipping `None`).
 fn wrote_line<'a>(paths: impl IntoIterator<Item = Option<&'a std::path::PathBuf>>) -> String {
-    let names: Vec<String> = paths.into_iter().flatten().map(|p| p.display().to_string()).collect();
+    let names: Vec<String> = paths.into_iter().flatten().map(|p| shown(p)).collect();
     format!("wrote {}\n", names.join(", "))
 }
 

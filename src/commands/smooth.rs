@@ -244,9 +244,9 @@ fn summary(args: &SmoothArgs, field: &Field, result: &Smoothed, counts: [usize; 
     if hidden > 0 {
         text += &format!("plot: {hidden} kept extrema face away from the camera (try --view)\n");
     }
-    let mut wrote = vec![args.output.display().to_string()];
+    let mut wrote = vec![super::shown(&args.output)];
     for p in [&args.complex, &args.diagram, &args.plot, &args.report].into_iter().flatten() {
-        wrote.push(p.display().to_string());
+        wrote.push(super::shown(p));
     }
     text += &format!("wrote {}\n", wrote.join(", "));
     text

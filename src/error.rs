@@ -3,7 +3,7 @@
 //! Bad input, settings and infeasible requests are `Err` values; a solver outcome that cannot
 //! be certified is an `Err` too, so no caller can print success for it.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// Result with the crate's [`Error`].
 pub type Result<T, E = Error> = std::result::Result<T, E>;
@@ -220,6 +220,31 @@ impl Error {
     /// An infeasibility error without a file.
     pub fn infeasible(message: impl Into<String>) -> Self {
         Error::Infeasible { path: None, at: None, message: message.into() }
+    }
+
+    /// The error with the file `from` called `to` (in its path and its message): a temporary
+    /// copy of the input named as the user gave it.
+    pub fn renamed(self, from: &Path, to: &Path) -> Self {
+        let (from_text, to_text) = (from.display().to_string(), to.display().to_string());
+        let text = |m: String| m.replace(&from_text, &to_text);
+        let file = |p: Option<PathBuf>| p.map(|p| if p == from { to.to_path_buf() } else { p });
+        match self {
+            Error::Input { path, at, message } => Error::Input { path: file(path), at, message: text(message) },
+            Error::Infeasible { path, at, message } => {
+                Error::Infeasible { path: file(path), at, message: text(message) }
+            }
+            Error::Representative { path, message } => {
+                Error::Representative { path: file(path), message: text(message) }
+            }
+            Error::Internal { path, message } => Error::Internal { path: file(path), message: text(message) },
+            Error::Uncertified { path, message } => Error::Uncertified { path: file(path), message: text(message) },
+            Error::NoSolution { path, status } => Error::NoSolution { path: file(path), status: text(status) },
+            Error::Usage(m) => Error::Usage(text(m)),
+            Error::Setting { setting, message } => Error::Setting { setting, message: text(message) },
+            Error::Io { path, source } => {
+                Error::Io { path: if path == from { to.to_path_buf() } else { path }, source }
+            }
+        }
     }
 
     /// Attaches `file` to an error that does not name one yet.

@@ -52,10 +52,15 @@ fn words(ws: &[u64]) -> Vec<u8> {
 
 /// A `.vti` of 2^27 × 1 × 1 Float64 points (1 GB) whose appended raw data holds `block`.
 fn vti(compressor: &str, block: &[u8]) -> Vec<u8> {
+    vti_extent("0 134217727 0 0 0 0", compressor, block)
+}
+
+/// A `.vti` of Float64 points over `extent` whose appended raw data holds `block`.
+fn vti_extent(extent: &str, compressor: &str, block: &[u8]) -> Vec<u8> {
     let mut f = format!(
         "<?xml version=\"1.0\"?>\n<VTKFile type=\"ImageData\" version=\"1.0\" byte_order=\"LittleEndian\" \
-         header_type=\"UInt64\"{compressor}>\n<ImageData WholeExtent=\"0 134217727 0 0 0 0\" Origin=\"0 0 0\" \
-         Spacing=\"1 1 1\">\n<Piece Extent=\"0 134217727 0 0 0 0\">\n<PointData Scalars=\"f\">\n\
+         header_type=\"UInt64\"{compressor}>\n<ImageData WholeExtent=\"{extent}\" Origin=\"0 0 0\" \
+         Spacing=\"1 1 1\">\n<Piece Extent=\"{extent}\">\n<PointData Scalars=\"f\">\n\
          <DataArray type=\"Float64\" Name=\"f\" format=\"appended\" offset=\"0\"/>\n</PointData>\n</Piece>\n\
          </ImageData>\n<AppendedData encoding=\"raw\">\n_"
     )
@@ -76,6 +81,10 @@ fn cases() -> Vec<(&'static str, Vec<u8>)> {
     }
     let mut zlib_block = words(&[1, GB, GB, tiny_zlib.len() as u64]);
     zlib_block.extend_from_slice(&tiny_zlib);
+    // 32768 × 32768 points (a proper 2D extent, so the extent is no reason to refuse it):
+    // one zlib block declared 8 GB long that holds 4 KiB of zeros
+    let mut zlib_8gb = words(&[1, 8 * GB, 8 * GB, tiny_zlib.len() as u64]);
+    zlib_8gb.extend_from_slice(&tiny_zlib);
     let mut lz4_block = words(&[1, GB, GB, 12]);
     lz4_block.extend_from_slice(&[0x1f, 0, 1, 0, 0xff, 0xff, 0xff, 0xff, 0xff, 0xff, 0xff, 0xff]);
     let mut tiny_xz = Vec::new();
@@ -104,6 +113,7 @@ fn cases() -> Vec<(&'static str, Vec<u8>)> {
         ("over-the-cap.vti", vti("", &words(&[8 * GB]))),
         ("zlib.vti", vti(&zlib("vtkZLibDataCompressor"), &zlib_block)),
         ("zlib-many-blocks.vti", vti(&zlib("vtkZLibDataCompressor"), &zlib_sizes)),
+        ("zlib-2d-8gb.vti", vti_extent("0 32767 0 32767 0 0", &zlib("vtkZLibDataCompressor"), &zlib_8gb)),
         ("lz4.vti", vti(&zlib("vtkLZ4DataCompressor"), &lz4_block)),
         ("lzma.vti", vti(&zlib("vtkLZMADataCompressor"), &lzma_block)),
         ("points.vtk", legacy),

@@ -270,3 +270,47 @@ fn progress_is_one_line_per_stage_off_a_terminal_and_quiet_silences_it() {
         assert!(String::from_utf8_lossy(&o.stdout).contains("certified"), "{}", text(&o));
     }
 }
+
+#[test]
+fn dash_reads_the_standard_input_and_a_fifo_input_is_read_once() {
+    let dir = scratch("stdin");
+    let out = dir.join("s.csv");
+    let bytes = std::fs::read(fx()).unwrap();
+    let mut child = Command::new(bin())
+        .args(["-q", "smooth", "-", "-o", out.to_str().unwrap(), "--persistence", "8%"])
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    std::io::Write::write_all(&mut child.stdin.take().unwrap(), &bytes).unwrap();
+    let o = child.wait_with_output().unwrap();
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+    assert!(String::from_utf8_lossy(&o.stdout).starts_with("standard input: 4754 samples"), "{}", text(&o));
+    let from_file = dir.join("f.csv");
+    let o = toposmooth(&["smooth", &fx(), "-o", from_file.to_str().unwrap(), "--persistence", "8%"]);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+    assert_eq!(std::fs::read(&out).unwrap(), std::fs::read(&from_file).unwrap(), "stdin and the file give one output");
+    // a bad standard input is named as such
+    let mut child = Command::new(bin())
+        .args(["smooth", "-", "-o", out.to_str().unwrap()])
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    std::io::Write::write_all(&mut child.stdin.take().unwrap(), b"a,b\n").unwrap();
+    let o = child.wait_with_output().unwrap();
+    assert_eq!(o.status.code(), Some(3), "{}", text(&o));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("standard input:") && !err.contains("toposmooth-input-"), "{err}");
+    // a FIFO is opened once: the writer below writes it once, and the run must not wait for more
+    let fifo = dir.join("in.csv");
+    mkfifo(&fifo);
+    let (f, data) = (fifo.clone(), bytes.clone());
+    let writer = std::thread::spawn(move || std::fs::write(&f, &data).unwrap());
+    let o = toposmooth(&["-q", "extrema", fifo.to_str().unwrap()]);
+    writer.join().unwrap();
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+    assert!(String::from_utf8_lossy(&o.stdout).contains("47 minima, 46 maxima"), "{}", text(&o));
+}

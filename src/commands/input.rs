@@ -242,8 +242,90 @@ pub fn is_grid_file(path: &Path, kind: DomainKind) -> Result<bool> {
     })
 }
 
-/// Reads the field of a command: a series or a grid, by [`is_grid_file`].
+/// An input that can be read only once (`-` for the standard input, a FIFO, a character
+/// device), read once into a temporary file that the readers (which sniff, then read) open
+/// as often as they need; removed when dropped.
+struct ReadOnce {
+    tmp: PathBuf,
+    original: PathBuf,
+}
+
+impl Drop for ReadOnce {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_file(&self.tmp);
+    }
+}
+
+impl ReadOnce {
+    /// Copies `path` when it is `-`, a FIFO or a character device; `None` for a file.
+    fn of(path: &Path) -> Result<Option<ReadOnce>> {
+        use std::io::Read;
+        use std::os::unix::fs::FileTypeExt;
+        let stdin = path.as_os_str() == "-";
+        if !stdin {
+            match std::fs::metadata(path) {
+                Ok(m) if m.file_type().is_fifo() || m.file_type().is_char_device() => {}
+                _ => return Ok(None),
+            }
+        }
+        let io = |source| Error::Io { path: path.to_path_buf(), source };
+        let mut bytes = Vec::new();
+        if stdin {
+            std::io::stdin().lock().read_to_end(&mut bytes).map_err(io)?;
+        } else {
+            std::fs::File::open(path).and_then(|mut f| f.read_to_end(&mut bytes)).map_err(io)?;
+        }
+        // the name's extension, else the content's: NPY by its magic, CSV otherwise
+        let ext = match path.extension().and_then(|e| e.to_str()) {
+            Some(e) if !e.is_empty() => e.to_string(),
+            _ if bytes.starts_with(b"\x93NUMPY") => "npy".into(),
+            _ => "csv".into(),
+        };
+        let nonce: u64 =
+            std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map_or(0, |d| d.as_nanos() as u64);
+        let tmp = std::env::temp_dir().join(format!("toposmooth-input-{}-{nonce:x}.{ext}", std::process::id()));
+        let write = std::fs::OpenOptions::new().write(true).create_new(true).open(&tmp);
+        write
+            .and_then(|mut f| std::io::Write::write_all(&mut f, &bytes))
+            .map_err(|source| Error::Io { path: tmp.clone(), source })?;
+        Ok(Some(ReadOnce { tmp, original: path.to_path_buf() }))
+    }
+
+    /// What a message calls the input.
+    fn name(&self) -> PathBuf {
+        if self.original.as_os_str() == "-" {
+            PathBuf::from("standard input")
+        } else {
+            self.original.clone()
+        }
+    }
+}
+
+/// Reads the field of a command: a series or a grid, by [`is_grid_file`]. `-` reads the
+/// standard input (CSV or NPY); a FIFO is read once.
+///
+/// # Errors
+/// As the readers, naming the input as given.
 pub fn read_field(
+    path: Option<&Path>,
+    kind: DomainKind,
+    csv: &SeriesCsvOptions,
+    grid: &GridOptions,
+) -> Result<FieldInput> {
+    let once = path.map(ReadOnce::of).transpose()?.flatten();
+    let Some(once) = once else {
+        return read_field_from(path, kind, csv, grid);
+    };
+    let name = once.name();
+    match read_field_from(Some(&once.tmp), kind, csv, grid) {
+        Ok(FieldInput::Grid(g)) => Ok(FieldInput::Grid(GridInput { path: name, ..g })),
+        Ok(FieldInput::Mesh(m)) => Ok(FieldInput::Mesh(MeshInput { path: name, ..m })),
+        Ok(series) => Ok(series),
+        Err(e) => Err(e.renamed(&once.tmp, &name)),
+    }
+}
+
+fn read_field_from(
     path: Option<&Path>,
     kind: DomainKind,
     csv: &SeriesCsvOptions,
@@ -575,7 +657,7 @@ impl FieldInput {
             FieldInput::Series(SeriesInput { data, filled }) => Field {
                 domain: AnyDomain::Series(Series::with_coordinates(data.x.clone()).map_err(|e| e.in_file(path))?),
                 values: data.values,
-                path: path.to_path_buf(),
+                path: if path.as_os_str() == "-" { PathBuf::from("standard input") } else { path.to_path_buf() },
                 description: data.column,
                 filled,
                 notes: Vec::new(),

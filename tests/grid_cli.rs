@@ -469,3 +469,76 @@ fn an_explicit_representative_is_built_or_refused() {
     assert_eq!(explicit_ok + explicit_refused, 40);
     eprintln!("explicit separatrix: {explicit_ok} built, {explicit_refused} refused; automatic fallbacks {fallbacks}");
 }
+
+/// An ASCII `.vti` of `nx × ny` points at origin `o` with spacing `d`, one Float64 array `h`
+/// sampled from `f(x, y)`.
+fn ascii_vti(nx: usize, ny: usize, o: [f64; 2], d: [f64; 2], f: impl Fn(f64, f64) -> f64) -> String {
+    let values: Vec<String> =
+        (0..nx * ny).map(|i| f(o[0] + (i % nx) as f64 * d[0], o[1] + (i / nx) as f64 * d[1]).to_string()).collect();
+    let (ex, ey) = (nx - 1, ny - 1);
+    format!(
+        "<?xml version=\"1.0\"?>\n<VTKFile type=\"ImageData\" version=\"1.0\" byte_order=\"LittleEndian\">\n\
+         <ImageData WholeExtent=\"0 {ex} 0 {ey} 0 0\" Origin=\"{} {} 0\" Spacing=\"{} {} 1\">\n\
+         <Piece Extent=\"0 {ex} 0 {ey} 0 0\"><PointData Scalars=\"h\">\n\
+         <DataArray type=\"Float64\" Name=\"h\" format=\"ascii\">{}</DataArray>\n\
+         </PointData></Piece></ImageData></VTKFile>\n",
+        o[0],
+        o[1],
+        d[0],
+        d[1],
+        values.join(" ")
+    )
+}
+
+/// The coloured (not grey, black or white) pixels down column `x` of a figure, top first.
+fn coloured_down(img: &image::RgbImage, x: u32) -> Vec<[u8; 3]> {
+    let grey = |p: &[u8; 3]| p.iter().max().unwrap() - p.iter().min().unwrap() < 12;
+    (0..img.height()).map(|y| img.get_pixel(x, y).0).filter(|p| !grey(p)).collect()
+}
+
+#[test]
+fn heat_maps_put_larger_y_on_top_as_paraview_does() {
+    // h = y + x/10 on 30 × 20 points; stored with dy = +1 and, rows reversed, with dy = −1
+    let root = scratch("plot_orientation");
+    let h = |x: f64, y: f64| y + x / 10.0;
+    let mut figures = Vec::new();
+    for (sub, o, d) in [("up", [0.0, 0.0], [1.0, 1.0]), ("down", [0.0, 19.0], [1.0, -1.0])] {
+        let dir = root.join(sub);
+        std::fs::create_dir_all(&dir).unwrap();
+        let vti = write(&dir, "ramp.vti", ascii_vti(30, 20, o, d, h).as_bytes());
+        let (out, png) = (path(&dir, "out.vti"), path(&dir, "fig.png"));
+        let r = toposmooth(&["smooth", &vti.display().to_string(), "-o", &out, "--plot", &png, "--quiet"]);
+        assert!(r.status.success(), "{}", text(&r));
+        figures.push(image::open(&png).unwrap().to_rgb8());
+    }
+    let (w, _) = figures[0].dimensions();
+    // down the middle of the input panel (the left one): high values (viridis yellow) on top
+    let column = coloured_down(&figures[0], w / 4);
+    let (top, bottom) = (column[0], column[column.len() - 1]);
+    assert!(top[0] > 150 && top[1] > 150 && top[2] < 120, "top is the high colour: {top:?}");
+    assert!(bottom[2] > bottom[1] && bottom[0] < 120, "bottom is the low colour: {bottom:?}");
+    // the same physical field gives the same input panel, axes included (the title row and the
+    // smoothed panel hold the run's own numbers)
+    let same =
+        (60..figures[0].height()).all(|y| (0..w / 2).all(|x| figures[0].get_pixel(x, y) == figures[1].get_pixel(x, y)));
+    assert!(same, "dy = +1 and dy = -1 draw the same picture");
+    std::fs::remove_dir_all(&root).ok();
+}
+
+#[test]
+fn a_png_keeps_its_look_in_the_heat_map() {
+    // a grey ramp bright at the image's top row, dark at its bottom
+    let dir = scratch("plot_png_look");
+    let img = image::GrayImage::from_fn(40, 30, |x, y| image::Luma([(250 - y * 8 + x % 3) as u8]));
+    let src = dir.join("ramp.png");
+    img.save(&src).unwrap();
+    let (out, png) = (path(&dir, "out.vti"), path(&dir, "fig.png"));
+    let r = toposmooth(&["smooth", &src.display().to_string(), "-o", &out, "--plot", &png, "--quiet"]);
+    assert!(r.status.success(), "{}", text(&r));
+    let fig = image::open(&png).unwrap().to_rgb8();
+    let column = coloured_down(&fig, fig.width() / 4);
+    let (top, bottom) = (column[0], column[column.len() - 1]);
+    assert!(top[0] > 150 && top[1] > 150 && top[2] < 120, "the image's bright top row stays on top: {top:?}");
+    assert!(bottom[2] > bottom[1] && bottom[0] < 120, "{bottom:?}");
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -235,6 +235,11 @@ fn outputs_that_cannot_be_written_are_refused_before_any_work() {
     }
     let o = toposmooth(&["smooth", &fx, "-o", o_, "--isolines", "5"]);
     assert_eq!(o.status.code(), Some(2), "a series has no isolines: {}", text(&o));
+    let spot = dataset("spot.obj");
+    let (mesh_out, fig) = (dir.join("spot.ply").display().to_string(), dir.join("spot.png").display().to_string());
+    let o = toposmooth(&["smooth", &spot, "--array", "y", "-o", &mesh_out, "--plot", &fig, "--isolines", "5"]);
+    assert_eq!(o.status.code(), Some(2), "a mesh figure has no isolines: {}", text(&o));
+    assert!(text(&o).contains("isolines") && !text(&o).contains("seconds:"), "{}", text(&o));
     let o = toposmooth(&["bench", "--sizes", "1000000000000"]);
     assert_eq!(o.status.code(), Some(2), "{}", text(&o));
     let o = toposmooth(&["bench", "--sizes", "100000x100000"]);

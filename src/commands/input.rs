@@ -221,6 +221,12 @@ fn extension(path: &Path) -> String {
     path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase()
 }
 
+/// Whether a grid file is a raster image (PNG, TIFF): its row 0 is the image's top row, read
+/// with origin 0 and spacing 1, so y (the row index) grows downward as image viewers show it.
+pub fn is_raster(path: &Path) -> bool {
+    matches!(extension(path).as_str(), "png" | "tif" | "tiff")
+}
+
 /// Whether a file is read as a grid.
 pub fn is_grid_file(path: &Path, kind: DomainKind) -> Result<bool> {
     Ok(match kind {

@@ -5,6 +5,12 @@
 //! Cells are drawn as nearest-neighbour blocks: small grids are scaled up by an integer factor where
 //! the width budget allows it, large grids are sampled down so that the image stays under about
 //! 2000 × 2000 pixels.
+//!
+//! Each panel has axes in the file's coordinates (vertex (r, c) at origin + (c·dx, r·dy), spacing
+//! signs kept) and is oriented as ParaView shows the grid: larger x to the right and larger y at
+//! the top, whatever the signs of the spacing, so a grid with dy < 0 and the same grid stored
+//! with its rows reversed and dy > 0 give the same picture. Rasters (PNG, TIFF) can ask for y
+//! growing downward instead (see [`GridPlotOptions::y_down`]), so that they look as the image does.
 
 use super::{min_max, nice_range, render, tick_label, Area, PlotError, FONT, MAX_C, MIN_C};
 use plotters::coord::types::RangedCoordf64;
@@ -17,8 +23,8 @@ use std::error::Error;
 pub struct GridPanel<'a> {
     /// Title drawn above the panel.
     pub title: String,
-    /// `nx * ny` values in row-major order (index `r * nx + c`); row 0 is drawn at the top, NaN
-    /// as a neutral grey "missing" colour.
+    /// `nx * ny` values in row-major order (index `r * nx + c`), placed as
+    /// [`GridPlotOptions`] says; NaN is drawn as a neutral grey "missing" colour.
     pub values: &'a [f64],
 }
 
@@ -40,13 +46,92 @@ pub struct GridPlotOptions {
     /// True: a diverging blue–white–red colour map symmetric about 0 (e.g. for vorticity);
     /// false: the sequential, perceptually uniform viridis map over the values' range.
     pub diverging: bool,
-    /// Physical cell height over width, |dy| / |dx|, so that the picture is not distorted.
-    pub aspect: f64,
+    /// Coordinates (x, y) of vertex (row 0, column 0).
+    pub origin: [f64; 2],
+    /// Spacing (dx, dy), signs kept: vertex (r, c) lies at `origin + (c·dx, r·dy)`. The cells
+    /// are drawn |dy| / |dx| as tall as wide, so that the picture is not distorted.
+    pub spacing: [f64; 2],
+    /// False (ParaView's view): y grows upward, the vertex with the largest y at the top. True
+    /// (an image viewer's view, for rasters whose row 0 is the image's top row): y grows
+    /// downward, the smallest y at the top. Either way larger x is to the right.
+    pub y_down: bool,
 }
 
 impl Default for GridPlotOptions {
     fn default() -> Self {
-        GridPlotOptions { isolines: 0, diverging: false, aspect: 1.0 }
+        GridPlotOptions { isolines: 0, diverging: false, origin: [0.0, 0.0], spacing: [1.0, 1.0], y_down: false }
+    }
+}
+
+/// How grid vertices map to the picture: which grid column and row each drawn column and row
+/// shows, and the coordinates along the two axes.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) struct View {
+    nx: usize,
+    ny: usize,
+    /// Drawn column 0 (left) is grid column `nx − 1` rather than 0.
+    flip_cols: bool,
+    /// Drawn row 0 (top) is grid row `ny − 1` rather than 0.
+    flip_rows: bool,
+    /// x of the left drawn column and y of the top drawn row.
+    first: [f64; 2],
+    /// Change of x per drawn column (rightward) and of y per drawn row (downward).
+    step: [f64; 2],
+}
+
+impl View {
+    /// The view of an `nx × ny` grid with the options' origin, spacing and y direction.
+    pub(super) fn new(nx: usize, ny: usize, o: &GridPlotOptions) -> View {
+        let ([ox, oy], [dx, dy]) = (o.origin, o.spacing);
+        let flip_cols = dx < 0.0;
+        // the top row holds the largest y (y up) or the smallest (y down)
+        let flip_rows = (dy > 0.0) != o.y_down;
+        let end = |o: f64, d: f64, n: usize, flip: bool| if flip { o + (n - 1) as f64 * d } else { o };
+        let first = [end(ox, dx, nx, flip_cols), end(oy, dy, ny, flip_rows)];
+        let step = [dx.abs(), if o.y_down { dy.abs() } else { -dy.abs() }];
+        View { nx, ny, flip_cols, flip_rows, first, step }
+    }
+
+    /// Grid column shown in drawn column `d` (0 at the left).
+    fn col(&self, d: usize) -> usize {
+        if self.flip_cols {
+            self.nx - 1 - d
+        } else {
+            d
+        }
+    }
+
+    /// Grid row shown in drawn row `d` (0 at the top).
+    fn row(&self, d: usize) -> usize {
+        if self.flip_rows {
+            self.ny - 1 - d
+        } else {
+            d
+        }
+    }
+
+    /// Pixel position (within a panel of `size` pixels) of the centre of grid vertex `index`'s cell.
+    pub(super) fn centre(&self, (pw, ph): (u32, u32), index: usize) -> (f64, f64) {
+        // `col` and `row` are their own inverses
+        let (c, r) = (self.col(index % self.nx), self.row(index / self.nx));
+        ((c as f64 + 0.5) * pw as f64 / self.nx as f64, (r as f64 + 0.5) * ph as f64 / self.ny as f64)
+    }
+
+    /// The ranges `(lo, hi)` of x and of y over the vertices, in the file's coordinates.
+    pub(super) fn ranges(&self) -> [(f64, f64); 2] {
+        let range = |k: usize, n: usize| {
+            let last = self.first[k] + (n - 1) as f64 * self.step[k];
+            (self.first[k].min(last), self.first[k].max(last))
+        };
+        [range(0, self.nx), range(1, self.ny)]
+    }
+
+    /// Pixel offset, along axis `k` (0: x rightward, 1: y downward) of a panel `size` pixels
+    /// long, of the coordinate `v`: vertex centres land on their cells' centres.
+    pub(super) fn pixel(&self, k: usize, v: f64, size: u32) -> f64 {
+        let n = [self.nx, self.ny][k] as f64;
+        let d = if n > 1.0 { (v - self.first[k]) / self.step[k] } else { 0.0 };
+        (d + 0.5) * size as f64 / n
     }
 }
 
@@ -58,6 +143,10 @@ const ISOLINE: RGBColor = RGBColor(30, 30, 30);
 const MARGIN: u32 = 12;
 const TITLE_H: u32 = 44;
 const PANEL_TITLE_H: u32 = 30;
+/// Room left of each panel for the y axis's tick labels and name.
+const AXIS_W: u32 = 84;
+/// Room below each panel for the x axis's tick labels and name.
+const AXIS_H: u32 = 46;
 const GAP: u32 = 16;
 const BAR_GAP: u32 = 20;
 const BAR_W: u32 = 22;
@@ -87,14 +176,17 @@ struct Layout {
 
 impl Layout {
     /// Layout of `n` panels of an `nx × ny` grid with cells of height/width `aspect`: side by side
-    /// or stacked, whichever gives an overall shape closer to 0.6 tall per wide.
+    /// or stacked, whichever gives an overall shape closer to 0.6 tall per wide. Each panel has
+    /// room for its axes on its left and below it.
     fn new(nx: usize, ny: usize, n: usize, aspect: f64) -> Layout {
         let a = (ny as f64 * aspect / nx as f64).clamp(1e-6, 1e6); // panel height / width
         let shape = |r: f64| (r / 0.6).ln().abs();
         let stacked = n > 1 && shape(a * n as f64) < shape(a / n as f64);
         let (cols, rows) = if stacked { (1, n as u32) } else { (n as u32, 1) };
-        let w_budget = (MAX_W - 2 * MARGIN - BAR_GAP - BAR_W - BAR_LABELS).saturating_sub((cols - 1) * GAP) / cols;
-        let h_budget = (MAX_H - TITLE_H - MARGIN).saturating_sub(rows * PANEL_TITLE_H + (rows - 1) * GAP) / rows;
+        let w_budget =
+            (MAX_W - 2 * MARGIN - BAR_GAP - BAR_W - BAR_LABELS).saturating_sub((cols - 1) * GAP + cols * AXIS_W) / cols;
+        let h_budget =
+            (MAX_H - TITLE_H - MARGIN).saturating_sub(rows * (PANEL_TITLE_H + AXIS_H) + (rows - 1) * GAP) / rows;
         let (wb, hb) = (w_budget.max(MIN_SIDE) as f64, h_budget.max(MIN_SIDE) as f64);
         let (nxf, want) = (nx as f64, WANT_W.max(WANT_H / a));
         let mut pw = if nxf >= wb {
@@ -111,36 +203,31 @@ impl Layout {
         }
         let side = |v: f64, max: f64| v.round().clamp(MIN_SIDE as f64, max.max(MIN_SIDE as f64)) as u32;
         let panel = (side(pw, wb), side(ph, hb));
-        let w = 2 * MARGIN + cols * panel.0 + (cols - 1) * GAP + BAR_GAP + BAR_W + BAR_LABELS;
-        let h = TITLE_H + rows * (PANEL_TITLE_H + panel.1) + (rows - 1) * GAP + MARGIN;
+        let w = 2 * MARGIN + cols * (AXIS_W + panel.0) + (cols - 1) * GAP + BAR_GAP + BAR_W + BAR_LABELS;
+        let h = TITLE_H + rows * (PANEL_TITLE_H + panel.1 + AXIS_H) + (rows - 1) * GAP + MARGIN;
         Layout { size: (w, h), panel, stacked, n }
     }
 
     /// Top-left pixel of panel `k`'s heat map.
     fn origin(&self, k: usize) -> (i32, i32) {
         let (pw, ph, k) = (self.panel.0 as i32, self.panel.1 as i32, k as i32);
-        let top = (TITLE_H + PANEL_TITLE_H) as i32;
+        let (left, top) = ((MARGIN + AXIS_W) as i32, (TITLE_H + PANEL_TITLE_H) as i32);
         if self.stacked {
-            (MARGIN as i32, top + k * (ph + (PANEL_TITLE_H + GAP) as i32))
+            (left, top + k * (ph + (AXIS_H + PANEL_TITLE_H + GAP) as i32))
         } else {
-            (MARGIN as i32 + k * (pw + GAP as i32), top)
+            (left + k * (pw + (GAP + AXIS_W) as i32), top)
         }
     }
 
-    /// The colour bar's top-left pixel and size; shorter if room for the "missing" swatch is needed.
+    /// The colour bar's top-left pixel and size, level with the panels; shorter if room for the
+    /// "missing" swatch is needed.
     fn bar(&self, missing: bool) -> ((i32, i32), (u32, u32)) {
         let cols = if self.stacked { 1 } else { self.n as u32 };
-        let x = MARGIN + cols * self.panel.0 + (cols - 1) * GAP + BAR_GAP;
+        let x = MARGIN + cols * (AXIS_W + self.panel.0) + (cols - 1) * GAP + BAR_GAP;
         let y = TITLE_H + PANEL_TITLE_H;
-        let h = self.size.1 - MARGIN - y - if missing { SWATCH_H } else { 0 };
+        let h = self.size.1 - MARGIN - AXIS_H - y - if missing { SWATCH_H } else { 0 };
         ((x as i32, y as i32), (BAR_W, h.max(2)))
     }
-}
-
-/// Pixel position (within a panel of `size` pixels) of the centre of grid cell `index`.
-fn cell_centre(nx: usize, ny: usize, (pw, ph): (u32, u32), index: usize) -> (f64, f64) {
-    let (r, c) = (index / nx, index % nx);
-    ((c as f64 + 0.5) * pw as f64 / nx as f64, (r as f64 + 0.5) * ph as f64 / ny as f64)
 }
 
 /// Viridis at 0, 1/8, …, 1.
@@ -211,12 +298,15 @@ impl Scale {
     }
 }
 
-/// The heat map of `values` as an RGB buffer of `pw × ph` pixels, cells as nearest-neighbour blocks.
-fn heat_map(values: &[f64], nx: usize, ny: usize, (pw, ph): (u32, u32), scale: &Scale) -> Vec<u8> {
+/// The heat map of `values` as an RGB buffer of `pw × ph` pixels, cells as nearest-neighbour
+/// blocks, oriented by `view`.
+fn heat_map(values: &[f64], view: &View, (pw, ph): (u32, u32), scale: &Scale) -> Vec<u8> {
     let pick = |n: usize, size: u32| -> Vec<usize> {
         (0..size).map(|p| (((p as f64 + 0.5) * n as f64 / size as f64) as usize).min(n - 1)).collect()
     };
-    let (cols, rows) = (pick(nx, pw), pick(ny, ph));
+    let nx = view.nx;
+    let cols: Vec<usize> = pick(nx, pw).into_iter().map(|d| view.col(d)).collect();
+    let rows: Vec<usize> = pick(view.ny, ph).into_iter().map(|d| view.row(d)).collect();
     let mut buf = Vec::with_capacity(pw as usize * ph as usize * 3);
     for &r in &rows {
         for &c in &cols {
@@ -230,13 +320,9 @@ fn heat_map(values: &[f64], nx: usize, ny: usize, (pw, ph): (u32, u32), scale: &
 /// Contour segments, in panel pixels, of `values` at the sorted `levels`, by marching triangles
 /// over the cell centres (each square split along its diagonal). Triangles with a NaN or infinite
 /// corner are skipped. Grids larger than the panel are sampled with a stride of about one pixel.
-fn contour_segments(
-    values: &[f64],
-    nx: usize,
-    ny: usize,
-    size: (u32, u32),
-    levels: &[f64],
-) -> Vec<((f64, f64), (f64, f64))> {
+/// The segments are placed by `view`, so they lie over the heat map drawn with it.
+fn contour_segments(values: &[f64], view: &View, size: (u32, u32), levels: &[f64]) -> Vec<((f64, f64), (f64, f64))> {
+    let (nx, ny) = (view.nx, view.ny);
     let mut segs = Vec::new();
     if levels.is_empty() || nx < 2 || ny < 2 {
         return segs;
@@ -244,7 +330,7 @@ fn contour_segments(
     let stride = (nx as f64 / size.0 as f64).max(ny as f64 / size.1 as f64).ceil().max(1.0) as usize;
     let (cs, rs): (Vec<usize>, Vec<usize>) = ((0..nx).step_by(stride).collect(), (0..ny).step_by(stride).collect());
     let point = |r: usize, c: usize| {
-        let (x, y) = cell_centre(nx, ny, size, r * nx + c);
+        let (x, y) = view.centre(size, r * nx + c);
         (x, y, values[r * nx + c])
     };
     for rw in rs.windows(2) {
@@ -279,17 +365,18 @@ fn contour_segments(
 }
 
 /// Plots `panels` of an `nx × ny` grid as heat maps into a PNG written to `out`: side by side (stacked
-/// for wide grids), each with its title, under the overall `title`, with one colour scale shared by
-/// all panels' finite values and shown by a colour bar with tick labels on the right (plus a
-/// "missing" swatch if some value is NaN). NaN cells are grey; `markers` are drawn on every panel
-/// as dots (minima blue, maxima red, outlined in black and white); see [`GridPlotOptions`] for
-/// isolines, the colour map and the cell aspect.
+/// for wide grids), each with its title and its x and y axes in the grid's coordinates, under the
+/// overall `title`, with one colour scale shared by all panels' finite values and shown by a colour
+/// bar with tick labels on the right (plus a "missing" swatch if some value is NaN). NaN cells are
+/// grey; `markers` are drawn on every panel as dots (minima blue, maxima red, outlined in black
+/// and white); see [`GridPlotOptions`] for isolines, the colour map, the geometry and the
+/// orientation (by default larger y at the top, as ParaView draws it).
 ///
 /// Each panel is about 400 px wide or more (small grids scaled up by whole blocks), and the image
 /// stays within about 2000 × 2000 px (large grids sampled down). Constant fields, all-NaN panels
 /// and single finite values are drawn without error. Errors on an empty grid, no or too many (over
-/// 64) panels, a panel with other than `nx * ny` values, a non-positive or non-finite aspect, or a
-/// drawing/writing failure.
+/// 64) panels, a panel with other than `nx * ny` values, a zero or non-finite spacing, a
+/// non-finite origin or extent, or a drawing/writing failure.
 pub fn plot_grid_fields(
     out: &mut dyn std::io::Write,
     nx: usize,
@@ -307,10 +394,16 @@ pub fn plot_grid_fields(
     if let Some(p) = panels.iter().find(|p| p.values.len() != len) {
         return Err(fail(&format!("panel '{}' has {} values, expected {nx}x{ny}", p.title, p.values.len())));
     }
-    if !(options.aspect.is_finite() && options.aspect > 0.0) {
-        return Err(fail(&format!("cell aspect {} is not positive", options.aspect)));
+    let view = View::new(nx, ny, options);
+    let aspect = (options.spacing[1] / options.spacing[0]).abs();
+    let finite = |v: &f64| v.is_finite();
+    let extent_ok =
+        options.origin.iter().all(finite) && view.ranges().iter().all(|(lo, hi)| [lo, hi].iter().all(|v| finite(v)));
+    if !(aspect.is_finite() && aspect > 0.0 && extent_ok) {
+        let (o, d) = (options.origin, options.spacing);
+        return Err(fail(&format!("grid origin {o:?} and spacing {d:?} do not give finite, non-degenerate cells")));
     }
-    let layout = Layout::new(nx, ny, panels.len(), options.aspect);
+    let layout = Layout::new(nx, ny, panels.len(), aspect);
     let scale = Scale::new(panels, options.diverging);
     let n_lev = options.isolines;
     let levels: Vec<f64> =
@@ -325,12 +418,13 @@ pub fn plot_grid_fields(
             let (x0, y0) = layout.origin(k);
             let head = (x0 + pw as i32 / 2, y0 - PANEL_TITLE_H as i32 / 2);
             root.draw(&Text::new(panel.title.as_str(), head, centred(18.0)))?;
-            let buf = heat_map(panel.values, nx, ny, layout.panel, &scale);
+            let buf = heat_map(panel.values, &view, layout.panel, &scale);
             root.draw(&BitMapElement::with_owned_buffer((x0, y0), layout.panel, buf).ok_or("heat map buffer")?)?;
             root.draw(&Rectangle::new([(x0 - 1, y0 - 1), (x0 + pw as i32, y0 + ph as i32)], BLACK))?;
+            draw_axes(root, &view, (x0, y0), layout.panel)?;
             let at = |(x, y): (f64, f64)| (x0 + x.round() as i32, y0 + y.round() as i32);
             let line = ISOLINE.stroke_width(1);
-            for (a, b) in contour_segments(panel.values, nx, ny, layout.panel, &levels) {
+            for (a, b) in contour_segments(panel.values, &view, layout.panel, &levels) {
                 // left end first: the bitmap backend's fast path draws nothing for a horizontal
                 // 1-px line given right to left
                 let (a, b) = (at(a), at(b));
@@ -338,7 +432,7 @@ pub fn plot_grid_fields(
             }
             let r = if dots.len() > 200 { 3 } else { 5 };
             for m in &dots {
-                let c = at(cell_centre(nx, ny, layout.panel, m.index));
+                let c = at(view.centre(layout.panel, m.index));
                 let colour = if m.is_max { MAX_C } else { MIN_C };
                 root.draw(&Circle::new(c, r + 2, BLACK.filled()))?;
                 root.draw(&Circle::new(c, r + 1, WHITE.filled()))?;
@@ -347,6 +441,49 @@ pub fn plot_grid_fields(
         }
         draw_colour_bar(root, &layout, &scale, missing)
     })
+}
+
+/// Tick values for an axis over `lo..=hi`: about `max` round values, or the single value of a
+/// degenerate range.
+fn axis_ticks(lo: f64, hi: f64, max: usize) -> Vec<f64> {
+    if hi > lo {
+        let axis: RangedCoordf64 = (lo..hi).into();
+        axis.key_points(max.max(2))
+    } else {
+        vec![lo]
+    }
+}
+
+/// The ticks of axis `k` (0: x along the panel's width, 1: y along its height) of a panel of
+/// `size` pixels: each tick's pixel offset from the panel's left or top edge and its label, a
+/// coordinate of the grid placed by `view`.
+fn axis_marks(view: &View, k: usize, size: (u32, u32)) -> Vec<(i32, String)> {
+    let (lo, hi) = view.ranges()[k];
+    let (len, per_tick) = if k == 0 { (size.0, 90) } else { (size.1, 60) };
+    axis_ticks(lo, hi, (len as usize / per_tick).clamp(2, 10))
+        .into_iter()
+        .map(|v| (view.pixel(k, v, len).round() as i32, tick_label(v, hi - lo)))
+        .collect()
+}
+
+/// Draws the x axis below and the y axis left of the panel whose heat map's top-left pixel is
+/// `(x0, y0)` and size `(pw, ph)`: ticks and labels from [`axis_marks`], and the axis names.
+fn draw_axes(root: &Area<'_>, view: &View, (x0, y0): (i32, i32), (pw, ph): (u32, u32)) -> Result<(), Box<dyn Error>> {
+    let style = |h: HPos, v: VPos| TextStyle::from((FONT, 14.0).into_font()).pos(Pos::new(h, v));
+    let (bottom, left) = (y0 + ph as i32, x0 - 1);
+    for (x, label) in axis_marks(view, 0, (pw, ph)) {
+        root.draw(&PathElement::new(vec![(x0 + x, bottom), (x0 + x, bottom + 5)], BLACK))?;
+        root.draw(&Text::new(label, (x0 + x, bottom + 7), style(HPos::Center, VPos::Top)))?;
+    }
+    let name = (x0 + pw as i32 / 2, bottom + AXIS_H as i32 - 4);
+    root.draw(&Text::new("x", name, style(HPos::Center, VPos::Bottom)))?;
+    for (y, label) in axis_marks(view, 1, (pw, ph)) {
+        root.draw(&PathElement::new(vec![(left - 5, y0 + y), (left, y0 + y)], BLACK))?;
+        root.draw(&Text::new(label, (left - 7, y0 + y), style(HPos::Right, VPos::Center)))?;
+    }
+    let name = (x0 - AXIS_W as i32 + 2, y0 + ph as i32 / 2);
+    root.draw(&Text::new("y", name, style(HPos::Left, VPos::Center)))?;
+    Ok(())
 }
 
 /// Draws the colour bar (high values at the top) with ticks and labels, and the "missing" swatch.

@@ -61,6 +61,9 @@ const GREY: RGBColor = RGBColor(90, 90, 90);
 const ORANGE: RGBColor = RGBColor(255, 140, 0);
 const MIN_C: RGBColor = RGBColor(20, 70, 220);
 const MAX_C: RGBColor = RGBColor(210, 20, 20);
+/// Cancelled pairs in a persistence diagram: a light grey, so that a dense band of them stays
+/// background.
+const CANCELLED_C: RGBColor = RGBColor(175, 175, 175);
 
 /// Registers DejaVu Sans as "sans-serif" once; plotters' `ab_glyph` text needs it.
 fn ensure_font() -> Result<(), PlotError> {
@@ -327,6 +330,8 @@ enum Mark {
     Dot(ShapeStyle, u32),
     Tri(ShapeStyle, u32),
     Dash(ShapeStyle),
+    /// An × of this half-size.
+    Cross(ShapeStyle, u32),
 }
 
 /// Draws legend entries in a row starting at x = `row` (centred vertically), or in a column.
@@ -349,6 +354,7 @@ fn draw_legend<S: AsRef<str>>(
             Mark::Dot(st, r) => area.draw(&Circle::new((c, y), *r, *st))?,
             Mark::Tri(st, r) => area.draw(&TriangleMarker::new((c, y), *r, *st))?,
             Mark::Dash(st) => area.draw(&DashedPathElement::new([(x, y), (x + w, y)], px(6.0), px(4.0), *st))?,
+            Mark::Cross(st, r) => area.draw(&Cross::new((c, y), *r, *st))?,
         }
         area.draw(&Text::new(label.as_ref(), (x + px(35.0), y), text.clone()))?;
         match row {
@@ -359,11 +365,68 @@ fn draw_legend<S: AsRef<str>>(
     Ok(())
 }
 
-/// Plots a persistence diagram: minima pairs blue, maxima pairs red, kept ones filled and larger,
-/// cancelled ones hollow and smaller, the diagonal in grey and, for `Some(t)`, dashed lines at
-/// |death − birth| = t. Essential points (infinite death) are drawn as triangles at the top edge
-/// (bottom edge for −∞), 5% of the range beyond the finite values. The legend sits on the right.
-/// Points with a non-finite birth or NaN death are skipped; an empty diagram is still drawn.
+/// How a persistence pair is drawn: kept pairs as large filled dots (minima blue, maxima red)
+/// outlined in black, cancelled ones as small thin light-grey crosses whatever their kind, so
+/// that a dense band of cancelled pairs cannot pass for kept ones.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct PairLook {
+    colour: RGBColor,
+    /// Radius of a dot, half-size of a cross, in pixels.
+    size: u32,
+    /// A filled dot (kept) rather than a cross (cancelled).
+    dot: bool,
+    /// Line width of a cross.
+    stroke: u32,
+}
+
+/// The look of a kept or cancelled pair of a maximum (`is_max`) or minimum, at font scale `s`.
+fn pair_look(kept: bool, is_max: bool, s: f64) -> PairLook {
+    let px = |v: f64| ((v * s).round() as u32).max(1);
+    match (kept, is_max) {
+        (true, true) => PairLook { colour: MAX_C, size: px(6.0), dot: true, stroke: px(1.0) },
+        (true, false) => PairLook { colour: MIN_C, size: px(6.0), dot: true, stroke: px(1.0) },
+        (false, _) => PairLook { colour: CANCELLED_C, size: px(3.0), dot: false, stroke: 1 },
+    }
+}
+
+/// `n` with commas between groups of three digits: 1128 → "1,128".
+fn thousands(n: usize) -> String {
+    let digits = n.to_string();
+    let mut out = String::new();
+    for (i, ch) in digits.chars().enumerate() {
+        if i > 0 && (digits.len() - i).is_multiple_of(3) {
+            out.push(',');
+        }
+        out.push(ch);
+    }
+    out
+}
+
+/// The legend's counts of the pairs drawn: kept minima and kept maxima (each when the diagram
+/// has pairs of that kind), then cancelled pairs (when there are any).
+fn diagram_counts(points: &[&DiagramPoint]) -> Vec<(PairLook, String)> {
+    let count = |f: &dyn Fn(&DiagramPoint) -> bool| points.iter().filter(|p| f(p)).count();
+    let mut out = Vec::new();
+    for (is_max, name) in [(false, "minima"), (true, "maxima")] {
+        if count(&|p| p.is_max == is_max) > 0 {
+            let kept = count(&|p| p.is_max == is_max && p.kept);
+            out.push((pair_look(true, is_max, 1.0), format!("kept: {} {name}", thousands(kept))));
+        }
+    }
+    let cancelled = count(&|p| !p.kept);
+    if cancelled > 0 {
+        out.push((pair_look(false, false, 1.0), format!("cancelled: {}", thousands(cancelled))));
+    }
+    out
+}
+
+/// Plots a persistence diagram: kept pairs as large filled dots (minima blue, maxima red) drawn
+/// over the cancelled ones, which are small thin light-grey crosses (see [`PairLook`]); the
+/// diagonal in grey and, for `Some(t)`, dashed lines at |death − birth| = t. Essential points
+/// (infinite death) are drawn as triangles at the top edge (bottom edge for −∞), 5% of the range
+/// beyond the finite values. The legend on the right gives the counts ("kept: 6 minima",
+/// "kept: 6 maxima", "cancelled: 1,128"). Points with a non-finite birth or NaN death are
+/// skipped; an empty diagram is still drawn.
 pub fn plot_persistence_diagram(
     out: &mut dyn std::io::Write,
     points: &[DiagramPoint],
@@ -409,25 +472,32 @@ pub fn plot_persistence_diagram(
             chart.draw_series(DashedLineSeries::new([(a, y), (b, y)], px(2.0), px(5.0), GREY.stroke_width(1)))?;
             legend.push((Mark::Tri(BLACK.stroke_width(px(1.5)), px(7.0)), "essential (death = ∞)".into()));
         }
-        for (is_max, kept) in [(false, true), (false, false), (true, true), (true, false)] {
-            let sel: Vec<&DiagramPoint> =
-                pts.iter().copied().filter(|p| p.is_max == is_max && p.kept == kept).collect();
-            if sel.is_empty() {
-                continue;
+        // cancelled pairs first, so that every kept pair is drawn over them
+        for (kept, is_max) in [(false, false), (false, true), (true, false), (true, true)] {
+            let look = pair_look(kept, is_max, s);
+            let sel = pts.iter().filter(|p| p.is_max == is_max && p.kept == kept);
+            let (fin, ess): (Vec<&&DiagramPoint>, Vec<_>) = sel.partition(|p| ok(p.death));
+            let at = |p: &DiagramPoint| (p.birth, level(p.death));
+            if look.dot {
+                let (fill, edge) = (look.colour.filled(), BLACK.filled());
+                chart.draw_series(fin.iter().map(|p| Circle::new(at(p), look.size + px(1.0).max(1), edge)))?;
+                chart.draw_series(fin.iter().map(|p| Circle::new(at(p), look.size, fill)))?;
+                let tri = look.size + px(2.0);
+                chart.draw_series(ess.iter().map(|p| TriangleMarker::new(at(p), tri + px(1.0).max(1), edge)))?;
+                chart.draw_series(ess.iter().map(|p| TriangleMarker::new(at(p), tri, fill)))?;
+            } else {
+                let line = look.colour.stroke_width(look.stroke);
+                chart.draw_series(fin.iter().chain(&ess).map(|p| Cross::new(at(p), look.size, line)))?;
             }
-            let colour = if is_max { MAX_C } else { MIN_C };
-            let (style, rad) = if kept { (colour.filled(), px(5.0)) } else { (colour.stroke_width(px(1.5)), px(3.5)) };
-            let (fin, ess): (Vec<&DiagramPoint>, Vec<_>) = sel.into_iter().partition(|p| ok(p.death));
-            chart.draw_series(fin.iter().map(|p| Circle::new((p.birth, p.death), rad, style)))?;
-            chart.draw_series(
-                ess.iter().map(|p| TriangleMarker::new((p.birth, level(p.death)), rad + px(2.0), style)),
-            )?;
-            let name = format!(
-                "{} {} pair",
-                if kept { "kept" } else { "cancelled" },
-                if is_max { "maximum" } else { "minimum" }
-            );
-            legend.push((Mark::Dot(style, rad), name));
+        }
+        for (look, label) in diagram_counts(&pts) {
+            let size = ((look.size as f64 * s).round() as u32).max(1);
+            let mark = if look.dot {
+                Mark::Dot(look.colour.filled(), size)
+            } else {
+                Mark::Cross(look.colour.stroke_width(look.stroke), size)
+            };
+            legend.push((mark, label));
         }
         draw_legend(&panel, &legend, s, None)
     })
@@ -517,6 +587,58 @@ mod tests {
             plot_persistence_diagram(&mut std::fs::File::create(&path).unwrap(), pts, t, name, (700, 600)).unwrap();
             check_png(&path, (700, 600));
         }
+    }
+
+    /// A band of `n` cancelled minima pairs just above the diagonal, 3 kept minima well above it
+    /// and 2 kept maxima below it.
+    fn banded(n: usize) -> Vec<DiagramPoint> {
+        let pt = |birth, death, is_max, kept| DiagramPoint { birth, death, is_max, kept };
+        let mut pts: Vec<DiagramPoint> = (0..n)
+            .map(|i| {
+                let t = i as f64 / n as f64;
+                pt(t, t + 0.01 + 0.01 * (i as f64 * 7.3).sin().abs(), false, false)
+            })
+            .collect();
+        pts.extend([pt(0.1, 0.9, false, true), pt(0.2, 0.7, false, true), pt(0.0, 0.5, false, true)]);
+        pts.extend([pt(0.9, 0.1, true, true), pt(0.8, 0.3, true, true)]);
+        pts
+    }
+
+    #[test]
+    fn cancelled_pairs_are_small_grey_crosses_and_kept_ones_large_dots() {
+        let (kept, cancelled) = (pair_look(true, false, 1.0), pair_look(false, false, 1.0));
+        assert_eq!(pair_look(false, true, 1.0), cancelled, "cancelled pairs look alike whatever their kind");
+        assert!(kept.dot && kept.colour == MIN_C && pair_look(true, true, 1.0).colour == MAX_C);
+        assert!(!cancelled.dot && cancelled.stroke == 1 && 2 * cancelled.size <= kept.size);
+        let RGBColor(r, g, b) = cancelled.colour;
+        assert!(r == g && g == b && r > 150, "light grey: {:?}", cancelled.colour);
+
+        // drawn: the band of 1,000 cancelled pairs adds light grey, not blue
+        let mut png = Vec::new();
+        plot_persistence_diagram(&mut png, &banded(1000), Some(0.3), "band", (900, 800)).unwrap();
+        let img = image::load_from_memory(&png).unwrap().to_rgb8();
+        let blue = img.pixels().filter(|p| p[2] > 150 && p[0] < 90 && p[1] < 120).count();
+        let red = img.pixels().filter(|p| p[0] > 150 && p[1] < 90 && p[2] < 90).count();
+        let light = img.pixels().filter(|p| p[0] == p[1] && p[1] == p[2] && (160..=190).contains(&p[0])).count();
+        // 3 kept dots and the legend's of radius 6: about 4 · 113 px
+        assert!(blue > 300 && blue < 700, "blue pixels: {blue}");
+        assert!(red > 200 && red < 500, "red pixels: {red}");
+        assert!(light > 1000, "light grey pixels: {light}");
+    }
+
+    #[test]
+    fn the_legend_counts_kept_and_cancelled_pairs() {
+        let pts = banded(1128);
+        let refs: Vec<&DiagramPoint> = pts.iter().collect();
+        let labels: Vec<String> = diagram_counts(&refs).into_iter().map(|(_, l)| l).collect();
+        assert_eq!(labels, ["kept: 3 minima", "kept: 2 maxima", "cancelled: 1,128"]);
+        let only_kept_minima: Vec<String> = diagram_counts(&refs[1128..1131]).into_iter().map(|(_, l)| l).collect();
+        assert_eq!(only_kept_minima, ["kept: 3 minima"], "no maxima, none cancelled");
+        assert!(diagram_counts(&[]).is_empty());
+        assert_eq!(
+            [thousands(0), thousands(999), thousands(1000), thousands(1234567)],
+            ["0", "999", "1,000", "1,234,567"]
+        );
     }
 
     #[test]

@@ -379,6 +379,18 @@ fn check_geometry(path: &Path, points: &[[f64; 3]], cells: &Cells) -> Result<()>
     Ok(())
 }
 
+/// Checks the points, the cells' corners and the arrays' lengths of a mesh output.
+fn check_mesh(
+    path: &Path,
+    points: &[[f64; 3]],
+    cells: &Cells,
+    (point, cell): (&[OutArray], &[OutArray]),
+) -> Result<()> {
+    check_geometry(path, points, cells)?;
+    check_section(path, "point", point, points.len())?;
+    check_section(path, "cell", cell, cells.len())
+}
+
 /// Stages a `.vtu` unstructured grid of any cells with point and cell arrays of any type
 /// (`arrays`: point, cell); `active` names the active point scalars.
 ///
@@ -392,9 +404,7 @@ pub fn stage_vtu_cells(
     active: Option<&str>,
 ) -> Result<Staged> {
     let n = points.len();
-    check_geometry(path, points, cells)?;
-    check_section(path, "point", point, n)?;
-    check_section(path, "cell", cell_arrays, cells.len())?;
+    check_mesh(path, points, cells, (point, cell_arrays))?;
     let coords: Vec<f64> = points.iter().flatten().copied().collect();
     stage(path, |w| {
         writeln!(w, "{XML_HEAD}")?;
@@ -429,9 +439,7 @@ pub fn stage_vtp_cells(
     active: Option<&str>,
 ) -> Result<Staged> {
     let n = points.len();
-    check_geometry(path, points, cells)?;
-    check_section(path, "point", point, n)?;
-    check_section(path, "cell", cell_arrays, cells.len())?;
+    check_mesh(path, points, cells, (point, cell_arrays))?;
     let section = |t: u8| match t {
         cell::VERTEX | cell::POLY_VERTEX => Some(0),
         cell::LINE | cell::POLY_LINE => Some(1),

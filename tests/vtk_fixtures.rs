@@ -368,7 +368,10 @@ fn thresholding_the_ttk_diagram_selects_exactly_the_kept_pairs() {
         ["threshold"]
         .as_f64()
         .unwrap();
-    let roles = array(&read_dataset(&out).unwrap().point_data, "role").values.clone();
+    let smoothed = read_dataset(&out).unwrap();
+    // a CSV grid names no array: the smoothed field is the active scalars as `smoothed`
+    assert_eq!(smoothed.active_scalars.as_deref(), Some("smoothed"));
+    let roles = array(&smoothed.point_data, "role").values.clone();
     let kept: std::collections::BTreeSet<usize> = (0..roles.len()).filter(|&v| roles[v].abs() == 1.0).collect();
     assert!(kept.len() >= 2, "{kept:?}");
 

@@ -130,8 +130,7 @@ const OWN_ARRAYS: [&str; 5] = ["input", "smoothed", "representative", "role", "f
 /// The point arrays of a VTK output: the smoothed field under the input array's name (or
 /// `output_array`) first, as the active scalars, then `smoothed`, `input`, `representative`,
 /// `role` (and `filled`), then every other input array unchanged, renamed `<name>_input` where
-/// its name is taken. Returns each array's name and where its values come from; the first is
-/// the active scalars.
+/// its name is taken. Returns each array's name and where its values come from.
 fn vtk_point_plan(
     own: &[(&str, &[f64])],
     carried: Option<&Carried>,
@@ -156,6 +155,12 @@ fn vtk_point_plan(
         plan.push((name, Source::Carried(k)));
     }
     plan
+}
+
+/// The active scalars of a planned output: the smoothed field, under the input array's name
+/// when it has one, else `smoothed`.
+fn active_of(plan: &[(String, Source)]) -> &str {
+    plan.iter().find(|(_, s)| *s == Source::Smoothed).map_or("smoothed", |(n, _)| n.as_str())
 }
 
 /// Where a planned output array's values come from.
@@ -247,10 +252,10 @@ pub fn stage_results(
                 let cells: Vec<OutArray> = carried_cells(r.carried);
                 let (nx, ny, spacing, origin) = (g.nx(), g.ny(), g.spacing(), g.origin());
                 if e == "vti" {
-                    stage_vti_arrays(path, (nx, ny, spacing, origin), &point, &cells, Some(&plan[0].0))
+                    stage_vti_arrays(path, (nx, ny, spacing, origin), &point, &cells, Some(active_of(&plan)))
                 } else {
                     let geometry = LegacyGeometry::Image { nx, ny, spacing, origin };
-                    stage_legacy(path, &geometry, (&point, &cells), Some(&plan[0].0))
+                    stage_legacy(path, &geometry, (&point, &cells), Some(active_of(&plan)))
                 }
             }
             "npz" => stage_npz(path, g.ny(), g.nx(), &arrays),
@@ -269,7 +274,7 @@ pub fn stage_results(
                         (&triangles, Vec::new())
                     }
                 };
-                let active = Some(plan[0].0.as_str());
+                let active = Some(active_of(&plan));
                 match e {
                     "vtu" => stage_vtu_cells(path, m.positions(), cells, (&point, &cell_arrays), active),
                     "vtp" => stage_vtp_cells(path, m.positions(), cells, (&point, &cell_arrays), active),

@@ -148,6 +148,10 @@ karman = os.path.join(DATASETS, "karman_vortex_street_ttk_example1.vti")
 out, cx = os.path.join(WORK, "karman.vti"), os.path.join(WORK, "karman_complex.vtp")
 if run("smooth", karman, "--derive", "vorticity", "--persistence", "5%", "-o", out, "--complex", cx):
     check_opens(out, ["smoothed", "input", "representative", "role", "Vectors_"])
+    # a derived field has no input array's name: `smoothed` is the active scalars
+    k, _ = read(out)
+    if k.GetPointData().GetScalars() is None or k.GetPointData().GetScalars().GetName() != "smoothed":
+        fail(out, "the active scalars are not `smoothed`")
     check_opens(cx, ["input"])
 bunny = os.path.join(DATASETS, "bunny.obj")
 geo = os.path.join(WORK, "bunny_geodesic.vtu")

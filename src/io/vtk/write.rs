@@ -101,9 +101,10 @@ fn check_section(path: &Path, what: &str, arrays: &[OutArray], tuples: usize) ->
             return Err(input(
                 path,
                 format!(
-                    "{what} array `{}` has {} values for {tuples} tuples of {} components",
+                    "{what} array `{}` has {} values for {tuples} {}s of {} components",
                     a.name,
                     a.values.len(),
+                    if what == "cell" { "cell" } else { "point" },
                     a.components
                 ),
             ));
@@ -124,6 +125,11 @@ fn write_section(w: &mut dyn Write, tag: &str, arrays: &[OutArray], active: Opti
         write_array(w, "        ", a.ty.xml_name(), a.name, a.components, &raw)?;
     }
     writeln!(w, "      </{tag}>")
+}
+
+/// Owned Float64 scalar arrays to write.
+fn float64_of(arrays: &[(String, Vec<f64>)]) -> Vec<OutArray<'_>> {
+    arrays.iter().map(|(n, v)| OutArray::float64(n, v)).collect()
 }
 
 /// Float64 scalar arrays, the first of them the active scalars.
@@ -246,96 +252,27 @@ pub struct PolyData {
 /// Input errors naming the file: a cell referring to a missing point, an empty line, an
 /// array of the wrong length, duplicate array names, a non-finite coordinate. I/O errors.
 pub fn stage_vtp(path: &Path, poly: &PolyData) -> Result<Staged> {
-    let n = poly.points.len();
-    if let Some(i) = poly.points.iter().position(|p| p.iter().any(|c| !c.is_finite())) {
-        return Err(input(path, format!("point {i} has a non-finite coordinate {:?}", poly.points[i])));
+    if let Some(k) = poly.lines.iter().position(Vec::is_empty) {
+        return Err(input(path, format!("line {k} has no points")));
     }
-    if let Some(&v) = poly.verts.iter().find(|&&v| v >= n) {
-        return Err(input(path, format!("a vertex cell refers to point {v}, but there are {n} points")));
+    let mut cells = Cells::default();
+    let mut push = |corners: &[usize], ty: u8| {
+        cells.connectivity.extend_from_slice(corners);
+        cells.offsets.push(cells.connectivity.len());
+        cells.types.push(ty);
+    };
+    for &v in &poly.verts {
+        push(&[v], cell::VERTEX);
     }
-    for (k, line) in poly.lines.iter().enumerate() {
-        if line.is_empty() {
-            return Err(input(path, format!("line {k} has no points")));
-        }
-        if let Some(&v) = line.iter().find(|&&v| v >= n) {
-            return Err(input(path, format!("line {k} refers to point {v}, but there are {n} points")));
-        }
+    for line in &poly.lines {
+        push(line, if line.len() == 2 { cell::LINE } else { cell::POLY_LINE });
     }
-    if let Some((k, t)) = poly.polys.iter().enumerate().find(|(_, t)| t.iter().any(|&v| v >= n)) {
-        return Err(input(path, format!("triangle {k} = {t:?} refers to a missing point (there are {n} points)")));
+    for t in &poly.polys {
+        push(t, cell::TRIANGLE);
     }
-    let cells = poly.verts.len() + poly.lines.len() + poly.polys.len();
-    let mut seen = Vec::new();
-    for (name, values) in &poly.point_arrays {
-        check_name(path, name, &mut seen)?;
-        if values.len() != n {
-            return Err(input(path, format!("point array `{name}` has {} values for {n} points", values.len())));
-        }
-    }
-    let mut seen = Vec::new();
-    for (name, values) in &poly.cell_arrays {
-        check_name(path, name, &mut seen)?;
-        if values.len() != cells {
-            return Err(input(
-                path,
-                format!(
-                    "cell array `{name}` has {} values for {cells} cells ({} vertices + {} lines + {} triangles)",
-                    values.len(),
-                    poly.verts.len(),
-                    poly.lines.len(),
-                    poly.polys.len()
-                ),
-            ));
-        }
-    }
-    let coords: Vec<f64> = poly.points.iter().flatten().copied().collect();
-    let vert_offsets: Vec<usize> = (1..=poly.verts.len()).collect();
-    let line_conn: Vec<usize> = poly.lines.concat();
-    let line_offsets: Vec<usize> = poly
-        .lines
-        .iter()
-        .scan(0, |acc, l| {
-            *acc += l.len();
-            Some(*acc)
-        })
-        .collect();
-    stage(path, |w| {
-        writeln!(w, "{XML_HEAD}")?;
-        writeln!(w, "{}", file_open("PolyData"))?;
-        writeln!(w, "  <PolyData>")?;
-        writeln!(
-            w,
-            "    <Piece NumberOfPoints=\"{n}\" NumberOfVerts=\"{}\" NumberOfLines=\"{}\" NumberOfStrips=\"0\" NumberOfPolys=\"{}\">",
-            poly.verts.len(),
-            poly.lines.len(),
-            poly.polys.len()
-        )?;
-        for (tag, arrays) in [("PointData", &poly.point_arrays), ("CellData", &poly.cell_arrays)] {
-            let arrays: Vec<(&str, &[f64])> = arrays.iter().map(|(n, v)| (n.as_str(), v.as_slice())).collect();
-            let (arrays, active) = float64_arrays(&arrays);
-            write_section(w, tag, &arrays, active)?;
-        }
-        write_points(w, &coords)?;
-        // empty cell lists are left out (VTK reads that as none; vtkio fails on empty arrays)
-        let poly_conn: Vec<usize> = poly.polys.iter().flatten().copied().collect();
-        let poly_offsets: Vec<usize> = (1..=poly.polys.len()).map(|k| 3 * k).collect();
-        for (tag, conn, offsets) in [
-            ("Verts", &poly.verts, &vert_offsets),
-            ("Lines", &line_conn, &line_offsets),
-            ("Polys", &poly_conn, &poly_offsets),
-        ] {
-            if conn.is_empty() {
-                continue;
-            }
-            writeln!(w, "      <{tag}>")?;
-            write_array(w, "        ", "Int64", "connectivity", 1, &i64_bytes(conn))?;
-            write_array(w, "        ", "Int64", "offsets", 1, &i64_bytes(offsets))?;
-            writeln!(w, "      </{tag}>")?;
-        }
-        writeln!(w, "    </Piece>")?;
-        writeln!(w, "  </PolyData>")?;
-        writeln!(w, "</VTKFile>")
-    })
+    let (point, cell_arrays) = (float64_of(&poly.point_arrays), float64_of(&poly.cell_arrays));
+    let active = point.first().map(|a| a.name);
+    stage_vtp_cells(path, &poly.points, &cells, (&point, &cell_arrays), active)
 }
 
 /// Stages a `.vtu` unstructured grid of triangles (VTK_TRIANGLE cells) with one Float64
@@ -370,11 +307,13 @@ fn check_geometry(path: &Path, points: &[[f64; 3]], cells: &Cells) -> Result<()>
     if let Some(i) = points.iter().position(|p| p.iter().any(|c| !c.is_finite())) {
         return Err(input(path, format!("point {i} has a non-finite coordinate {:?}", points[i])));
     }
-    if let Some(c) = (0..cells.len()).find(|&c| cells.corners(c).iter().any(|&v| v >= n)) {
-        return Err(input(
-            path,
-            format!("cell {c} = {:?} refers to a missing point (there are {n} points)", cells.corners(c)),
-        ));
+    for c in 0..cells.len() {
+        if let Some(&v) = cells.corners(c).iter().find(|&&v| v >= n) {
+            return Err(input(
+                path,
+                format!("cell {c} = {:?} refers to point {v}, but there are {n} points", cells.corners(c)),
+            ));
+        }
     }
     Ok(())
 }

@@ -355,6 +355,43 @@ pub fn check_written(staged: &Staged, domain: &AnyDomain, r: &Results) -> Result
 /// # Errors
 /// Usage errors for another extension; I/O errors naming the file.
 pub fn stage_mesh(path: &Path, mesh: &TriMesh, arrays: &[(&str, &[f64])]) -> Result<Staged> {
+    let staged = stage_mesh_unchecked(path, mesh, arrays)?;
+    check_mesh_written(&staged, mesh, arrays)?;
+    Ok(staged)
+}
+
+/// Certificate item 5 for the mesh outputs of every command (weights, geodesic distance,
+/// colours, deformations): the staged file, read back with its format's reader, holds the
+/// positions, as many triangles and every array bit for bit.
+///
+/// # Errors
+/// [`Error::Uncertified`] naming the target and what reads back differently.
+fn check_mesh_written(staged: &Staged, mesh: &TriMesh, arrays: &[(&str, &[f64])]) -> Result<()> {
+    let target = staged.target();
+    let fail = |what: String| Error::Uncertified {
+        path: Some(target.to_path_buf()),
+        message: format!("certificate item 5: the file as written reads back with {what}"),
+    };
+    let data = super::mesh::read_mesh(staged.temp_path()).map_err(|e| fail(format!("an error: {e}")))?;
+    let bits = |p: &[[f64; 3]]| p.iter().flatten().map(|v| v.to_bits()).collect::<Vec<u64>>();
+    if bits(&data.positions) != bits(mesh.positions()) {
+        return Err(fail("other vertex positions".into()));
+    }
+    if data.triangles.len() != mesh.faces().len() {
+        return Err(fail(format!("{} triangles instead of {}", data.triangles.len(), mesh.faces().len())));
+    }
+    for (name, values) in arrays {
+        let read = data.arrays.iter().find(|a| a.name == *name).ok_or_else(|| fail(format!("no array `{name}`")))?;
+        let same = read.values.len() == values.len()
+            && read.values.iter().zip(*values).all(|(a, b)| a.to_bits() == b.to_bits());
+        if !same {
+            return Err(fail(format!("other values in `{name}`")));
+        }
+    }
+    Ok(())
+}
+
+fn stage_mesh_unchecked(path: &Path, mesh: &TriMesh, arrays: &[(&str, &[f64])]) -> Result<Staged> {
     match extension(path).as_str() {
         "vtu" => super::vtk::stage_vtu(path, mesh.positions(), mesh.faces(), arrays),
         "vtp" => stage_vtp(
@@ -610,6 +647,32 @@ mod tests {
         assert!(check_complex_output(Path::new("c.vtp"), &series).is_err());
         assert!(check_complex_output(Path::new("c.vtp"), &grid).is_ok());
         assert!(check_complex_output(Path::new("c.vtu"), &grid).is_err());
+    }
+
+    #[test]
+    fn a_mesh_output_that_reads_back_otherwise_is_refused() {
+        let mesh = TriMesh::new(
+            vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.0]],
+            vec![[0, 1, 2], [0, 2, 3]],
+        )
+        .unwrap();
+        let dir = std::env::temp_dir().join(format!("toposmooth-readback-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let d = [0.0, 1.0, 2.0, 0.1 + 0.2];
+        for ext in ["vtu", "vtp", "ply", "vtk"] {
+            let path = dir.join(format!("m.{ext}"));
+            let staged = stage_mesh(&path, &mesh, &[("distance", &d)]).unwrap();
+            // the same file, its array one ulp off: the check reads the bits, not a rounding
+            let off = [0.0, 1.0, 2.0, (0.1 + 0.2f64).next_up()];
+            let other = stage_mesh_unchecked(&dir.join(format!("o.{ext}")), &mesh, &[("distance", &off)]).unwrap();
+            std::fs::copy(other.temp_path(), staged.temp_path()).unwrap();
+            let e = check_mesh_written(&staged, &mesh, &[("distance", &d)]).unwrap_err().to_string();
+            assert!(
+                e.contains("certificate item 5") && e.contains("`distance`") && e.contains(&format!("m.{ext}")),
+                "{e}"
+            );
+        }
+        let _ = std::fs::remove_dir_all(&dir);
     }
 
     #[test]

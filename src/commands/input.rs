@@ -567,13 +567,10 @@ pub fn read_grid(path: &Path, opts: &GridOptions) -> Result<GridInput> {
             let v: Vec<f64> = a.2.iter().skip(1).step_by(a.1).copied().collect();
             let grid = with_spacing(path, &raw.grid, opts.spacing)?;
             let values = derive(&grid, d, &u, &v);
-            carried = raw.carried.clone();
-            (
-                grid,
-                values,
-                format!("{} of {}", if d == Derive::Vorticity { "vorticity" } else { "magnitude" }, a.0),
-                path.to_path_buf(),
-            )
+            let description = format!("{} of {}", if d == Derive::Vorticity { "vorticity" } else { "magnitude" }, a.0);
+            // the file's arrays move into the output's carried arrays, not copied
+            carried = raw.carried;
+            (grid, values, description, path.to_path_buf())
         }
         (None, None) => {
             let raw = read_raw(path, opts.array.as_deref())?;
@@ -586,8 +583,9 @@ pub fn read_grid(path: &Path, opts: &GridOptions) -> Result<GridInput> {
                 .in_file(path));
             }
             let grid = with_spacing(path, &raw.grid, opts.spacing)?;
-            carried = raw.carried.clone().map(|c| Carried { source: Some(a.0.clone()), ..c });
-            (grid, a.2.clone(), a.0.clone(), path.to_path_buf())
+            let (name, values) = (a.0.clone(), a.2.clone());
+            carried = raw.carried.map(|c| Carried { source: Some(name.clone()), ..c });
+            (grid, values, name, path.to_path_buf())
         }
     };
     let mut filled = None;

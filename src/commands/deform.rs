@@ -191,12 +191,13 @@ fn stage_picture(
     })
 }
 
-/// Stages a mesh without arrays in the format its extension names.
+/// Stages a mesh without arrays in the format its extension names, read back before commit
+/// (certificate item 5: the same positions bit for bit and as many triangles).
 fn stage_geometry(path: &std::path::Path, positions: &[[f64; 3]], triangles: &[[usize; 3]]) -> Result<Staged> {
     use crate::io::mesh::{stage_obj, stage_off, stage_ply};
     use crate::io::vtk::{stage_vtp, stage_vtu, PolyData};
     let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
-    match ext.as_str() {
+    let staged = match ext.as_str() {
         "obj" => stage_obj(path, positions, triangles),
         "off" => stage_off(path, positions, triangles),
         "ply" => stage_ply(path, positions, triangles, &[]),
@@ -207,7 +208,9 @@ fn stage_geometry(path: &std::path::Path, positions: &[[f64; 3]], triangles: &[[
         _ => {
             Err(Error::Usage(format!("{}: a posed mesh is written as .obj, .off, .ply, .vtu or .vtp", path.display())))
         }
-    }
+    }?;
+    crate::io::export::check_mesh_written(&staged, positions, triangles, &[])?;
+    Ok(staged)
 }
 
 fn bounds(p: &[[f64; 3]]) -> ([f64; 3], [f64; 3]) {

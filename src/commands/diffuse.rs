@@ -273,8 +273,34 @@ fn stage_diffused(args: &DiffuseArgs, d: &Diffused, weights_path: &Path) -> Resu
     Ok((staged, wrote))
 }
 
+/// Stages a PNG and reads it back before commit (certificate item 5: every pixel as coloured).
 fn stage_png(path: &Path, img: &image::RgbaImage) -> Result<Staged> {
-    stage_with(path, |w| img.write_to(w, image::ImageFormat::Png).map_err(|e| std::io::Error::other(e.to_string())))
+    let staged = stage_with(path, |w| {
+        img.write_to(w, image::ImageFormat::Png).map_err(|e| std::io::Error::other(e.to_string()))
+    })?;
+    check_png_written(&staged, img)?;
+    Ok(staged)
+}
+
+fn check_png_written(staged: &Staged, img: &image::RgbaImage) -> Result<()> {
+    let fail = |what: String| Error::Uncertified {
+        path: Some(staged.target().to_path_buf()),
+        message: format!("certificate item 5: the image as written reads back with {what}"),
+    };
+    // the temporary's name has no .png: the format is the content's
+    let decoded = image::ImageReader::open(staged.temp_path())
+        .and_then(|r| r.with_guessed_format())
+        .map_err(|e| fail(format!("an error: {e}")))?
+        .decode();
+    let read = decoded.map_err(|e| fail(format!("an error: {e}")))?.into_rgba8();
+    if read.dimensions() != img.dimensions() {
+        let ((w, h), (w0, h0)) = (read.dimensions(), img.dimensions());
+        return Err(fail(format!("{w} × {h} pixels instead of {w0} × {h0}")));
+    }
+    match read.pixels().zip(img.pixels()).position(|(a, b)| a != b) {
+        Some(i) => Err(fail(format!("another colour at pixel {i}"))),
+        None => Ok(()),
+    }
 }
 
 /// The image enlarged (nearest neighbour, at least 600 pixels wide) on a checkerboard, with
@@ -315,4 +341,27 @@ fn enlarged(img: &image::RgbaImage, pm: &PixelMesh, sets: &[Vec<usize>], rgbs: &
         }
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_png_that_reads_back_otherwise_is_refused() {
+        let dir = std::env::temp_dir().join(format!("toposmooth-png-readback-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let img = image::RgbaImage::from_fn(5, 3, |x, y| image::Rgba([x as u8 * 50, y as u8 * 80, 7, 255]));
+        let staged = stage_png(&dir.join("d.png"), &img).unwrap();
+        assert!(check_png_written(&staged, &img).is_ok());
+        // the same image with one pixel one step off: refused, naming the target
+        let mut other = img.clone();
+        other.get_pixel_mut(4, 2).0[2] = 8;
+        let e = check_png_written(&staged, &other).unwrap_err().to_string();
+        assert!(e.contains("certificate item 5") && e.contains("pixel 14") && e.contains("d.png"), "{e}");
+        let e = check_png_written(&staged, &image::RgbaImage::new(3, 5)).unwrap_err().to_string();
+        assert!(e.contains("5 × 3 pixels instead of 3 × 5"), "{e}");
+        drop(staged);
+        let _ = std::fs::remove_dir_all(&dir);
+    }
 }

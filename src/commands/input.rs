@@ -6,7 +6,7 @@ use crate::derive::{describe_missing, fill_missing, magnitude, vorticity};
 use crate::domain::{Domain, Grid2d, TriMesh};
 use crate::error::{Error, Result};
 use crate::io::export::Carried;
-use crate::io::grid::{read_grid_csv, read_raster, GridField};
+use crate::io::grid::{raster_grid, read_grid_csv, read_raster, GridField};
 use crate::io::mesh::is_mesh_file;
 pub use crate::io::mesh::read_trimesh;
 use crate::io::npy_input::{is_numpy, read_numpy, NumpyField, Wanted};
@@ -221,8 +221,8 @@ fn extension(path: &Path) -> String {
     path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase()
 }
 
-/// Whether a grid file is a raster image (PNG, TIFF): its row 0 is the image's top row, read
-/// with origin 0 and spacing 1, so y (the row index) grows downward as image viewers show it.
+/// Whether a grid file is a raster image (PNG, TIFF): its row 0 is the image's top row, placed
+/// at the largest y as ParaView places it ([`raster_grid`]).
 pub fn is_raster(path: &Path) -> bool {
     matches!(extension(path).as_str(), "png" | "tif" | "tiff")
 }
@@ -478,8 +478,11 @@ fn read_raw(path: &Path, array: Option<&str>) -> Result<Raw> {
     }
 }
 
+/// The grid with `--spacing` applied: the file's origin kept, except for a raster, whose spacing
+/// is its pixel size with the top row kept at the top ([`raster_grid`]).
 fn with_spacing(path: &Path, grid: &Grid2d, spacing: Option<[f64; 2]>) -> Result<Grid2d> {
     match spacing {
+        Some(s) if is_raster(path) => raster_grid(grid.nx(), grid.ny(), s).map_err(|e| e.in_file(path)),
         Some(s) => Grid2d::with_geometry(grid.nx(), grid.ny(), s, grid.origin()).map_err(|e| e.in_file(path)),
         None => Ok(grid.clone()),
     }

@@ -383,8 +383,6 @@ fn stage_figure(path: &Path, args: &SmoothArgs, field: &Field, result: &Smoothed
                 diverging: lo < 0.0 && hi > 0.0,
                 origin: g.origin(),
                 spacing: g.spacing(),
-                // a raster looks as the image does (row 0 at the top); other grids as in ParaView
-                y_down: super::input::is_raster(&field.path),
             };
             let markers = kept_markers(&result.roles);
             stage_plot(path, |p| plot_grid_fields(p, g.nx(), g.ny(), &panels, &markers, &title, &options))?

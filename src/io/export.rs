@@ -356,7 +356,7 @@ pub fn check_written(staged: &Staged, domain: &AnyDomain, r: &Results) -> Result
 /// Usage errors for another extension; I/O errors naming the file.
 pub fn stage_mesh(path: &Path, mesh: &TriMesh, arrays: &[(&str, &[f64])]) -> Result<Staged> {
     let staged = stage_mesh_unchecked(path, mesh, arrays)?;
-    check_mesh_written(&staged, mesh, arrays)?;
+    check_mesh_written(&staged, mesh.positions(), mesh.faces(), arrays)?;
     Ok(staged)
 }
 
@@ -366,7 +366,12 @@ pub fn stage_mesh(path: &Path, mesh: &TriMesh, arrays: &[(&str, &[f64])]) -> Res
 ///
 /// # Errors
 /// [`Error::Uncertified`] naming the target and what reads back differently.
-fn check_mesh_written(staged: &Staged, mesh: &TriMesh, arrays: &[(&str, &[f64])]) -> Result<()> {
+pub fn check_mesh_written(
+    staged: &Staged,
+    positions: &[[f64; 3]],
+    triangles: &[[usize; 3]],
+    arrays: &[(&str, &[f64])],
+) -> Result<()> {
     let target = staged.target();
     let fail = |what: String| Error::Uncertified {
         path: Some(target.to_path_buf()),
@@ -374,11 +379,11 @@ fn check_mesh_written(staged: &Staged, mesh: &TriMesh, arrays: &[(&str, &[f64])]
     };
     let data = super::mesh::read_mesh(staged.temp_path()).map_err(|e| fail(format!("an error: {e}")))?;
     let bits = |p: &[[f64; 3]]| p.iter().flatten().map(|v| v.to_bits()).collect::<Vec<u64>>();
-    if bits(&data.positions) != bits(mesh.positions()) {
+    if bits(&data.positions) != bits(positions) {
         return Err(fail("other vertex positions".into()));
     }
-    if data.triangles.len() != mesh.faces().len() {
-        return Err(fail(format!("{} triangles instead of {}", data.triangles.len(), mesh.faces().len())));
+    if data.triangles.len() != triangles.len() {
+        return Err(fail(format!("{} triangles instead of {}", data.triangles.len(), triangles.len())));
     }
     for (name, values) in arrays {
         let read = data.arrays.iter().find(|a| a.name == *name).ok_or_else(|| fail(format!("no array `{name}`")))?;
@@ -666,7 +671,9 @@ mod tests {
             let off = [0.0, 1.0, 2.0, (0.1 + 0.2f64).next_up()];
             let other = stage_mesh_unchecked(&dir.join(format!("o.{ext}")), &mesh, &[("distance", &off)]).unwrap();
             std::fs::copy(other.temp_path(), staged.temp_path()).unwrap();
-            let e = check_mesh_written(&staged, &mesh, &[("distance", &d)]).unwrap_err().to_string();
+            let e = check_mesh_written(&staged, mesh.positions(), mesh.faces(), &[("distance", &d)])
+                .unwrap_err()
+                .to_string();
             assert!(
                 e.contains("certificate item 5") && e.contains("`distance`") && e.contains(&format!("m.{ext}")),
                 "{e}"

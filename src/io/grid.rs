@@ -1,6 +1,11 @@
 //! 2D scalar fields on grids: CSV matrices, NumPy `.npy`, grayscale PNG and TIFF (8/16-bit
 //! integers and 32/64-bit floats). Row 0 is the first row the file stores (SPEC.md); NaN is
 //! kept (measured fields have holes: the caller decides), infinities are errors.
+//!
+//! Rasters (PNG, TIFF) are placed as ParaView's image readers place them: pixel (row r,
+//! column c) at `(c·dx, (ny−1−r)·dy)` with pixel size dx, dy (1, 1 unless `--spacing` says
+//! otherwise), so the image's top row has the largest y ([`raster_grid`]). Indices stay the
+//! file's order (row 0 is the top row, as numpy reads the image).
 
 use crate::domain::Grid2d;
 use crate::error::{Error, Result};
@@ -31,6 +36,24 @@ fn finish(path: &Path, nx: usize, ny: usize, values: Vec<f64>, array: String) ->
     }
     let grid = Grid2d::new(nx, ny).map_err(|e| e.in_file(path))?;
     Ok(GridField { grid, values, array })
+}
+
+/// The grid of an `nx × ny` raster with pixel size `[dx, dy]`: row 0 (the image's top row) at
+/// y = (ny−1)·dy, each next row dy lower, column c at x = c·dx — where ParaView's PNG and TIFF
+/// readers put the pixels (they store the bottom row first at y = 0).
+///
+/// # Errors
+/// A grid smaller than 2 × 2 or a spacing out of range.
+pub fn raster_grid(nx: usize, ny: usize, pixel: [f64; 2]) -> Result<Grid2d> {
+    let top = ny.saturating_sub(1) as f64 * pixel[1];
+    Grid2d::with_geometry(nx, ny, [pixel[0], -pixel[1]], [0.0, top])
+}
+
+#[cfg(feature = "image")]
+fn finish_raster(path: &Path, nx: usize, ny: usize, values: Vec<f64>) -> Result<GridField> {
+    let f = finish(path, nx, ny, values, "gray".into())?;
+    let grid = raster_grid(nx, ny, [1.0, 1.0]).map_err(|e| e.in_file(path))?;
+    Ok(GridField { grid, ..f })
 }
 
 /// Reads a CSV matrix: one grid row per line, numbers or `NaN` separated by `,`, `;` or tabs
@@ -115,7 +138,7 @@ pub fn read_raster(path: &Path) -> Result<GridField> {
             ))
         }
     };
-    finish(path, nx, ny, values, "gray".into())
+    finish_raster(path, nx, ny, values)
 }
 
 #[cfg(feature = "image")]
@@ -145,7 +168,7 @@ fn read_tiff(path: &Path) -> Result<GridField> {
     if values.len() != nx * ny {
         return Err(err(path, format!("{} samples for {nx} × {ny} pixels", values.len())));
     }
-    finish(path, nx, ny, values, "gray".into())
+    finish_raster(path, nx, ny, values)
 }
 
 /// Stages a CSV matrix: one grid row per line, shortest round-trip numbers (a single-array
@@ -245,6 +268,8 @@ mod tests {
         let g = read_raster(&d.join("g.png")).unwrap();
         assert_eq!((g.grid.nx(), g.grid.ny(), g.grid.n_vertices()), (4, 3, 12));
         assert_eq!(g.values[g.grid.index(2, 1)], 21_000.0, "row 2 is the third stored row");
+        // placed as ParaView's PNG reader places it: the top row (row 0) at y = 2, the bottom at 0
+        assert_eq!((g.grid.origin(), g.grid.spacing()), ([0.0, 2.0], [1.0, -1.0]));
         image::RgbImage::new(3, 3).save(d.join("rgb.png")).unwrap();
         assert!(read_raster(&d.join("rgb.png")).unwrap_err().to_string().contains("grayscale"));
         // a float TIFF, the usual elevation format
@@ -254,6 +279,7 @@ mod tests {
         enc.write_image::<tiff::encoder::colortype::Gray32Float>(3, 2, &data).unwrap();
         let t = read_raster(&d.join("f.tif")).unwrap();
         assert_eq!(t.values, vec![0.0, 0.5, 1.0, 1.5, 2.0, 2.5]);
+        assert_eq!((t.grid.spacing(), t.grid.origin()), ([1.0, -1.0], [0.0, 1.0]));
         std::fs::write(d.join("trunc.tif"), &std::fs::read(d.join("f.tif")).unwrap()[..20]).unwrap();
         assert!(read_raster(&d.join("trunc.tif")).is_err());
     }

@@ -9,8 +9,8 @@
 //! Each panel has axes in the file's coordinates (vertex (r, c) at origin + (c·dx, r·dy), spacing
 //! signs kept) and is oriented as ParaView shows the grid: larger x to the right and larger y at
 //! the top, whatever the signs of the spacing, so a grid with dy < 0 and the same grid stored
-//! with its rows reversed and dy > 0 give the same picture. Rasters (PNG, TIFF) can ask for y
-//! growing downward instead (see [`GridPlotOptions::y_down`]), so that they look as the image does.
+//! with its rows reversed and dy > 0 give the same picture (a raster, read with its top row at the
+//! largest y, looks as the image does).
 
 use super::{min_max, nice_range, render, tick_label, Area, PlotError, FONT, MAX_C, MIN_C};
 use plotters::coord::types::RangedCoordf64;
@@ -51,15 +51,11 @@ pub struct GridPlotOptions {
     /// Spacing (dx, dy), signs kept: vertex (r, c) lies at `origin + (c·dx, r·dy)`. The cells
     /// are drawn |dy| / |dx| as tall as wide, so that the picture is not distorted.
     pub spacing: [f64; 2],
-    /// False (ParaView's view): y grows upward, the vertex with the largest y at the top. True
-    /// (an image viewer's view, for rasters whose row 0 is the image's top row): y grows
-    /// downward, the smallest y at the top. Either way larger x is to the right.
-    pub y_down: bool,
 }
 
 impl Default for GridPlotOptions {
     fn default() -> Self {
-        GridPlotOptions { isolines: 0, diverging: false, origin: [0.0, 0.0], spacing: [1.0, 1.0], y_down: false }
+        GridPlotOptions { isolines: 0, diverging: false, origin: [0.0, 0.0], spacing: [1.0, 1.0] }
     }
 }
 
@@ -84,11 +80,11 @@ impl View {
     pub(super) fn new(nx: usize, ny: usize, o: &GridPlotOptions) -> View {
         let ([ox, oy], [dx, dy]) = (o.origin, o.spacing);
         let flip_cols = dx < 0.0;
-        // the top row holds the largest y (y up) or the smallest (y down)
-        let flip_rows = (dy > 0.0) != o.y_down;
+        // the top row holds the largest y
+        let flip_rows = dy > 0.0;
         let end = |o: f64, d: f64, n: usize, flip: bool| if flip { o + (n - 1) as f64 * d } else { o };
         let first = [end(ox, dx, nx, flip_cols), end(oy, dy, ny, flip_rows)];
-        let step = [dx.abs(), if o.y_down { dy.abs() } else { -dy.abs() }];
+        let step = [dx.abs(), -dy.abs()];
         View { nx, ny, flip_cols, flip_rows, first, step }
     }
 

@@ -465,7 +465,9 @@ pub fn plot_persistence_diagram(
                     chart.draw_series(DashedLineSeries::new([(x0, x0 + c), (x1, x1 + c)], px(8.0), px(6.0), dash))?;
                 }
             }
-            legend.push((Mark::Dash(dash), format!("|death − birth| = {}", t as f32)));
+            // four significant digits: the legend's width holds the label
+            let digits = (4.0 - t.log10().ceil()).clamp(0.0, 12.0) as usize;
+            legend.push((Mark::Dash(dash), format!("persistence = {t:.digits$}")));
         }
         if pts.iter().any(|p| !ok(p.death)) {
             let y = level(f64::INFINITY);

@@ -190,6 +190,38 @@ if run("smooth", volcano, "--persistence", "5%", "-o", vo, "--diagram", vd, "--c
     else:
         print(f"ok Threshold on Persistence: {pairs} pairs for {kept} kept extrema")
 
+# a raster: our .vti puts every pixel where ParaView's PNG reader puts it (top row at the top)
+png = os.path.join(WORK, "ramp.png")
+rows, cols = np.mgrid[0:5, 0:7]
+pixels = (rows * 40 + cols * 3 + ((rows * 7 + cols * 5) % 4)).astype(np.uint8)
+writer = vtk.vtkPNGWriter()
+image = vtk.vtkImageData()
+image.SetDimensions(7, 5, 1)
+# vtkPNGWriter writes VTK's row y = 0 as the file's bottom row: hand it the rows reversed so
+# that the file's top row is pixels[0]
+from vtk.util.numpy_support import numpy_to_vtk
+image.GetPointData().SetScalars(numpy_to_vtk(pixels[::-1].ravel(), array_type=vtk.VTK_UNSIGNED_CHAR))
+writer.SetInputData(image)
+writer.SetFileName(png)
+writer.Write()
+ramp = os.path.join(WORK, "ramp.vti")
+if run("smooth", png, "--minima", "1", "--maxima", "1", "-o", ramp):
+    ours, _ = read(ramp)
+    theirs = vtk.vtkPNGReader()
+    theirs.SetFileName(png)
+    theirs.Update()
+    ref = theirs.GetOutput()
+    ref_values = vtk_to_numpy(ref.GetPointData().GetScalars()).astype(float)
+    our_values = vtk_to_numpy(ours.GetPointData().GetArray("input"))
+    ref_at = {tuple(np.round(ref.GetPoint(i), 9)): ref_values[i] for i in range(ref.GetNumberOfPoints())}
+    our_at = {tuple(np.round(ours.GetPoint(i), 9)): our_values[i] for i in range(ours.GetNumberOfPoints())}
+    if ref_at != our_at:
+        fail(ramp, "pixels are not where vtkPNGReader puts them (the image is flipped)")
+    elif ours.GetPoint(0)[1] != 4.0 or our_values[0] != pixels[0, 0]:
+        fail(ramp, f"the file's top-left pixel is at {ours.GetPoint(0)}, expected y = 4")
+    else:
+        print("ok raster .vti: every pixel where vtkPNGReader puts it")
+
 if failures:
     print(f"{len(failures)} failures", file=sys.stderr)
     sys.exit(1)

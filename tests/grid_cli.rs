@@ -507,7 +507,7 @@ fn heat_maps_put_larger_y_on_top_as_paraview_does() {
         std::fs::create_dir_all(&dir).unwrap();
         let vti = write(&dir, "ramp.vti", ascii_vti(30, 20, o, d, h).as_bytes());
         let (out, png) = (path(&dir, "out.vti"), path(&dir, "fig.png"));
-        let r = toposmooth(&["smooth", &vti.display().to_string(), "-o", &out, "--plot", &png, "--quiet"]);
+        let r = toposmooth(&["smooth", &vti.display().to_string(), "-o", &out, "--plot", &png]);
         assert!(r.status.success(), "{}", text(&r));
         figures.push(image::open(&png).unwrap().to_rgb8());
     }
@@ -533,12 +533,82 @@ fn a_png_keeps_its_look_in_the_heat_map() {
     let src = dir.join("ramp.png");
     img.save(&src).unwrap();
     let (out, png) = (path(&dir, "out.vti"), path(&dir, "fig.png"));
-    let r = toposmooth(&["smooth", &src.display().to_string(), "-o", &out, "--plot", &png, "--quiet"]);
+    let r = toposmooth(&["smooth", &src.display().to_string(), "-o", &out, "--plot", &png]);
     assert!(r.status.success(), "{}", text(&r));
     let fig = image::open(&png).unwrap().to_rgb8();
     let column = coloured_down(&fig, fig.width() / 4);
     let (top, bottom) = (column[0], column[column.len() - 1]);
     assert!(top[0] > 150 && top[1] > 150 && top[2] < 120, "the image's bright top row stays on top: {top:?}");
     assert!(bottom[2] > bottom[1] && bottom[0] < 120, "{bottom:?}");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// The dark (text) pixels of `img` in the rectangle `xs × ys`.
+fn dark_pixels(img: &image::RgbImage, xs: std::ops::Range<u32>, ys: std::ops::Range<u32>) -> usize {
+    ys.flat_map(|y| xs.clone().map(move |x| (x, y)))
+        .filter(|&(x, y)| img.get_pixel(x, y).0.iter().all(|&c| c < 100))
+        .count()
+}
+
+#[test]
+fn heat_maps_have_axes_in_the_file_coordinates() {
+    // cac0d08 drew the panels with no axes at all: nothing told where x and y were, and two
+    // files with the same values at other coordinates gave the same picture
+    let root = scratch("plot_axes");
+    let h = |x: f64, y: f64| (x / 7.0).sin() + (y / 5.0).cos();
+    let mut figures = Vec::new();
+    for (sub, o, d) in [("near", [0.0, 0.0], [1.0, 1.0]), ("far", [5000.0, -300.0], [2.5, 4.0])] {
+        let dir = root.join(sub);
+        std::fs::create_dir_all(&dir).unwrap();
+        // the same values at each index: only the coordinates differ
+        let vti =
+            write(&dir, "wave.vti", ascii_vti(40, 30, o, d, |x, y| h((x - o[0]) / d[0], (y - o[1]) / d[1])).as_bytes());
+        let (out, png) = (path(&dir, "out.vti"), path(&dir, "fig.png"));
+        let r = toposmooth(&["smooth", &vti.display().to_string(), "-o", &out, "--plot", &png]);
+        assert!(r.status.success(), "{}", text(&r));
+        figures.push(image::open(&png).unwrap().to_rgb8());
+    }
+    let img = &figures[0];
+    let (w, ht) = img.dimensions();
+    let coloured = |p: &[u8; 3]| p.iter().max().unwrap() - p.iter().min().unwrap() >= 12;
+    // the input panel: its left edge along the middle row, its bottom edge down its middle column
+    let left = (0..w).find(|&x| coloured(&img.get_pixel(x, ht / 2).0)).unwrap();
+    let bottom = (0..ht).rev().find(|&y| coloured(&img.get_pixel(left + 40, y).0)).unwrap();
+    // markers may overhang the panel by their radius: labels are looked for beyond that
+    assert!(left > 20, "room for y tick labels left of the panel (left edge at {left})");
+    assert!(dark_pixels(img, 0..left - 10, 0..ht) > 100, "y tick labels left of the panel");
+    assert!(dark_pixels(img, left..w / 2, bottom + 10..ht) > 100, "x tick labels below the panel");
+    // the labels are the file's coordinates: the two figures differ left of and below the panel
+    let differ = |xs: std::ops::Range<u32>, ys: std::ops::Range<u32>| {
+        ys.flat_map(|y| xs.clone().map(move |x| (x, y)))
+            .any(|(x, y)| figures[0].get_pixel(x, y) != figures[1].get_pixel(x, y))
+    };
+    assert!(differ(0..left - 10, 60..ht), "the y labels follow the origin and spacing");
+    assert!(differ(left..w / 2, bottom + 10..ht), "the x labels follow the origin and spacing");
+    std::fs::remove_dir_all(&root).ok();
+}
+
+#[test]
+fn a_band_of_cancelled_pairs_stays_light_grey_in_the_diagram() {
+    // 50 × 50 noise: 725 pairs, 3 minima and 1 maximum kept at 70 %. cac0d08 drew each
+    // cancelled pair as a hollow circle in the kept pairs' blue or red, 18,000 coloured pixels
+    // each way, a band that looked kept; now they are small light-grey crosses
+    let dir = scratch("diagram_band");
+    let v = common::uniform(3, 50 * 50);
+    let rows: Vec<String> =
+        v.chunks(50).map(|r| r.iter().map(|x| format!("{x}")).collect::<Vec<_>>().join(",")).collect();
+    let csv = write(&dir, "noise.csv", (rows.join("\n") + "\n").as_bytes());
+    let png = path(&dir, "d.png");
+    let o = toposmooth(&["extrema", &csv.display().to_string(), "--plot", &png, "--persistence", "70%"]);
+    assert!(o.status.success(), "{}", text(&o));
+    assert!(text(&o).contains("kept at persistence"), "{}", text(&o));
+    let img = image::open(&png).unwrap().to_rgb8();
+    let blue = img.pixels().filter(|p| p[2] > 150 && p[0] < 90 && p[1] < 120).count();
+    let red = img.pixels().filter(|p| p[0] > 150 && p[1] < 90 && p[2] < 90).count();
+    let light = img.pixels().filter(|p| p[0] == p[1] && p[1] == p[2] && (160..=190).contains(&p[0])).count();
+    // the kept dots, the essential pairs' triangles and the legend's marks: a few hundred pixels
+    assert!(blue < 1500, "blue pixels: {blue}");
+    assert!(red < 1500, "red pixels: {red}");
+    assert!(light > 3000, "light grey pixels: {light}");
     std::fs::remove_dir_all(&dir).ok();
 }

@@ -259,9 +259,10 @@ fn the_active_scalars_are_the_default_array_as_in_a_vtk_filter() {
     }
 }
 
-/// Runs the tool; panics with its output unless it exits 0.
+/// Runs the tool; panics with its output unless it exits 0. (No `-q`: a build without it,
+/// like cac0d08's, then fails on what the test checks, not on the flag.)
 fn smooth_ok(args: &[&str]) {
-    let o = std::process::Command::new(env!("CARGO_BIN_EXE_toposmooth")).arg("-q").args(args).output().unwrap();
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_toposmooth")).args(args).output().unwrap();
     assert_eq!(
         o.status.code(),
         Some(0),
@@ -422,5 +423,105 @@ fn thresholding_the_ttk_diagram_selects_exactly_the_kept_pairs() {
     assert_eq!(kept_in_complex, kept);
     let sep = array(&c.cell_data, "SeparatrixType").values.clone();
     assert!(sep.contains(&0.0) && sep.contains(&1.0) && sep.contains(&-1.0), "{sep:?}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Legacy `.vtk` output (cac0d08 refused `-o out.vtk`, exit 2): binary, big-endian, structured
+/// points for an image and an unstructured grid for a surface, every input array carried and
+/// the smoothed field the active scalars, read back by the crate's own legacy reader (VTK's
+/// reader opens them in tests/vtk_open).
+#[test]
+fn legacy_vtk_outputs_carry_the_input_arrays() {
+    let dir = std::env::temp_dir().join(format!("toposmooth-legacy-out-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    for (input, dataset) in
+        [("types.appended-raw-zlib-u64.vti", "STRUCTURED_POINTS"), ("surf.binary-zlib-u64.vtu", "UNSTRUCTURED_GRID")]
+    {
+        let path = fixtures().join(input);
+        let out = dir.join(format!("{input}.vtk"));
+        smooth_ok(&[
+            "smooth",
+            path.to_str().unwrap(),
+            "--array",
+            "f",
+            "--persistence",
+            "20%",
+            "-o",
+            out.to_str().unwrap(),
+        ]);
+        let bytes = std::fs::read(&out).unwrap();
+        let head: Vec<&[u8]> = bytes.split(|&b| b == b'\n').take(4).collect();
+        assert!(head[0].starts_with(b"# vtk DataFile Version"), "{input}: {:?}", String::from_utf8_lossy(head[0]));
+        assert_eq!(head[2], b"BINARY", "{input}");
+        assert_eq!(head[3], format!("DATASET {dataset}").as_bytes(), "{input}");
+        let (a, b) = (read_dataset(&path).unwrap(), read_dataset(&out).unwrap());
+        assert_eq!(b.active_scalars.as_deref(), Some("f"), "{input}");
+        assert_eq!(array(&b.point_data, "f").values, array(&b.point_data, "smoothed").values, "{input}");
+        assert_eq!(array(&b.point_data, "input").values, array(&a.point_data, "f").values, "{input}");
+        for x in a.point_data.iter().filter(|x| x.name != "f") {
+            assert_eq!(array(&b.point_data, &x.name).values, x.values, "{input}: point array {}", x.name);
+        }
+        for x in &a.cell_data {
+            assert_eq!(array(&b.cell_data, &x.name).values, x.values, "{input}: cell array {}", x.name);
+        }
+        assert_eq!(a.points, b.points, "{input}: the points");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// `--complex` in TTK's codes. cac0d08 wrote one `type` array whose ±1 meant minimum/maximum on
+/// the points but descending/ascending on the lines; now points carry `CriticalType` (0
+/// minimum, 1 saddle, 3 maximum, 5 regular, as TTK) and lines `SeparatrixType` (0 descending, 1
+/// ascending, −1 on vertex cells), each line from its saddle to a kept extremum of that kind.
+#[test]
+fn the_complex_carries_ttk_critical_and_separatrix_types() {
+    let dir = std::env::temp_dir().join(format!("toposmooth-complex-types-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let volcano = Path::new(env!("CARGO_MANIFEST_DIR")).join("datasets/volcano_maunga_whau_61x87.csv");
+    let (out, complex) = (dir.join("v.vti"), dir.join("c.vtp"));
+    smooth_ok(&[
+        "smooth",
+        volcano.to_str().unwrap(),
+        "--persistence",
+        "5%",
+        "-o",
+        out.to_str().unwrap(),
+        "--complex",
+        complex.to_str().unwrap(),
+    ]);
+    let roles = array(&read_dataset(&out).unwrap().point_data, "role").values.clone();
+    let c = read_dataset(&complex).unwrap();
+    assert!(!c.point_data.iter().chain(&c.cell_data).any(|a| a.name == "type"), "no ambiguous `type` array");
+    let critical = array(&c.point_data, "CriticalType");
+    assert_eq!(critical.ty, toposmooth::io::vtk::Scalar::I32);
+    let (ct, vid, kept) =
+        (&critical.values, &array(&c.point_data, "ttkVertexScalarField").values, &array(&c.point_data, "Kept").values);
+    assert!(ct.iter().all(|t| [0.0, 1.0, 3.0, 5.0].contains(t)), "{ct:?}");
+    // the kept extrema are the points of type 0 and 3 marked kept, with the output's roles
+    for p in 0..ct.len() {
+        let v = vid[p] as usize;
+        if kept[p] == 1.0 && ct[p] != 1.0 {
+            assert_eq!(roles[v], if ct[p] == 0.0 { -1.0 } else { 1.0 }, "point {p} (vertex {v}) of type {}", ct[p]);
+        }
+    }
+    let sep = array(&c.cell_data, "SeparatrixType");
+    assert_eq!(sep.ty, toposmooth::io::vtk::Scalar::I32);
+    let destination = &array(&c.cell_data, "DestinationId").values;
+    let (mut descending, mut ascending) = (0, 0);
+    for (cell, &t) in sep.values.iter().enumerate() {
+        match t as i32 {
+            -1 => assert_eq!(destination[cell], -1.0),
+            0 => {
+                descending += 1;
+                assert_eq!(roles[destination[cell] as usize], -1.0, "a descending line ends at a kept minimum");
+            }
+            1 => {
+                ascending += 1;
+                assert_eq!(roles[destination[cell] as usize], 1.0, "an ascending line ends at a kept maximum");
+            }
+            t => panic!("separatrix type {t}"),
+        }
+    }
+    assert!(descending > 0 && ascending > 0, "{descending} descending, {ascending} ascending");
     let _ = std::fs::remove_dir_all(&dir);
 }

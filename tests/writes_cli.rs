@@ -319,3 +319,118 @@ fn dash_reads_the_standard_input_and_a_fifo_input_is_read_once() {
     assert_eq!(o.status.code(), Some(0), "{}", text(&o));
     assert!(String::from_utf8_lossy(&o.stdout).contains("47 minima, 46 maxima"), "{}", text(&o));
 }
+
+// The defects of issue 18 as they were on cac0d08 (the commit before 676bbb5), each a case
+// that fails there and passes now.
+
+#[test]
+fn links_planted_at_predictable_temporary_names_are_never_written_through() {
+    // cac0d08 staged every output at `.NAME.PID.tmp`, opened with `File::create` (which follows
+    // a link): a link planted there made the run overwrite the link's target, then renamed the
+    // link over the output. The shell plants links at those names for its own PID, then `exec`s
+    // the tool, which keeps that PID.
+    let dir = scratch("planted-links");
+    let victim = dir.join("victim.txt");
+    std::fs::write(&victim, "precious").unwrap();
+    let o = Command::new("sh")
+        .current_dir(&dir)
+        .arg("-c")
+        .arg(r#"for n in fx.csv r.json; do ln -s victim.txt ".$n.$$.tmp" || exit 99; done; exec "$0" "$@""#)
+        .arg(bin())
+        .args(["smooth", &fx(), "-o", "fx.csv", "--report", "r.json", "--persistence", "2%"])
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+    assert_eq!(std::fs::read_to_string(&victim).unwrap(), "precious", "the link's target is untouched");
+    for (name, start) in [("fx.csv", "date,input,output,u,role\n"), ("r.json", "{")] {
+        let p = dir.join(name);
+        assert!(std::fs::symlink_metadata(&p).unwrap().is_file(), "{name} is a regular file, not a link");
+        assert!(std::fs::read_to_string(&p).unwrap().starts_with(start), "{name}");
+    }
+    let links = std::fs::read_dir(&dir).unwrap().flatten().filter(|e| e.file_type().unwrap().is_symlink()).count();
+    assert_eq!(links, 2, "the planted links are neither followed nor moved");
+    assert!(temporaries(&dir).is_empty(), "{:?}", temporaries(&dir));
+}
+
+#[test]
+fn a_report_to_a_device_node_leaves_the_device_in_place() {
+    // cac0d08 renamed the report's temporary over the device: as root, `--report /dev/null`
+    // replaced /dev/null with a regular file. The device here is made in a scratch directory.
+    let dir = scratch("report-device");
+    let null = dir.join("null");
+    if !mknod_null(&null) {
+        eprintln!("note: this process may not make device nodes; a_fifo_output_is_written_through covers FIFOs");
+        return;
+    }
+    let out = dir.join("fx.csv");
+    let o = toposmooth(&[
+        "smooth",
+        &fx(),
+        "-o",
+        out.to_str().unwrap(),
+        "--report",
+        null.to_str().unwrap(),
+        "--persistence",
+        "2%",
+    ]);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+    let m = std::fs::symlink_metadata(&null).unwrap();
+    assert!(m.file_type().is_char_device(), "the device is still a device: {:?}", m.file_type());
+    assert!(std::fs::read_to_string(&out).unwrap().starts_with("date,"));
+    let mut names: Vec<String> =
+        std::fs::read_dir(&dir).unwrap().flatten().map(|e| e.file_name().to_string_lossy().into_owned()).collect();
+    names.sort();
+    assert_eq!(names, ["fx.csv", "null"]);
+}
+
+#[test]
+fn names_that_differ_only_in_invalid_utf8_bytes_get_their_own_files() {
+    // cac0d08 named temporaries from the lossy UTF-8 form of the name: `a\xff.csv` and
+    // `a\xfe.csv` shared `.a\u{fffd}.csv.PID.tmp`, so the first output received the second's
+    // bytes and the second's rename failed (exit 3).
+    use std::os::unix::ffi::OsStrExt;
+    let dir = scratch("invalid-utf8-pair");
+    let (csv, report) =
+        (dir.join(std::ffi::OsStr::from_bytes(b"a\xff.csv")), dir.join(std::ffi::OsStr::from_bytes(b"a\xfe.csv")));
+    let o = Command::new(bin())
+        .args(["smooth", &fx(), "--persistence", "2%", "-o"])
+        .arg(&csv)
+        .arg("--report")
+        .arg(&report)
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+    assert!(std::fs::read_to_string(&csv).unwrap().starts_with("date,input,output,u,role\n"), "the output's own bytes");
+    let r: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    assert_eq!(r["tool"], "toposmooth", "the report's own bytes");
+    assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 2, "the two outputs and nothing else");
+}
+
+#[test]
+fn the_input_summary_is_printed_while_the_work_has_not_ended() {
+    // cac0d08 printed nothing on standard error, and its summary only at the end: a long run
+    // was silent until it finished. The first line of standard error is the input's summary,
+    // and it arrives while the run is still going (the run is waited for, never timed).
+    use std::io::BufRead;
+    let dir = scratch("summary-first");
+    let input = long_grid(&dir);
+    let out = dir.join("s.vti");
+    let mut child = Command::new(bin())
+        .args(["smooth", input.to_str().unwrap(), "-o", out.to_str().unwrap(), "--persistence", "1%"])
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut err = std::io::BufReader::new(child.stderr.take().unwrap());
+    let mut first = String::new();
+    err.read_line(&mut first).unwrap();
+    let running = child.try_wait().unwrap().is_none();
+    let solved_yet = out.exists();
+    if running {
+        // SAFETY: signalling our own child, not yet waited for
+        assert_eq!(unsafe { libc::kill(child.id() as libc::pid_t, libc::SIGTERM) }, 0);
+        let _ = child.wait();
+    }
+    assert!(first.starts_with("read: ") && first.contains("grid 300 × 300 (90000 vertices)"), "{first:?}");
+    assert!(running && !solved_yet, "the summary came before the work ended");
+}

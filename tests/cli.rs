@@ -150,6 +150,14 @@ fn extrema_lists_json() {
     assert_eq!(m["persistence"], 1.0);
     let e = rows.iter().find(|r| r["index"] == 4).unwrap();
     assert!(e["persistence"].is_null(), "essential minimum: null");
+    // x as a number (the sample index here); dates also as the file's text
+    assert_eq!((m["x"].as_f64(), e["x"].as_f64()), (Some(2.0), Some(4.0)));
+    assert!(m.get("x_text").is_none());
+    let dated = write(&dir, "d.csv", "date,v\n2020-01-01,0\n2020-01-03,3\n2020-01-04,1\n2020-01-05,2\n2020-01-07,-1\n");
+    let j: serde_json::Value = serde_json::from_slice(&toposmooth(&["extrema", &dated, "--json"]).stdout).unwrap();
+    let m = j["extrema"].as_array().unwrap().iter().find(|r| r["index"] == 2).unwrap().clone();
+    // dates: x in days since 1970-01-01 (2020-01-04 is day 18,265)
+    assert_eq!((m["x"].as_f64(), m["x_text"].as_str()), (Some(18265.0), Some("2020-01-04")), "{m}");
     let o = toposmooth(&["extrema", &f]);
     assert!(text(&o).contains("strict"), "{}", text(&o));
 }

@@ -243,6 +243,14 @@ fn extrema_lists_grid_extrema_from_every_reader() {
     assert_eq!(j["grid"], serde_json::json!([87, 61]));
     assert_eq!(j["strict_minima"].as_u64().unwrap() as usize, mins.len());
     assert_eq!(j["strict_maxima"].as_u64().unwrap() as usize, maxs.len());
+    // each extremum's place as numbers, not text: row, column and position (origin 0, spacing 1)
+    for e in j["extrema"].as_array().unwrap() {
+        let i = e["index"].as_u64().unwrap() as usize;
+        let (r, c) = (i / nx, i % nx);
+        assert_eq!((e["row"].as_u64(), e["col"].as_u64()), (Some(r as u64), Some(c as u64)), "{e}");
+        assert_eq!(e["position"], serde_json::json!([c as f64, r as f64]), "{e}");
+        assert!(e.get("x").is_none(), "{e}");
+    }
     // the same field as .npy (written by the tool) lists the same extrema
     let npy = path(&dir, "v.npy");
     let npz_out = path(&dir, "v.npz");

@@ -4,7 +4,7 @@ use super::input::{read_field, DomainKind, Field, GridOptions};
 use super::{check_distinct, check_png_name, sig6, stage_plot};
 use crate::domain::{AnyDomain, Domain};
 use crate::error::{Error, Result};
-use crate::io::series_csv::SeriesCsvOptions;
+use crate::io::series_csv::{SeriesCsvOptions, XSource};
 use crate::plot::{plot_persistence_diagram, DiagramPoint};
 use crate::topology::{extrema_table, select, ExtremumKind, KeptSet, Role, Selection};
 use std::path::{Path, PathBuf};
@@ -50,8 +50,39 @@ struct Listing<'a> {
 struct Row<'a> {
     #[serde(flatten)]
     info: &'a crate::topology::ExtremumInfo,
-    x: String,
+    #[serde(flatten)]
+    place: serde_json::Map<String, serde_json::Value>,
     kept: bool,
+    /// The table's text for the place.
+    #[serde(skip)]
+    label: String,
+}
+
+/// Where a vertex is, as JSON: on a series `x` (the domain's coordinate: days since 1970-01-01
+/// for dates, which also get `x_text`, the file's text), on a grid `row`, `col` and `position`
+/// [x, y] in the file's coordinates, on a mesh `position` [x, y, z].
+fn place(field: &Field, i: usize) -> serde_json::Map<String, serde_json::Value> {
+    use serde_json::{json, Map};
+    let mut m = Map::new();
+    match &field.domain {
+        AnyDomain::Series(s) => {
+            m.insert("x".into(), json!(s.x()[i]));
+            if let Some(axis) = field.axis.as_ref().filter(|a| matches!(a.source, XSource::Dates(..))) {
+                m.insert("x_text".into(), json!(axis.x_text[i]));
+            }
+        }
+        AnyDomain::Grid(g) => {
+            let (r, c) = g.row_col(i);
+            let ([dx, dy], [ox, oy]) = (g.spacing(), g.origin());
+            m.insert("row".into(), json!(r));
+            m.insert("col".into(), json!(c));
+            m.insert("position".into(), json!([ox + c as f64 * dx, oy + r as f64 * dy]));
+        }
+        AnyDomain::Mesh(mesh) => {
+            m.insert("position".into(), json!(mesh.positions()[i]));
+        }
+    }
+    m
 }
 
 /// Runs `extrema`; returns the text printed on standard output.
@@ -118,7 +149,12 @@ fn list<D: Domain>(args: &ExtremaArgs, field: &Field, domain: &D) -> Result<Stri
         threshold: kept.threshold,
         extrema: table
             .iter()
-            .map(|r| Row { info: r, x: label(r.index), kept: matches!(kept.roles[r.index], Role::Min | Role::Max) })
+            .map(|r| Row {
+                info: r,
+                place: place(field, r.index),
+                kept: matches!(kept.roles[r.index], Role::Min | Role::Max),
+                label: label(r.index),
+            })
             .collect(),
     };
     if let Some(plot_path) = &args.plot {
@@ -207,7 +243,7 @@ fn table_text(
         out += &format!(
             "{:>8} {:>12} {:>9} {:>14} {:>14} {:>6} {:>4}\n",
             r.index,
-            row.x,
+            row.label,
             kind,
             sig6(r.value),
             pers,

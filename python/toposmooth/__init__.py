@@ -1,0 +1,649 @@
+"""toposmooth: smooth scalar fields with certified control of their extrema.
+
+The field keeps exactly the local minima and maxima you ask for (by persistence, by count or
+by an explicit list), at their places and values, and every result carries a certificate
+that proves it (Jacobson, Weinkauf & Sorkine, *Smooth Shape-Aware Functions with Controlled
+Extrema*, SGP 2012).
+
+Domains
+-------
+- a 1-D array or pandas Series: a series (x = 0, 1, ..., or ``x=``, or the Series' index;
+  a DatetimeIndex gives x in days since 1970-01-01, as the CLI reads dates);
+- a 2-D array: a regular grid, rows = y (``values[r, c]`` at ``origin + (c*dx, r*dy)``);
+- ``vertices=V, faces=F``: a triangle mesh, one value per vertex.
+
+Functions
+---------
+smooth     the field with exactly the kept extrema, certified
+extrema    every extremum with its persistence and whether a selection keeps it
+verify     re-check a field's certificate
+geodesic   geodesic distance on a mesh (heat method)
+weights    smooth, certified weight functions for handles
+Smoother   many fields on one domain, the domain's analysis reused
+
+Example
+-------
+>>> import numpy as np, toposmooth
+>>> rng = np.random.default_rng(0)
+>>> y, x = np.mgrid[0:40, 0:60]
+>>> h = np.sin(x / 9.0) * np.cos(y / 7.0) + 0.05 * rng.standard_normal(x.shape)
+>>> r = toposmooth.smooth(h, persistence="20%")
+>>> r.certified, r.smoothed.shape
+(True, (40, 60))
+"""
+
+from __future__ import annotations
+
+import json
+from typing import Any, Dict, List, Optional, Sequence, Union
+
+import numpy as np
+
+from . import _toposmooth
+from .errors import (
+    CertificateError,
+    Error,
+    InfeasibleError,
+    InputError,
+    InternalError,
+    IoError,
+    SolverError,
+    UsageError,
+)
+
+__version__ = _toposmooth.version()
+
+__all__ = [
+    "smooth",
+    "extrema",
+    "verify",
+    "geodesic",
+    "weights",
+    "Smoother",
+    "SmoothResult",
+    "Domain",
+    "Error",
+    "UsageError",
+    "InputError",
+    "IoError",
+    "InfeasibleError",
+    "CertificateError",
+    "SolverError",
+    "InternalError",
+]
+
+Domain = _toposmooth.Domain
+
+#: Role codes of ``SmoothResult.roles`` (the ``role`` array of the CLI's outputs).
+ROLE_MIN, ROLE_MAX, ROLE_OTHER, ROLE_FIXED, ROLE_END = -1, 1, 0, 2, 3
+
+
+def _float64(name: str, a: Any, ndim: Optional[int] = None) -> np.ndarray:
+    """A C-contiguous float64 view of ``a`` (no copy when it already is one)."""
+    arr = np.asarray(a)
+    if arr.dtype.kind not in "fiub":
+        raise UsageError(f"{name} must hold numbers, got dtype {arr.dtype}")
+    arr = np.ascontiguousarray(arr, dtype=np.float64)
+    if ndim is not None and arr.ndim != ndim:
+        raise InputError(f"{name} must be {ndim}-D, got shape {arr.shape}")
+    return arr
+
+
+def _days_since_epoch(index: Any) -> np.ndarray:
+    """Days since 1970-01-01 of a pandas DatetimeIndex, computed as the CLI computes them
+    from the timestamps' text: (whole seconds + nanoseconds * 1e-9) / 86400, in UTC."""
+    # pandas 2+ stores dates in s, ms, us or ns: asi8 is in the index's unit
+    if hasattr(index, "as_unit"):
+        index = index.as_unit("ns")
+    ns = np.asarray(index.asi8, dtype=np.int64)
+    seconds, nanos = np.divmod(ns, 1_000_000_000)
+    return (seconds.astype(np.float64) + nanos.astype(np.float64) * 1e-9) / 86400.0
+
+
+def _series_x(values: Any, x: Any) -> Optional[np.ndarray]:
+    if x is not None:
+        return _float64("x", x, 1)
+    index = getattr(values, "index", None)
+    if index is None:
+        return None
+    try:
+        import pandas as pd
+    except ImportError:  # pragma: no cover - a Series without pandas cannot exist
+        return None
+    if isinstance(index, pd.DatetimeIndex):
+        return _days_since_epoch(index)
+    if isinstance(index, pd.RangeIndex) and index.start == 0 and index.step == 1:
+        return None
+    if index.dtype.kind in "iuf":
+        return _float64("x (the Series' index)", index.to_numpy(), 1)
+    raise UsageError(f"a Series' index must be numbers or dates to serve as x, got dtype {index.dtype}")
+
+
+def _domain(
+    values: Any,
+    x: Any = None,
+    spacing: Optional[Sequence[float]] = None,
+    origin: Optional[Sequence[float]] = None,
+    vertices: Any = None,
+    faces: Any = None,
+) -> "tuple[Any, np.ndarray, tuple]":
+    """The domain for ``values`` and the values as one contiguous float64 vector."""
+    if (vertices is None) != (faces is None):
+        raise UsageError("a mesh needs both vertices= and faces=")
+    h = _float64("values", values)
+    if vertices is not None:
+        if x is not None or spacing is not None or origin is not None:
+            raise UsageError("x=, spacing= and origin= are for series and grids, not meshes")
+        v = _float64("vertices", vertices, 2)
+        f = np.ascontiguousarray(np.asarray(faces), dtype=np.int64)
+        if f.ndim != 2:
+            raise InputError(f"faces must be 2-D (m, 3), got shape {f.shape}")
+        if h.ndim != 1:
+            raise InputError(f"values on a mesh must be 1-D (one per vertex), got shape {h.shape}")
+        return _toposmooth.Domain.mesh(v, f), h, h.shape
+    if h.ndim == 1:
+        if spacing is not None or origin is not None:
+            raise UsageError("spacing= and origin= are for grids (2-D values); a series takes x=")
+        return _toposmooth.Domain.series(h.shape[0], _series_x(values, x)), h, h.shape
+    if h.ndim == 2:
+        if x is not None:
+            raise UsageError("x= is for series; a grid takes spacing=(dx, dy) and origin=(x0, y0)")
+        ny, nx = h.shape
+        dx, dy = (1.0, 1.0) if spacing is None else (float(spacing[0]), float(spacing[1]))
+        x0, y0 = (0.0, 0.0) if origin is None else (float(origin[0]), float(origin[1]))
+        return _toposmooth.Domain.grid(nx, ny, [dx, dy], [x0, y0]), h.reshape(-1), h.shape
+    raise InputError(f"values must be 1-D (a series or a mesh field) or 2-D (a grid), got shape {h.shape}")
+
+
+def _selection_kwargs(
+    persistence: Union[float, str, None],
+    minima: Optional[int],
+    maxima: Optional[int],
+    pairs: Optional[int],
+    keep_min: Optional[Sequence[int]],
+    keep_max: Optional[Sequence[int]],
+    keep_all_maxima: bool,
+    keep_all_minima: bool,
+) -> Dict[str, Any]:
+    def indices(name: str, v: Optional[Sequence[int]]) -> Optional[List[int]]:
+        if v is None:
+            return None
+        a = np.asarray(v)
+        if a.ndim != 1 or (a.size and a.dtype.kind not in "iu"):
+            raise UsageError(f"{name} must be a list of vertex indices")
+        if a.size and a.min() < 0:
+            raise UsageError(f"{name} holds a negative vertex index ({int(a.min())})")
+        return [int(i) for i in a]
+
+    explicit = keep_min is not None or keep_max is not None
+    return {
+        "persistence": persistence,
+        "minima": minima,
+        "maxima": maxima,
+        "pairs": pairs,
+        "keep_min": indices("keep_min", keep_min) if explicit else None,
+        "keep_max": (indices("keep_max", keep_max) or []) if explicit else None,
+        "keep_all_maxima": keep_all_maxima,
+        "keep_all_minima": keep_all_minima,
+    }
+
+
+class SmoothResult:
+    """What :func:`smooth` returns.
+
+    Attributes
+    ----------
+    smoothed : ndarray of float64, the input's shape
+        The output field, certified to have exactly the kept extrema.
+    representative : ndarray of float64, the input's shape
+        The representative function u whose order the output follows.
+    roles : ndarray of int8, the input's shape
+        -1 kept minimum, 1 kept maximum, 0 other, 2 fixed, 3 free end of a series.
+    kept_minima, kept_maxima : ndarray of int64
+        Flat vertex indices of the kept extrema (``r * nx + c`` on a grid).
+    filled : ndarray of bool or None
+        The samples ``fill_missing`` filled (None when nothing was missing).
+    report : dict
+        The JSON report (settings, selection, certificate, deviations, the fit's gap, seconds).
+    certified : bool
+        Always True: a result that cannot be certified raises :class:`CertificateError`.
+    certificate : dict
+        The report's certificate: the strict extrema counted and what was checked.
+    """
+
+    __slots__ = ("smoothed", "representative", "roles", "kept_minima", "kept_maxima", "filled", "report", "certified")
+
+    def __init__(self, raw: Dict[str, Any], shape: tuple, filled: Optional[np.ndarray]) -> None:
+        self.smoothed: np.ndarray = raw["smoothed"].reshape(shape)
+        self.representative: np.ndarray = raw["representative"].reshape(shape)
+        roles = raw["roles"]
+        self.roles: np.ndarray = roles.reshape(shape)
+        self.kept_minima: np.ndarray = np.flatnonzero(roles == ROLE_MIN).astype(np.int64)
+        self.kept_maxima: np.ndarray = np.flatnonzero(roles == ROLE_MAX).astype(np.int64)
+        self.filled: Optional[np.ndarray] = None if filled is None else filled.reshape(shape)
+        self.report: Dict[str, Any] = json.loads(raw["report"])
+        self.certified: bool = bool(raw["certified"])
+
+    @property
+    def certificate(self) -> Dict[str, Any]:
+        return self.report["certificate"]
+
+    def __repr__(self) -> str:
+        c = self.certificate
+        return (
+            f"SmoothResult(shape={self.smoothed.shape}, kept {self.kept_minima.size} minima and "
+            f"{self.kept_maxima.size} maxima, certified={self.certified}: "
+            f"{c.get('strict_minima')} strict minima, {c.get('strict_maxima')} strict maxima)"
+        )
+
+
+def _settings(
+    order: Union[int, str],
+    data_weight: float,
+    smooth_length: Optional[float],
+    smooth_weight: Optional[float],
+    edges: str,
+    representative: Optional[str],
+    max_iter: int,
+    solver: str,
+    formulation: str,
+    selection: Dict[str, Any],
+) -> Dict[str, Any]:
+    s = dict(selection)
+    s.update(
+        order=str(order),
+        data_weight=float(data_weight),
+        smooth_length=None if smooth_length is None else float(smooth_length),
+        smooth_weight=None if smooth_weight is None else float(smooth_weight),
+        edges=edges,
+        representative=representative,
+        max_iter=int(max_iter),
+        solver=solver,
+        formulation=formulation,
+    )
+    return s
+
+
+class Smoother:
+    """Many fields on one domain with one set of settings (time steps, ensemble members).
+
+    Built once, it keeps the domain's operators (stiffness, mass, the fills' Laplacian) and
+    the symbolic analyses of their factorisations; each :meth:`smooth` reuses them. Takes the
+    same domain and settings arguments as :func:`smooth`, without the values::
+
+        s = toposmooth.Smoother(shape=(ny, nx), spacing=(dx, dy), persistence="5%")
+        results = [s.smooth(frame) for frame in frames]
+
+    Parameters
+    ----------
+    shape : tuple, optional
+        ``(n,)`` for a series, ``(ny, nx)`` for a grid; not for a mesh.
+    x, spacing, origin, vertices, faces
+        As in :func:`smooth`.
+    **settings
+        Every setting of :func:`smooth` except ``fill_missing``, which is per field.
+    """
+
+    def __init__(
+        self,
+        shape: Optional[Sequence[int]] = None,
+        *,
+        x: Any = None,
+        spacing: Optional[Sequence[float]] = None,
+        origin: Optional[Sequence[float]] = None,
+        vertices: Any = None,
+        faces: Any = None,
+        fill_missing: bool = False,
+        **settings: Any,
+    ) -> None:
+        if vertices is not None:
+            n = np.asarray(vertices).shape[0]
+            self._shape: tuple = (n,)
+        elif shape is not None:
+            self._shape = tuple(int(s) for s in shape)
+        elif x is not None:
+            self._shape = (np.asarray(x).shape[0],)
+        else:
+            raise UsageError("Smoother needs shape= (series or grid), x= (series) or vertices=, faces= (mesh)")
+        self._domain, _, _ = _domain(np.zeros(self._shape), x, spacing, origin, vertices, faces)
+        self._fill_missing = bool(fill_missing)
+        self._inner = _toposmooth.Smoother(self._domain, _resolve(settings))
+
+    @property
+    def domain(self) -> Any:
+        """The domain (a ``toposmooth.Domain``)."""
+        return self._domain
+
+    def smooth(self, values: Any) -> SmoothResult:
+        """Smooths one field of the smoother's shape; see :func:`smooth` for the result."""
+        h = _float64("values", values)
+        if h.shape != self._shape:
+            raise InputError(f"values has shape {h.shape}, the smoother's domain {self._shape}")
+        flat, filled = _fill(self._domain, h.reshape(-1), self._fill_missing)
+        return SmoothResult(self._inner.smooth(flat), self._shape, filled)
+
+
+_SETTING_DEFAULTS: Dict[str, Any] = dict(
+    persistence=None,
+    minima=None,
+    maxima=None,
+    pairs=None,
+    keep_min=None,
+    keep_max=None,
+    keep_all_maxima=False,
+    keep_all_minima=False,
+    order=2,
+    data_weight=1.0,
+    smooth_length=None,
+    smooth_weight=None,
+    edges="minimal",
+    representative=None,
+    max_iter=200,
+    solver="structured",
+    formulation="auto",
+)
+
+
+def _resolve(settings: Dict[str, Any]) -> Dict[str, Any]:
+    unknown = sorted(set(settings) - set(_SETTING_DEFAULTS))
+    if unknown:
+        raise UsageError(f"unknown setting(s): {', '.join(unknown)}")
+    s = dict(_SETTING_DEFAULTS, **settings)
+    selection = _selection_kwargs(
+        s["persistence"],
+        s["minima"],
+        s["maxima"],
+        s["pairs"],
+        s["keep_min"],
+        s["keep_max"],
+        s["keep_all_maxima"],
+        s["keep_all_minima"],
+    )
+    return _settings(
+        s["order"],
+        s["data_weight"],
+        s["smooth_length"],
+        s["smooth_weight"],
+        s["edges"],
+        s["representative"],
+        s["max_iter"],
+        s["solver"],
+        s["formulation"],
+        selection,
+    )
+
+
+def _fill(domain: Any, flat: np.ndarray, fill_missing: bool) -> "tuple[np.ndarray, Optional[np.ndarray]]":
+    if not fill_missing or not np.isnan(flat).any():
+        return flat, None
+    filled, mask = _toposmooth.fill_missing(domain, flat)
+    return filled, mask
+
+
+def smooth(
+    values: Any,
+    *,
+    x: Any = None,
+    spacing: Optional[Sequence[float]] = None,
+    origin: Optional[Sequence[float]] = None,
+    vertices: Any = None,
+    faces: Any = None,
+    persistence: Union[float, str, None] = None,
+    minima: Optional[int] = None,
+    maxima: Optional[int] = None,
+    pairs: Optional[int] = None,
+    keep_min: Optional[Sequence[int]] = None,
+    keep_max: Optional[Sequence[int]] = None,
+    keep_all_maxima: bool = False,
+    keep_all_minima: bool = False,
+    order: Union[int, str] = 2,
+    data_weight: float = 1.0,
+    smooth_length: Optional[float] = None,
+    smooth_weight: Optional[float] = None,
+    edges: str = "minimal",
+    representative: Optional[str] = None,
+    fill_missing: bool = False,
+    max_iter: int = 200,
+    solver: str = "structured",
+    formulation: str = "auto",
+) -> SmoothResult:
+    """Smooth a field keeping exactly the chosen extrema, with a certificate.
+
+    Parameters
+    ----------
+    values : array_like or pandas.Series
+        Shape (n,): a series, or a field on a mesh's n vertices. Shape (ny, nx): a grid, row r
+        at y = y0 + r*dy. float64 is used without a copy when C-contiguous; float32 and
+        integers are converted.
+    x : array_like of shape (n,), optional
+        Series coordinates, strictly increasing (default 0, 1, ...; a pandas Series' index:
+        numbers, or dates as days since 1970-01-01).
+    spacing : (dx, dy), optional
+        Grid spacing (default (1, 1)); signs kept (dy < 0 for rows running downward).
+    origin : (x0, y0), optional
+        Coordinates of ``values[0, 0]`` (default (0, 0)).
+    vertices : array_like of shape (n, 2) or (n, 3), optional
+        Mesh vertex positions (with ``faces``).
+    faces : array_like of int, shape (m, 3), optional
+        Mesh triangles as vertex indices.
+    persistence : float or str, optional
+        Keep the extrema of persistence >= this: a number in the field's units, or a
+        percentage of the value range such as ``"5%"`` (the default rule, at 5 %).
+    minima, maxima : int, optional
+        Keep the N most persistent minima and M most persistent maxima (grids and meshes).
+    pairs : int, optional
+        Series: keep the N most persistent (minimum, maximum) pairs.
+    keep_min, keep_max : sequence of int, optional
+        Keep exactly these vertices (flat indices); checked for realizability.
+    keep_all_maxima, keep_all_minima : bool
+        Keep every maximum (resp. minimum) and only each part's global minimum (maximum).
+    order : int or str
+        Polyharmonic order k (1-4), or a blend such as ``"1:0.5,2:1"``.
+    data_weight : float
+        Weight of the data term (0: the no-data mode, u harmonic).
+    smooth_length : float, optional
+        Smoothing length as a fraction of the domain's diameter (default: chosen from the
+        domain and the kept extrema; the report says which rule set it).
+    smooth_weight : float, optional
+        Energy weight for every order (default: smooth_length ** (2k)).
+    edges : {"minimal", "all"}
+        Constraint set: one lower and one higher neighbour per vertex, or every edge.
+    representative : {"separatrix", "harmonic", "flooded"}, optional
+        Representative function on grids and meshes (default: separatrix, falling back in
+        that order, each fallback reported).
+    fill_missing : bool
+        Fill NaN samples first (linearly on series, harmonically on grids and meshes), as
+        the CLI's ``--fill-missing``; otherwise NaN is an :class:`InputError`.
+    max_iter : int
+        Largest number of solver iterations.
+    solver : {"structured", "clarabel", "clarabel-auxiliary"}
+    formulation : {"auto", "assembled", "factored"}
+
+    Returns
+    -------
+    SmoothResult
+        ``smoothed``, ``representative``, ``roles``, ``kept_minima``, ``kept_maxima``,
+        ``filled``, ``report`` (dict), ``certified`` and ``certificate``; arrays in the
+        input's shape.
+
+    Raises
+    ------
+    UsageError
+        Contradictory or invalid settings (two selection rules, an unknown edge set).
+    InputError
+        NaN without ``fill_missing``, wrong sizes, a degenerate mesh.
+    InfeasibleError
+        An explicit list of extrema that no strict function realizes.
+    CertificateError
+        The output failed its certificate (a bug or a numerical failure).
+    SolverError
+        The solver returned no point.
+
+    Notes
+    -----
+    The computation releases the GIL: other Python threads run meanwhile. Do not modify
+    ``values`` from another thread during the call.
+
+    Examples
+    --------
+    >>> import numpy as np, toposmooth
+    >>> t = np.linspace(0, 6 * np.pi, 600)
+    >>> h = np.sin(t) + 0.2 * np.sin(17 * t)
+    >>> r = toposmooth.smooth(h, pairs=3)
+    >>> r.kept_maxima.size, r.certified
+    (3, True)
+    """
+    domain, flat, shape = _domain(values, x, spacing, origin, vertices, faces)
+    settings = _resolve(
+        dict(
+            persistence=persistence,
+            minima=minima,
+            maxima=maxima,
+            pairs=pairs,
+            keep_min=keep_min,
+            keep_max=keep_max,
+            keep_all_maxima=keep_all_maxima,
+            keep_all_minima=keep_all_minima,
+            order=order,
+            data_weight=data_weight,
+            smooth_length=smooth_length,
+            smooth_weight=smooth_weight,
+            edges=edges,
+            representative=representative,
+            max_iter=max_iter,
+            solver=solver,
+            formulation=formulation,
+        )
+    )
+    flat, filled = _fill(domain, flat, fill_missing)
+    raw = _toposmooth.Smoother(domain, settings).smooth(flat)
+    return SmoothResult(raw, shape, filled)
+
+
+def extrema(
+    values: Any,
+    *,
+    x: Any = None,
+    spacing: Optional[Sequence[float]] = None,
+    origin: Optional[Sequence[float]] = None,
+    vertices: Any = None,
+    faces: Any = None,
+    persistence: Union[float, str, None] = None,
+    minima: Optional[int] = None,
+    maxima: Optional[int] = None,
+    pairs: Optional[int] = None,
+    keep_min: Optional[Sequence[int]] = None,
+    keep_max: Optional[Sequence[int]] = None,
+    keep_all_maxima: bool = False,
+    keep_all_minima: bool = False,
+    fill_missing: bool = False,
+) -> Dict[str, np.ndarray]:
+    """Every extremum of a field with its persistence (simulation of simplicity for ties).
+
+    Parameters
+    ----------
+    values, x, spacing, origin, vertices, faces, fill_missing
+        As in :func:`smooth`.
+    persistence, minima, maxima, pairs, keep_min, keep_max, keep_all_maxima, keep_all_minima
+        A selection, as in :func:`smooth` (default 5 % of the range), for the ``kept`` column.
+
+    Returns
+    -------
+    dict of ndarray, one entry per extremum in (value, index) order
+        ``vertex`` (int64 flat index), ``is_max`` (bool), ``endpoint`` (bool, a series'
+        end), ``value`` (float64), ``persistence`` (float64, inf for each part's essential
+        extrema), ``partner`` (int64, the vertex it pairs with, -1 for none), ``strict``
+        (bool, no equal neighbour) and ``kept`` (bool, kept by the selection).
+    """
+    domain, flat, _ = _domain(values, x, spacing, origin, vertices, faces)
+    flat, _ = _fill(domain, flat, fill_missing)
+    sel = _selection_kwargs(persistence, minima, maxima, pairs, keep_min, keep_max, keep_all_maxima, keep_all_minima)
+    return dict(_toposmooth.extrema(domain, flat, sel))
+
+
+def verify(
+    smoothed: Any,
+    roles: Any,
+    input: Any = None,
+    *,
+    x: Any = None,
+    spacing: Optional[Sequence[float]] = None,
+    origin: Optional[Sequence[float]] = None,
+    vertices: Any = None,
+    faces: Any = None,
+) -> Dict[str, Any]:
+    """Re-check a field's certificate: its strict extrema are exactly the vertices whose role
+    is -1 (minima) and 1 (maxima), every other vertex has a lower and a higher neighbour and,
+    when ``input`` is given, the kept extrema keep their input values.
+
+    Returns
+    -------
+    dict
+        ``passed`` (bool), ``strict_minima``, ``strict_maxima``, ``flat`` (int), ``summary``
+        (str), ``failures`` (list of str: item, vertex and reason) and ``report`` (dict).
+    """
+    domain, f, shape = _domain(smoothed, x, spacing, origin, vertices, faces)
+    r = np.ascontiguousarray(np.asarray(roles), dtype=np.int8).reshape(-1)
+    if r.size != f.size:
+        raise InputError(f"roles has {r.size} entries, the field {f.size}")
+    h = None if input is None else _float64("input", input).reshape(-1)
+    out = dict(_toposmooth.certify(domain, f, r, h))
+    out["report"] = json.loads(out["report"])
+    return out
+
+
+def geodesic(vertices: Any, faces: Any, sources: Sequence[int]) -> np.ndarray:
+    """Geodesic distance on a triangle mesh from the ``sources``, by the heat method.
+
+    Parameters
+    ----------
+    vertices : array_like of shape (n, 2) or (n, 3)
+    faces : array_like of int, shape (m, 3)
+    sources : sequence of int
+        Source vertices.
+
+    Returns
+    -------
+    ndarray of float64, shape (n,)
+        The distance, 0 at the sources.
+    """
+    domain, _, _ = _domain(np.zeros(np.asarray(vertices).shape[0]), vertices=vertices, faces=faces)
+    return _toposmooth.geodesic(domain, [int(s) for s in sources])
+
+
+def weights(
+    vertices: Any,
+    faces: Any,
+    handles: Sequence[Sequence[int]],
+    *,
+    order: int = 2,
+    method: str = "monotone",
+    edges: str = "minimal",
+    threads: int = 2,
+) -> Dict[str, Any]:
+    """Smooth weight functions, one per handle, with no spurious extrema (certified).
+
+    Parameters
+    ----------
+    vertices, faces
+        The mesh, as in :func:`smooth`.
+    handles : sequence of sequences of int
+        Each handle's vertices (a point handle is one vertex); weight 1 there, 0 on the others.
+    order : int
+        Polyharmonic order k (1-4).
+    method : {"monotone", "bounded", "unconstrained", "harmonic"}
+        ``monotone`` certifies that each function has its extrema only at the handles.
+    edges : {"minimal", "all"}
+    threads : int
+        Worker threads for the independent functions.
+
+    Returns
+    -------
+    dict
+        ``weights`` (list of float64 arrays: a partition of unity), ``raw`` (as certified),
+        ``certified`` (bool) and ``max_normalisation_change`` (float).
+    """
+    domain, _, _ = _domain(np.zeros(np.asarray(vertices).shape[0]), vertices=vertices, faces=faces)
+    sets = [[int(v) for v in h] for h in handles]
+    settings = {"order": int(order), "method": method, "edges": edges, "threads": int(threads)}
+    return dict(_toposmooth.weights(domain, sets, settings))

@@ -1,0 +1,43 @@
+"""Type stubs of the extension module (python/src/lib.rs); the package's functions in
+``toposmooth/__init__.py`` are the documented interface."""
+
+from typing import Any, Dict, List, Optional, Tuple
+
+import numpy as np
+import numpy.typing as npt
+
+class Domain:
+    """A series, a regular grid or a triangle mesh (validated)."""
+
+    @staticmethod
+    def series(n: int, x: Optional[npt.NDArray[np.float64]] = None) -> "Domain": ...
+    @staticmethod
+    def grid(nx: int, ny: int, spacing: List[float], origin: List[float]) -> "Domain": ...
+    @staticmethod
+    def mesh(vertices: npt.NDArray[np.float64], faces: npt.NDArray[np.int64]) -> "Domain": ...
+    @property
+    def n_vertices(self) -> int: ...
+    @property
+    def kind(self) -> str: ...
+
+class Smoother:
+    def __init__(self, domain: Domain, settings: Dict[str, Any]) -> None: ...
+    def smooth(self, h: npt.NDArray[np.float64]) -> Dict[str, Any]:
+        """``smoothed``, ``representative`` (float64 (n,)), ``roles`` (int8 (n,)), ``report``
+        (JSON text), ``certified`` (bool)."""
+    @property
+    def n_vertices(self) -> int: ...
+
+def extrema(domain: Domain, h: npt.NDArray[np.float64], settings: Dict[str, Any]) -> Dict[str, np.ndarray]: ...
+def certify(
+    domain: Domain,
+    f: npt.NDArray[np.float64],
+    roles: npt.NDArray[np.int8],
+    input: Optional[npt.NDArray[np.float64]] = None,
+) -> Dict[str, Any]: ...
+def geodesic(domain: Domain, sources: List[int]) -> npt.NDArray[np.float64]: ...
+def weights(domain: Domain, handles: List[List[int]], settings: Dict[str, Any]) -> Dict[str, Any]: ...
+def fill_missing(
+    domain: Domain, h: npt.NDArray[np.float64]
+) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.bool_]]: ...
+def version() -> str: ...

@@ -62,6 +62,7 @@ pub mod derive;
 pub(crate) mod harmonic_order;
 pub mod io;
 pub(crate) mod linalg;
+pub mod parallel;
 pub mod pipeline;
 #[cfg(feature = "plot")]
 pub mod plot;

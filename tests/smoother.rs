@@ -84,3 +84,34 @@ fn a_smoother_can_move_to_another_thread() {
     let any = AnySmoother::new(AnyDomain::Series(Series::uniform(50)), SmoothSettings::default()).unwrap();
     send(&any);
 }
+
+/// Results do not depend on the thread count: one thread runs every parallel part (the
+/// representative beside the solver's analysis, nested dissection's halves, the two-way
+/// factorisation) one after the other, with the plans chosen from the problem alone. The
+/// 120 × 90 grid (10,800 unknowns) is past the size where nested dissection and the two-way
+/// plan are considered; weights run their functions on 1 and 2 workers.
+#[test]
+fn results_are_bit_identical_for_one_and_two_threads() {
+    use toposmooth::parallel::with_threads;
+    let grid = Grid2d::new(120, 90).unwrap();
+    let settings = SmoothSettings { selection: Selection::Relative(0.1), ..Default::default() };
+    for h in fields(&grid, 11).iter().take(2) {
+        let one = with_threads(1, || smooth(&grid, h, &settings).unwrap());
+        let two = with_threads(2, || smooth(&grid, h, &settings).unwrap());
+        assert!(one.report.certificate.passed);
+        assert_eq!(one.output, two.output, "the outputs differ between 1 and 2 threads");
+        assert_eq!((one.u, one.roles), (two.u, two.roles));
+    }
+    use toposmooth::apps::weights::{weights, WeightSettings};
+    let sheet = Grid2d::new(70, 50).unwrap();
+    let handles = vec![vec![0], vec![69], vec![70 * 49 + 35]];
+    let run = |threads: usize| {
+        let s = WeightSettings { threads, ..Default::default() };
+        with_threads(threads, || weights(&sheet, &handles, &s).unwrap())
+    };
+    let (one, two) = (run(1), run(2));
+    for (a, b) in one.functions.iter().zip(&two.functions) {
+        assert!(a.certificate.passed);
+        assert_eq!(a.raw, b.raw, "weight {} differs between 1 and 2 threads", a.handle);
+    }
+}

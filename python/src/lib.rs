@@ -255,6 +255,7 @@ fn smooth_settings(py: Python<'_>, d: &Bound<'_, PyDict>) -> PyResult<SmoothSett
         "max_iter",
         "solver",
         "formulation",
+        "threads",
     ];
     for key in d.keys() {
         let key: String = key.extract()?;
@@ -304,16 +305,28 @@ fn role_codes(roles: &[Role]) -> Vec<i8> {
 #[pyclass(module = "toposmooth._toposmooth")]
 struct Smoother {
     inner: AnySmoother,
+    /// The thread cap of each call ([`toposmooth::parallel::with_threads`]).
+    threads: usize,
+}
+
+/// The `threads` setting: at most this many threads per call (default the library's 2).
+fn threads(py: Python<'_>, d: &Bound<'_, PyDict>) -> PyResult<usize> {
+    match get::<usize>(py, d, "threads")? {
+        None => Ok(toposmooth::parallel::DEFAULT_THREADS),
+        Some(0) => Err(usage(py, "threads must be at least 1".into())),
+        Some(n) => Ok(n),
+    }
 }
 
 #[pymethods]
 impl Smoother {
     #[new]
     fn new(py: Python<'_>, domain: &Domain, settings: &Bound<'_, PyDict>) -> PyResult<Self> {
+        let threads = threads(py, settings)?;
         let settings = smooth_settings(py, settings)?;
         let domain = domain.inner.clone();
         let inner = py.detach(|| AnySmoother::new(domain, settings)).map_err(|e| to_py(py, e))?;
-        Ok(Smoother { inner })
+        Ok(Smoother { inner, threads })
     }
 
     /// Smooths one field: a dict with `smoothed`, `representative` (float64), `roles` (int8
@@ -325,8 +338,9 @@ impl Smoother {
         if h.len() != n {
             return Err(to_py(py, Error::input(format!("values has {} entries, the domain {n} vertices", h.len()))));
         }
-        let inner = &mut self.inner;
-        let out = py.detach(|| inner.smooth(h)).map_err(|e| to_py(py, e))?;
+        let (inner, threads) = (&mut self.inner, self.threads);
+        let out =
+            py.detach(|| toposmooth::parallel::with_threads(threads, || inner.smooth(h))).map_err(|e| to_py(py, e))?;
         let report = serde_json::to_string(&out.report).map_err(|e| to_py(py, Error::internal(e.to_string())))?;
         let d = PyDict::new(py);
         d.set_item("certified", out.report.certificate.passed)?;
@@ -476,11 +490,14 @@ fn weights<'py>(
         threads: get::<usize>(py, settings, "threads")?.unwrap_or(2).max(1),
     };
     let d = &domain.inner;
+    let cap = ws.threads;
     let w = py
-        .detach(|| match d {
-            AnyDomain::Series(s) => toposmooth::apps::weights::weights(s, &handles, &ws),
-            AnyDomain::Grid(g) => toposmooth::apps::weights::weights(g, &handles, &ws),
-            AnyDomain::Mesh(m) => toposmooth::apps::weights::weights(m, &handles, &ws),
+        .detach(|| {
+            toposmooth::parallel::with_threads(cap, || match d {
+                AnyDomain::Series(s) => toposmooth::apps::weights::weights(s, &handles, &ws),
+                AnyDomain::Grid(g) => toposmooth::apps::weights::weights(g, &handles, &ws),
+                AnyDomain::Mesh(m) => toposmooth::apps::weights::weights(m, &handles, &ws),
+            })
         })
         .map_err(|e| to_py(py, e))?;
     let out = PyDict::new(py);
@@ -501,11 +518,7 @@ type Filled<'py> = (Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<bool>>);
 /// on a series (the ends stepped one ulp per sample), harmonically on grids and meshes. Returns
 /// the filled copy and the mask of filled samples; infinities are refused.
 #[pyfunction]
-fn fill_missing<'py>(
-    py: Python<'py>,
-    domain: &Domain,
-    h: PyReadonlyArray1<'py, f64>,
-) -> PyResult<Filled<'py>> {
+fn fill_missing<'py>(py: Python<'py>, domain: &Domain, h: PyReadonlyArray1<'py, f64>) -> PyResult<Filled<'py>> {
     let mut v = values(py, "values", &h)?.to_vec();
     let d = &domain.inner;
     if v.len() != d.n_vertices() {

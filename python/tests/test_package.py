@@ -260,3 +260,16 @@ def test_the_readme_example_runs(datasets, capsys, monkeypatch):
     exec(compile(blocks[0], "README.md", "exec"), {})
     lines = capsys.readouterr().out.split("\n")
     assert lines[0] == "9 4 True" and lines[1].startswith("0.02348"), lines
+
+
+def test_results_do_not_depend_on_the_thread_count(datasets):
+    h = piv(datasets)
+    one = toposmooth.smooth(h, minima=9, maxima=4, fill_missing=True, threads=1)
+    two = toposmooth.smooth(h, minima=9, maxima=4, fill_missing=True, threads=2)
+    assert np.array_equal(one.smoothed, two.smoothed) and np.array_equal(one.roles, two.roles)
+    y, x = np.mgrid[0:90, 0:120]
+    g = np.sin(x / 11.0) * np.cos(y / 8.0) + 0.05 * np.random.default_rng(2).standard_normal(x.shape)
+    s1, s2 = toposmooth.Smoother(g.shape, persistence="10%", threads=1), toposmooth.Smoother(g.shape, persistence="10%")
+    assert np.array_equal(s1.smooth(g).smoothed, s2.smooth(g).smoothed)
+    with pytest.raises(toposmooth.UsageError):
+        toposmooth.smooth(g, threads=0)

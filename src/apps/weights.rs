@@ -381,25 +381,29 @@ pub fn weights_prescribed<D: Smoothable + Sync>(
         let done = AtomicUsize::new(0);
         let stage = crate::progress::Stage::begin("weights");
         let threads = settings.threads.clamp(1, count);
+        let inner = (crate::parallel::threads() / threads).max(1);
         let mut results: Vec<Option<Result<WeightFunction>>> = (0..count).map(|_| None).collect();
         std::thread::scope(|s| {
             let workers: Vec<_> = (0..threads)
                 .map(|_| {
                     s.spawn(|| {
-                        // one function per core already: no nested two-thread factorisations;
-                        // the normal matrix's analysis is shared by this thread's functions
-                        let mut analyses = Analyses::new(threads == 1);
-                        let mut mine = Vec::new();
-                        loop {
-                            let h = next.fetch_add(1, Ordering::Relaxed);
-                            if h >= count {
-                                break;
+                        // the cap shared among the workers (the same results for any split: the
+                        // plans do not depend on the thread count); the normal matrix's
+                        // analysis is shared by this thread's functions
+                        crate::parallel::with_threads(inner, || {
+                            let mut analyses = Analyses::new();
+                            let mut mine = Vec::new();
+                            loop {
+                                let h = next.fetch_add(1, Ordering::Relaxed);
+                                if h >= count {
+                                    break;
+                                }
+                                mine.push((h, one_function(domain, &prescribed[h], h, &ops, settings, &mut analyses)));
+                                let d = done.fetch_add(1, Ordering::Relaxed) + 1;
+                                stage.update(|| format!("{d} of {count} functions"));
                             }
-                            mine.push((h, one_function(domain, &prescribed[h], h, &ops, settings, &mut analyses)));
-                            let d = done.fetch_add(1, Ordering::Relaxed) + 1;
-                            stage.update(|| format!("{d} of {count} functions"));
-                        }
-                        mine
+                            mine
+                        })
                     })
                 })
                 .collect();

@@ -22,10 +22,10 @@ pub fn solve_spd(
 
 /// The analyses a sequence of factorisations reuses, held by the caller: the last patterns
 /// analysed with their analyses (a run's geodesic distance and harmonic fills share the
-/// Laplacian's, the weight functions of a thread their normal matrix's), and whether an
-/// analysis may plan a factorisation over two threads. Nothing is kept anywhere else.
+/// Laplacian's, the weight functions of a thread their normal matrix's). Nothing is kept
+/// anywhere else.
+#[derive(Default)]
 pub struct Analyses {
-    split_allowed: bool,
     /// Most recent last; at most [`Analyses::KEPT`].
     kept: Vec<(SymbolicSparseColMat<usize>, std::sync::Arc<Analysis>)>,
 }
@@ -35,19 +35,13 @@ fn same_pattern(a: SymbolicSparseColMatRef<'_, usize>, b: SymbolicSparseColMatRe
     a.nrows() == b.nrows() && a.col_ptr() == b.col_ptr() && a.row_idx() == b.row_idx()
 }
 
-impl Default for Analyses {
-    fn default() -> Self {
-        Analyses::new(true)
-    }
-}
-
 impl Analyses {
     /// Patterns kept at once (a Laplacian, the energy and a normal matrix).
     const KEPT: usize = 3;
 
-    /// An empty store; `split_allowed`: see `analyse`.
-    pub fn new(split_allowed: bool) -> Self {
-        Analyses { split_allowed, kept: Vec::new() }
+    /// An empty store.
+    pub fn new() -> Self {
+        Analyses::default()
     }
 
     /// The analysis of `pattern`: a kept one for the same pattern, else a new one, then kept.
@@ -64,7 +58,7 @@ impl Analyses {
             self.kept.push(entry);
             return Ok(analysis);
         }
-        let analysis = std::sync::Arc::new(analyse(pattern, self.split_allowed)?);
+        let analysis = std::sync::Arc::new(analyse(pattern)?);
         self.keep(pattern.to_owned().map_err(|e| format!("{e:?}"))?, analysis.clone());
         Ok(analysis)
     }
@@ -82,11 +76,6 @@ impl Analyses {
     /// Drops every kept analysis (a million-vertex Laplacian's is hundreds of MiB).
     pub fn clear(&mut self) {
         self.kept.clear();
-    }
-
-    /// Whether analyses made here may plan two-thread factorisations.
-    pub fn split_allowed(&self) -> bool {
-        self.split_allowed
     }
 }
 

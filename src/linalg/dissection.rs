@@ -259,13 +259,13 @@ pub(super) fn dissection(g: &Graph, leaf_size: usize, parallel: bool) -> (Vec<us
     let (out_a, rest) = out.split_at_mut(la);
     let out_b = &mut rest[..lb];
     if parallel {
-        // the other part on another thread, with its own bookkeeping and part numbers
+        // the other part with its own bookkeeping and part numbers, on another thread where
+        // the cap allows one (the ordering is the same either way)
         let mut d2 = Dissect { owner: d.owner.clone(), ..Dissect::new(g, u32::MAX / 2) };
-        std::thread::scope(|scope| {
-            let other = scope.spawn(move || d2.run(vec![(pb, part_b, la)], out_b, la, leaf_size));
-            d.run(vec![(pa, part_a, 0)], out_a, 0, leaf_size);
-            other.join().unwrap_or_else(|e| std::panic::resume_unwind(e));
-        });
+        crate::parallel::join(
+            || d.run(vec![(pa, part_a, 0)], out_a, 0, leaf_size),
+            move || d2.run(vec![(pb, part_b, la)], out_b, la, leaf_size),
+        );
     } else {
         d.run(vec![(pa, part_a, 0)], out_a, 0, leaf_size);
         d.run(vec![(pb, part_b, la)], out_b, la, leaf_size);

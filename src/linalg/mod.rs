@@ -139,14 +139,17 @@ const PARALLEL_MIN_FLOPS: f64 = 2e10;
 /// dissection and AMD side by side, then the cheapest of AMD, nested dissection on one
 /// factorisation, and nested dissection's two halves on two threads (estimated time: flops on
 /// the critical path). From [`ND_ONLY_N`] unknowns on, nested dissection alone. Without
-/// `split_allowed` (callers that already run one problem per core) no two-thread plan.
+/// The plan depends on the pattern only: its two halves run on two threads where
+/// [`crate::parallel::threads`] allows it, one after the other otherwise, with the same result.
 ///
 /// # Errors
 /// A message if faer's analysis fails.
-pub(crate) fn analyse(
-    a: SymbolicSparseColMatRef<'_, usize>,
-    split_allowed: bool,
-) -> std::result::Result<Analysis, NumericalError> {
+pub(crate) fn analyse(a: SymbolicSparseColMatRef<'_, usize>) -> std::result::Result<Analysis, NumericalError> {
+    plan(a, true)
+}
+
+/// [`analyse`], with or without the two-way plan (tests compare the single ones).
+fn plan(a: SymbolicSparseColMatRef<'_, usize>, two_way: bool) -> std::result::Result<Analysis, NumericalError> {
     let n = a.ncols();
     let single = |symbolic: SymbolicCholesky<usize>| {
         let par = parallelism_for(&symbolic);
@@ -162,8 +165,8 @@ pub(crate) fn analyse(
     let nd = || -> Result<Result<two_way::Symbolic, SymbolicCholesky<usize>>, NumericalError> {
         // the dissection's own second thread only where the factorisation may use one
         let g = Graph::from_pattern(a);
-        let (perm, top) = dissection(&g, ND_LEAF, split_allowed && n >= PARALLEL_DISSECTION_MIN);
-        if let Some(t) = top.filter(|_| split_allowed).and_then(|sizes| two_way::Symbolic::new(a, &perm, sizes)) {
+        let (perm, top) = dissection(&g, ND_LEAF, n >= PARALLEL_DISSECTION_MIN);
+        if let Some(t) = top.filter(|_| two_way).and_then(|sizes| two_way::Symbolic::new(a, &perm, sizes)) {
             return Ok(Ok(t));
         }
         let inv = inverse(&perm);
@@ -183,11 +186,7 @@ pub(crate) fn analyse(
             }
         });
     }
-    let (amd, nd) = std::thread::scope(|scope| {
-        let other = scope.spawn(amd);
-        let nd = nd();
-        (other.join().unwrap_or_else(|e| std::panic::resume_unwind(e)), nd)
-    });
+    let (nd, amd) = crate::parallel::join(nd, amd);
     let (amd, nd) = (amd?, nd?);
     let time = |s: &SymbolicCholesky<usize>| {
         let f = factor_flops(s);
@@ -358,7 +357,7 @@ mod tests {
 
     /// [`analyse`] restricted to one factorisation (AMD or nested dissection).
     fn single_analysis(a: SymbolicSparseColMatRef<'_, usize>) -> SymbolicCholesky<usize> {
-        match analyse(a, false).unwrap() {
+        match plan(a, false).unwrap() {
             Analysis::Single { symbolic, .. } => *symbolic,
             Analysis::TwoWay(_) => panic!("split forbidden"),
         }
@@ -459,7 +458,7 @@ mod tests {
             let n = nx * ny;
             let a = upper_pattern(n, &grid_edges(nx, ny, ring2));
             let vals = spd_values(a.as_ref());
-            let analysis = analyse(a.as_ref(), true).unwrap();
+            let analysis = analyse(a.as_ref()).unwrap();
             let Analysis::TwoWay(t) = &analysis else { panic!("{nx}x{ny}: a grid is split in two") };
             // the separator is a thin cut: one or two grid lines across
             assert!(t.separator_len() <= 3 * nx.max(ny), "separator {}", t.separator_len());
@@ -487,7 +486,7 @@ mod tests {
         e.extend(grid_edges(30, 30, false).into_iter().map(|(i, j)| (i + 2000, j + 2000)));
         let n = 2000 + 900;
         let a = upper_pattern(n, &e);
-        let analysis = analyse(a.as_ref(), true).unwrap();
+        let analysis = analyse(a.as_ref()).unwrap();
         assert!(matches!(analysis, Analysis::Single { .. }));
         let vals = spd_values(a.as_ref());
         let mut f = SpdFactor::new(std::sync::Arc::new(analysis)).unwrap();
@@ -506,7 +505,7 @@ mod tests {
         // parts = first and second half of the rows, "separator" = the last row: they touch
         let perm: Vec<usize> = (0..n).collect();
         assert!(two_way::Symbolic::new(a.as_ref(), &perm, [n / 2, n / 2 - nx]).is_none());
-        assert!(matches!(analyse(a.as_ref(), false).unwrap(), Analysis::Single { .. }));
+        assert!(matches!(plan(a.as_ref(), false).unwrap(), Analysis::Single { .. }));
     }
 
     #[test]

@@ -126,10 +126,7 @@ impl Symbolic {
         };
         // the two halves side by side
         let [t0, t1] = triplets;
-        let (h0, h1) = std::thread::scope(|scope| {
-            let other = scope.spawn(|| half(1, t1));
-            (half(0, t0), other.join().unwrap_or_else(|e| std::panic::resume_unwind(e)))
-        });
+        let (h0, h1) = crate::parallel::join(|| half(0, t0), || half(1, t1));
         Some(Symbolic { n, halves: [h0?, h1?], sep, sep_entries })
     }
 
@@ -231,11 +228,8 @@ impl TwoWay {
         let [n0, n1] = &mut self.halves;
         let [h0, h1] = &s.halves;
         let (sigma, gram) = (&mut self.sigma, &mut self.gram);
-        let (r0, r1) = std::thread::scope(|scope| {
-            let other = scope.spawn(|| factor_half(h1, n1, values, gram));
-            let mine = factor_half(h0, n0, values, sigma);
-            (mine, other.join().unwrap_or_else(|e| std::panic::resume_unwind(e)))
-        });
+        let (r0, r1) =
+            crate::parallel::join(|| factor_half(h0, n0, values, sigma), || factor_half(h1, n1, values, gram));
         r0?;
         r1?;
         let ls = s.sep.len();
@@ -269,10 +263,7 @@ impl TwoWay {
         let [n0, n1] = &mut self.halves;
         let [h0, h1] = &s.halves;
         let rhs_ro: &[f64] = rhs;
-        let (g0, g1) = std::thread::scope(|scope| {
-            let other = scope.spawn(|| forward_half(h1, n1, rhs_ro, ls));
-            (forward_half(h0, n0, rhs_ro, ls), other.join().unwrap_or_else(|e| std::panic::resume_unwind(e)))
-        });
+        let (g0, g1) = crate::parallel::join(|| forward_half(h0, n0, rhs_ro, ls), || forward_half(h1, n1, rhs_ro, ls));
         let mut xs = Mat::<f64>::zeros(ls, 1);
         for k in 0..ls {
             xs[(k, 0)] = rhs[s.sep[k]] + g0[k] + g1[k];
@@ -285,11 +276,7 @@ impl TwoWay {
             par,
         );
         let xs_ref = xs.as_ref();
-        std::thread::scope(|scope| {
-            let other = scope.spawn(|| backward_half(h1, n1, xs_ref));
-            backward_half(h0, n0, xs_ref);
-            other.join().unwrap_or_else(|e| std::panic::resume_unwind(e));
-        });
+        crate::parallel::join(|| backward_half(h0, n0, xs_ref), || backward_half(h1, n1, xs_ref));
         for (h, num) in s.halves.iter().zip(&self.halves) {
             for (k, &v) in h.verts.iter().enumerate() {
                 rhs[v] = num.work[k];

@@ -151,28 +151,27 @@ pub(crate) fn smooth_on<D: Smoothable + Sync>(
 
     // The energy and the solver's analysis of its normal matrix need only the kept set: they
     // are built on the other core while the complex and the representative are.
-    let split = analyses.split_allowed();
-    let (ordered, (operators, operators_seconds, prepared)) = std::thread::scope(|scope| {
-        let background = scope.spawn(|| {
+    let (ordered, (operators, operators_seconds, prepared)) = crate::parallel::join(
+        || {
+            let stage = Stage::begin("representative");
+            let ordered = order_representative(domain, &problem, settings, ops.fill(), analyses, &mut seconds);
+            if let Ok(o) = &ordered {
+                stage.end(|| format!("{}, {} constraint edges", o.name, o.edges.len()));
+            }
+            ordered
+        },
+        || {
             let t = Instant::now();
             let built = build_operators(domain, (&ops.stiffness, &ops.mass), settings, length.0, &problem);
             let seconds = t.elapsed().as_secs_f64();
             let prepared = match (&built, settings.qp.method) {
                 // a failed analysis is redone (and reported) by the solver itself
-                (Ok(o), Method::Structured) if o.factor.is_none() => {
-                    crate::solve::prepare(&o.p, &problem.fixed, split).ok()
-                }
+                (Ok(o), Method::Structured) if o.factor.is_none() => crate::solve::prepare(&o.p, &problem.fixed).ok(),
                 _ => None,
             };
             (built, seconds, prepared)
-        });
-        let stage = Stage::begin("representative");
-        let ordered = order_representative(domain, &problem, settings, ops.fill(), analyses, &mut seconds);
-        if let Ok(o) = &ordered {
-            stage.end(|| format!("{}, {} constraint edges", o.name, o.edges.len()));
-        }
-        (ordered, background.join().unwrap_or_else(|e| std::panic::resume_unwind(e)))
-    });
+        },
+    );
     let ordered = ordered?;
     let operators = operators?;
     seconds.operators = operators_seconds;

@@ -58,8 +58,8 @@ pub(super) struct Normal<'r> {
 
 impl<'r> Normal<'r> {
     /// The pattern of `P + AᵀWA` (P's on the free variables and the constrained pairs), `F`'s
-    /// Gram matrix on it in double-double, and its symbolic factorisation (`split_allowed`:
-    /// see [`linalg::analyse`]).
+    /// Gram matrix on it in double-double, and its symbolic factorisation
+    /// ([`linalg::analyse`]).
     ///
     /// # Errors
     /// A message if `FᵀF` has an entry outside `P`'s pattern or the analysis fails.
@@ -68,7 +68,6 @@ impl<'r> Normal<'r> {
         f: &'r ReducedFactor,
         row_cols: &[[usize; 2]],
         row_len: &[u8],
-        split: bool,
     ) -> std::result::Result<Normal<'r>, crate::error::NumericalError> {
         let pattern = Pattern::new(r, row_cols, row_len);
         let (cp, ri) = (pattern.symbolic.col_ptr(), pattern.symbolic.row_idx());
@@ -99,7 +98,7 @@ impl<'r> Normal<'r> {
         for (j, &d) in r.d.iter().enumerate() {
             base[pattern.pos_diag[j]] += fx128::from(d);
         }
-        let analysis = std::sync::Arc::new(linalg::analyse(pattern.symbolic.as_ref(), split)?);
+        let analysis = std::sync::Arc::new(linalg::analyse(pattern.symbolic.as_ref())?);
         let spd = linalg::SpdFactor::new(analysis)?;
         Ok(Normal {
             f,

@@ -138,8 +138,7 @@ pub(super) fn solve(
     match &r.factor {
         Some(factor) => {
             drop(spare);
-            let split = analyses.split_allowed();
-            let mut objective = super::factored::Normal::new(r, factor, &rows.cols, &rows.len, split)?;
+            let mut objective = super::factored::Normal::new(r, factor, &rows.cols, &rows.len)?;
             run::<faer::fx128, _>(r, &rows, &mut objective, hint, settings)
         }
         None => {

@@ -88,7 +88,6 @@ impl Prepared {
         p: SymbolicSparseColMatRef<'_, usize>,
         slot: &[usize],
         n: usize,
-        split_allowed: bool,
     ) -> std::result::Result<Prepared, crate::error::NumericalError> {
         let (cp, ri) = (p.col_ptr(), p.row_idx());
         let pairs = (0..p.ncols()).flat_map(|j| {
@@ -99,7 +98,7 @@ impl Prepared {
         });
         let (col_ptr, row_idx) = upper_pattern(n, pairs);
         let pattern = SymbolicSparseColMat::new_checked(n, n, col_ptr, None, row_idx);
-        let analysis = ordering::analyse(pattern.as_ref(), split_allowed)?;
+        let analysis = ordering::analyse(pattern.as_ref())?;
         // without it (faer's scratch could not be allocated) the solver makes the storage
         let workspace = ordering::Workspace::new(&analysis).ok();
         Ok(Prepared { pattern, analysis, workspace })

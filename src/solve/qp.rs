@@ -128,11 +128,7 @@ pub fn solve_monotone_qp_with(
 ///
 /// # Errors
 /// A message if the analysis fails.
-pub fn prepare(
-    p: &Sparse,
-    fixed: &[Option<f64>],
-    split_allowed: bool,
-) -> std::result::Result<Prepared, crate::error::NumericalError> {
+pub fn prepare(p: &Sparse, fixed: &[Option<f64>]) -> std::result::Result<Prepared, crate::error::NumericalError> {
     let mut slot = vec![usize::MAX; fixed.len()];
     let mut n = 0;
     for (i, f) in fixed.iter().enumerate() {
@@ -141,7 +137,7 @@ pub fn prepare(
             n += 1;
         }
     }
-    Prepared::new(p.symbolic(), &slot, n, split_allowed)
+    Prepared::new(p.symbolic(), &slot, n)
 }
 
 #[cfg(test)]
@@ -194,7 +190,7 @@ mod tests {
         };
         let free: Vec<usize> = (0..n).filter(|&i| fixed[i].is_none()).collect();
         let reduced = reduce(&qp, &free);
-        let prepared = prepare(&p, &fixed, true).unwrap();
+        let prepared = prepare(&p, &fixed).unwrap();
         let normal = super::super::ipm::normal_pattern(&reduced);
         let same = |a: faer::sparse::SymbolicSparseColMatRef<'_, usize>| {
             a.col_ptr() == normal.col_ptr() && a.row_idx() == normal.row_idx()
@@ -207,8 +203,7 @@ mod tests {
         let settings = QpSettings::default();
         let plain = solve_monotone_qp(&qp, &settings).unwrap();
         let mut analyses = Analyses::default();
-        let with =
-            solve_monotone_qp_with(&qp, &settings, &mut analyses, Some(prepare(&p, &fixed, true).unwrap())).unwrap();
+        let with = solve_monotone_qp_with(&qp, &settings, &mut analyses, Some(prepare(&p, &fixed).unwrap())).unwrap();
         assert_eq!(plain.iterations, with.iterations);
         // kept for the next solve on the pattern: the same result again
         let again = solve_monotone_qp_with(&qp, &settings, &mut analyses, None).unwrap();

@@ -1,0 +1,75 @@
+//! How many threads a computation may use, per calling thread: [`with_threads`] caps it,
+//! [`join`] runs two independent parts side by side when the cap allows two threads and one
+//! after the other otherwise. Every parallel split of the library (the representative beside
+//! the solver's analysis, nested dissection's two halves, the two-way factorisation, weight
+//! functions) goes through it, and none changes what is computed: the orderings and plans are
+//! chosen from the problem alone, so results are bit-identical for every thread count.
+//!
+//! ```
+//! use toposmooth::parallel::{join, threads, with_threads};
+//! assert_eq!(threads(), toposmooth::parallel::DEFAULT_THREADS);
+//! let (a, b) = with_threads(1, || join(threads, threads));
+//! assert_eq!((a, b), (1, 1));
+//! ```
+
+use std::cell::Cell;
+
+/// The cap when no caller set one: the two cores the library is tuned for.
+pub const DEFAULT_THREADS: usize = 2;
+
+thread_local! {
+    static LIMIT: Cell<usize> = const { Cell::new(DEFAULT_THREADS) };
+}
+
+/// The number of threads the current thread's computations may use (at least 1).
+pub fn threads() -> usize {
+    LIMIT.with(Cell::get)
+}
+
+/// Runs `f` with at most `n` threads (`n` = 0 is taken as 1), restoring the previous cap after.
+pub fn with_threads<R>(n: usize, f: impl FnOnce() -> R) -> R {
+    struct Restore(usize);
+    impl Drop for Restore {
+        fn drop(&mut self) {
+            LIMIT.with(|l| l.set(self.0));
+        }
+    }
+    let _restore = Restore(LIMIT.with(|l| l.replace(n.max(1))));
+    f()
+}
+
+/// Runs `a` on this thread and `b` on another when two threads are allowed (the cap is split
+/// between them), else `a` then `b` here. A panic in either is propagated.
+pub fn join<RA, RB: Send>(a: impl FnOnce() -> RA, b: impl FnOnce() -> RB + Send) -> (RA, RB) {
+    let n = threads();
+    if n < 2 {
+        let ra = a();
+        return (ra, b());
+    }
+    let (na, nb) = (n - n / 2, n / 2);
+    std::thread::scope(|scope| {
+        let other = scope.spawn(move || with_threads(nb, b));
+        let ra = with_threads(na, a);
+        (ra, other.join().unwrap_or_else(|e| std::panic::resume_unwind(e)))
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_cap_is_split_and_restored() {
+        assert_eq!(threads(), DEFAULT_THREADS);
+        let main = std::thread::current().id();
+        let (a, b) = with_threads(4, || join(|| (threads(), std::thread::current().id()), threads));
+        assert_eq!((a.0, b), (2, 2));
+        assert_eq!(a.1, main, "a runs on the calling thread");
+        let ids = with_threads(1, || join(|| std::thread::current().id(), || std::thread::current().id()));
+        assert_eq!(ids, (main, main), "one thread: both parts here");
+        assert_eq!(threads(), DEFAULT_THREADS);
+        let r = std::panic::catch_unwind(|| with_threads(3, || -> usize { panic!("inside") }));
+        assert!(r.is_err());
+        assert_eq!(threads(), DEFAULT_THREADS, "restored after a panic");
+    }
+}

@@ -554,6 +554,29 @@ fn fill_missing<'py>(py: Python<'py>, domain: &Domain, h: PyReadonlyArray1<'py, 
     Ok((PyArray1::from_vec(py, v), PyArray1::from_vec(py, mask)))
 }
 
+/// Runs one CLI command in this process (`args` without the program's name, e.g.
+/// `["smooth", "a.vti", "-o", "b.vti"]`) and returns what the tool prints on standard output;
+/// errors are raised as the package's exceptions with the CLI's message.
+/// `threads` caps the threads the command uses (default 2).
+#[pyfunction]
+#[pyo3(signature = (args, threads=None))]
+fn run(py: Python<'_>, args: Vec<String>, threads: Option<usize>) -> PyResult<String> {
+    let cap = threads.unwrap_or(toposmooth::parallel::DEFAULT_THREADS).max(1);
+    py.detach(|| {
+        toposmooth::parallel::with_threads(cap, || {
+            toposmooth::commands::catch_panics(|| toposmooth::commands::cli::run_args(&args))
+        })
+    })
+    .map_err(|e| to_py(py, e))
+}
+
+/// The `toposmooth` console script: the CLI's `main` on `argv` (program name first); returns
+/// its exit status.
+#[pyfunction]
+fn main(py: Python<'_>, argv: Vec<String>) -> i32 {
+    py.detach(|| toposmooth::commands::cli::main(argv.into_iter().map(std::ffi::OsString::from)))
+}
+
 /// The library's version.
 #[pyfunction]
 fn version() -> &'static str {
@@ -569,6 +592,8 @@ fn _toposmooth(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(geodesic, m)?)?;
     m.add_function(wrap_pyfunction!(weights, m)?)?;
     m.add_function(wrap_pyfunction!(fill_missing, m)?)?;
+    m.add_function(wrap_pyfunction!(run, m)?)?;
+    m.add_function(wrap_pyfunction!(main, m)?)?;
     m.add_function(wrap_pyfunction!(version, m)?)?;
     Ok(())
 }

@@ -246,6 +246,9 @@ def test_help_reads_like_numpy():
 def test_the_docstring_examples_run():
     failures, tried = doctest.testmod(toposmooth, optionflags=doctest.NORMALIZE_WHITESPACE)
     assert tried >= 4 and failures == 0
+    pytest.importorskip("xarray")
+    failures, tried = doctest.testmod(toposmooth.xarray, optionflags=doctest.NORMALIZE_WHITESPACE)
+    assert tried >= 4 and failures == 0
 
 
 def test_the_readme_example_runs(datasets, capsys, monkeypatch):

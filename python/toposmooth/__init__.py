@@ -658,3 +658,35 @@ def weights(
     sets = [[int(v) for v in h] for h in handles]
     settings = {"order": int(order), "method": method, "edges": edges, "threads": int(threads)}
     return dict(_toposmooth.weights(domain, sets, settings))
+
+
+def _flags(settings: Dict[str, Any]) -> List[str]:
+    """Keyword settings as CLI flags: ``minima=9`` -> ``--minima 9``, ``fill_missing=True`` ->
+    ``--fill-missing``, lists comma-joined; None and False are left out."""
+    out: List[str] = []
+    for key, value in settings.items():
+        flag = "--" + key.replace("_", "-")
+        if value is None or value is False:
+            continue
+        if value is True:
+            out.append(flag)
+        elif isinstance(value, (list, tuple, np.ndarray)):
+            out += [flag, ",".join(str(v) for v in value)]
+        else:
+            out += [flag, str(value)]
+    return out
+
+
+def cli(*args: Any, threads: Optional[int] = None) -> str:
+    """Run one command of the command-line tool in this process and return what it prints.
+
+    ``toposmooth.cli("smooth", "in.vti", "-o", "out.vti", "--minima", 3)`` is the CLI's
+    ``toposmooth smooth in.vti -o out.vti --minima 3``, reading and writing the files the same
+    way (every format the CLI knows, certified outputs, the JSON report). Errors are raised as
+    this package's exceptions (:class:`UsageError` for arguments the CLI refuses).
+    """
+    return _toposmooth.run([str(a) for a in args], threads)
+
+
+# the submodules for many fields (they import xarray and dask only when used)
+from . import dask, xarray  # noqa: E402

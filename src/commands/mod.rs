@@ -2,6 +2,7 @@
 //! `main.rs` only parses arguments into these option structs and maps errors to exit codes.
 
 mod bench;
+pub mod cli;
 mod deform;
 mod diffuse;
 mod extrema;

@@ -1,0 +1,610 @@
+//! The command line: its arguments (clap) turned into the commands' arguments. The binary
+//! (`src/main.rs`) calls [`main`]; the Python package runs a command in its own process with
+//! [`run_args`].
+
+use crate::apps::skinning::Skinning;
+use crate::apps::weights::WeightMethod;
+use crate::commands::input::{Derive, DomainKind, GridOptions};
+use crate::commands::{self, BenchArgs, ExtremaArgs, SmoothArgs, VerifyArgs};
+use crate::constraints::EdgeSet;
+use crate::domain::{MAX_SPACING, MIN_SPACING};
+use crate::io::series_csv::SeriesCsvOptions;
+use crate::operators::Energy;
+use crate::pipeline::{RepresentativeChoice, SmoothSettings};
+use crate::plot::MeshView;
+use crate::solve::{Formulation, Method, QpSettings};
+use crate::topology::Selection;
+use crate::{Error, Result};
+use clap::{Args, Parser, Subcommand};
+use std::path::PathBuf;
+
+/// Smooth scalar fields keeping exactly the extrema you choose, with a certificate.
+#[derive(Parser)]
+#[command(name = "toposmooth", version, about, long_about = None)]
+struct Cli {
+    /// No progress on standard error (the stages, the input's summary); errors and warnings
+    /// are still printed.
+    #[arg(long, short, global = true)]
+    quiet: bool,
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// List the extrema with their persistence and strictness; draw the persistence diagram.
+    Extrema {
+        /// Input: a series (CSV), a grid (.vti, .vtk, .npy, CSV matrix, PNG, TIFF) or a mesh
+        /// (.obj, .off, .ply, .vtu, .vtp, legacy .vtk polydata).
+        #[arg(required_unless_present = "u")]
+        input: Option<PathBuf>,
+        #[command(flatten)]
+        csv: CsvArgs,
+        #[command(flatten)]
+        grid: GridCli,
+        /// Print JSON.
+        #[arg(long)]
+        json: bool,
+        /// Persistence diagram PNG.
+        #[arg(long, value_name = "PNG")]
+        plot: Option<PathBuf>,
+        /// Persistence diagram in TTK's layout (.vtu): one line cell per pair, threshold on
+        /// `Persistence` in ParaView to select pairs.
+        #[arg(long, value_name = "VTU")]
+        diagram: Option<PathBuf>,
+        /// Mark the extrema kept at this persistence: `5%` of the range or an absolute value.
+        #[arg(long, default_value = "5%")]
+        persistence: String,
+    },
+    /// Smooth a series keeping exactly the selected extrema; certify the output.
+    Smooth(Box<SmoothCli>),
+    /// Re-check an output file of `smooth` (or a weights file of `weights`/`diffuse`) from what it carries.
+    Verify {
+        /// Output file of `smooth`: series CSV (x,input,output,u,role), .vti, .npz, .vtu, .vtp
+        /// or .ply.
+        file: PathBuf,
+        /// The original input: check the file's input array against it (read with the same
+        /// options as for `smooth`).
+        #[arg(long, value_name = "FILE")]
+        input: Option<PathBuf>,
+        #[command(flatten)]
+        csv: CsvArgs,
+        #[command(flatten)]
+        grid: GridCli,
+    },
+    /// Geodesic distance on a triangle mesh from source vertices (heat method).
+    Geodesic {
+        /// Mesh: .obj, .off, .ply, .vtu, .vtp.
+        input: PathBuf,
+        /// Source vertex indices (0-based, comma-separated).
+        #[arg(long, value_name = "V")]
+        source: String,
+        /// Output mesh with the point array `distance` (.vtu, .vtp, .ply).
+        #[arg(short, long)]
+        output: PathBuf,
+        /// JSON report with per-stage seconds.
+        #[arg(long, value_name = "JSON")]
+        report: Option<PathBuf>,
+    },
+    /// Weight functions for handles on a mesh (no data): 1 on a handle, 0 on the others, no
+    /// other extremum (monotone, certified), normalised to a partition of unity.
+    Weights(Box<WeightsCli>),
+    /// Pose a mesh with its weights: linear blend (lbs) or dual-quaternion (dqs) skinning.
+    Deform {
+        /// The rest mesh.
+        input: PathBuf,
+        /// Weights file written by `weights` (arrays weight_<name>).
+        #[arg(long, value_name = "FILE")]
+        weights: PathBuf,
+        /// pose.json: {"transforms": {"name": [[a,b,c,tx],[d,e,f,ty],[g,h,i,tz]], ...}}.
+        #[arg(long, value_name = "JSON")]
+        transforms: PathBuf,
+        /// Posed mesh: .obj, .off, .ply, .vtu, .vtp.
+        #[arg(short, long)]
+        output: PathBuf,
+        /// Skinning method.
+        #[arg(long, value_enum, default_value_t = Skinning::Lbs)]
+        skinning: Skinning,
+        /// Rest and posed shapes side by side.
+        #[arg(long, value_name = "PNG")]
+        plot: Option<PathBuf>,
+        /// Camera of the picture: azimuth and elevation in degrees.
+        #[arg(long, value_name = "AZ,EL")]
+        view: Option<String>,
+    },
+    /// Colour diffusion from coloured points over an image's shape (alpha) or a mesh, with
+    /// monotone weights: no pixel leaves the per-channel box of the given colours.
+    Diffuse {
+        /// An image (PNG, TIFF; alpha ≥ 128 is the shape) or a mesh (.obj, .off, .ply, .vtu, .vtp).
+        input: PathBuf,
+        /// colors.json: {"points": [{"pixel": [col, row], "rgb": [r, g, b]}, ...]} ("vertex" or
+        /// "point" on meshes).
+        #[arg(long, value_name = "JSON")]
+        colors: PathBuf,
+        /// Output: PNG for an image; .vtu, .vtp or .ply (arrays red, green, blue) for a mesh.
+        #[arg(short, long)]
+        output: PathBuf,
+        /// Where an image's Float64 weights go (.vtu, .vtp, .ply); default <output>_weights.vtu.
+        #[arg(long, value_name = "FILE")]
+        weights: Option<PathBuf>,
+        /// Polyharmonic order k.
+        #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u8).range(1..=4))]
+        order: u8,
+        /// Weights: monotone (convex blend, certified) or unconstrained etc. for comparison.
+        #[arg(long, value_enum, default_value_t = WeightMethod::Monotone)]
+        method: WeightMethod,
+        /// Picture: the image enlarged with the colour points drawn, or the coloured mesh.
+        #[arg(long, value_name = "PNG")]
+        plot: Option<PathBuf>,
+        /// Camera of a mesh picture: azimuth and elevation in degrees.
+        #[arg(long, value_name = "AZ,EL")]
+        view: Option<String>,
+        /// JSON report.
+        #[arg(long, value_name = "JSON")]
+        report: Option<PathBuf>,
+    },
+    /// Triangulate the inside of a 2D outline (constrained Delaunay refinement): a polygon with
+    /// holes from JSON, the shapes of an SVG, or the largest region of a PNG mask.
+    Mesh {
+        /// Outline: .json (`{"outline": [[x, y], ...], "holes": [[[x, y], ...], ...]}`), .svg
+        /// (the visible filled shapes as drawn, CSS, units, <use> and transforms resolved: the
+        /// first subpath is the outer boundary, later ones holes; user units, y negated) or .png (inside: alpha ≥ 50 %, or dark pixels without alpha;
+        /// pixel-corner coordinates, y up).
+        input: PathBuf,
+        /// Output mesh: .obj, .off, .ply, .vtu or .vtp (z = 0).
+        #[arg(short, long)]
+        output: PathBuf,
+        /// Largest triangle area [default: the outline's bounding-box area / 2000].
+        #[arg(long, value_name = "A")]
+        max_area: Option<f64>,
+        /// Smallest angle in degrees (0 to 34; sharper corners of the outline itself stay).
+        #[arg(long, value_name = "DEG", default_value_t = 25.0, allow_hyphen_values = true)]
+        min_angle: f64,
+        /// Picture of the triangulation (PNG).
+        #[arg(long, value_name = "PNG")]
+        plot: Option<PathBuf>,
+    },
+    /// Benchmark on random-walk series, noisy grids and meshes: seconds per stage and peak memory.
+    Bench {
+        /// Series lengths `N`, grid sizes `NXxNY` (grids keep 7 minima and 6 maxima) and mesh files
+        /// `MESH[@levels]` (midpoint-subdivided; geodesic from vertex 0, every maximum kept).
+        #[arg(long, value_delimiter = ',', default_value = "1000,10000,100000,1000000")]
+        sizes: Vec<String>,
+        /// Benchmark weight functions instead: mesh files `MESH[@levels]` (4 point handles by
+        /// farthest-point sampling; orders from --weight-orders).
+        #[arg(long, value_delimiter = ',', value_name = "MESH[@LEVELS]")]
+        weights: Vec<String>,
+        /// Orders for --weights.
+        #[arg(long, value_delimiter = ',', default_value = "2,3,4")]
+        weight_orders: Vec<u8>,
+        /// Energy order or blend.
+        #[arg(long, default_value = "2")]
+        order: String,
+        /// Persistence threshold (percent of the range).
+        #[arg(long, default_value = "1%")]
+        persistence: String,
+        /// Constraint set.
+        #[arg(long, value_enum, default_value_t = EdgeSet::Minimal)]
+        edges: EdgeSet,
+        /// RNG seed.
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        /// QP solver.
+        #[arg(long, value_enum, default_value_t = Method::Structured)]
+        solver: Method,
+        /// Representative function on grids and meshes (default: automatic).
+        #[arg(long, value_enum)]
+        representative: Option<RepresentativeChoice>,
+        /// Fields per case through one `Smoother` (the case's field, then the same with a smooth
+        /// wave of 1 % of its range added): one row each.
+        #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=1000))]
+        fields: u32,
+        /// Run one size in this process and print one JSON line.
+        #[arg(long, hide = true)]
+        single: Option<String>,
+    },
+}
+
+#[derive(Args)]
+struct GridCli {
+    /// Read the input as a series, a grid or a mesh (default: by extension — .obj, .off, .ply,
+    /// .vtu, .vtp are meshes; a CSV whose first line is three or more numbers is a grid matrix).
+    #[arg(long, value_enum, default_value_t = DomainKind::Auto)]
+    domain: DomainKind,
+    /// Point array of a VTK file or PLY vertex property (default: the only scalar array, or
+    /// with --derive the only vector array); on a mesh also `x`, `y` or `z`.
+    #[arg(long, value_name = "NAME")]
+    array: Option<String>,
+    /// Grid spacing `dx,dy` (overrides the file's; may be negative, e.g. rows running down).
+    #[arg(long, value_name = "DX,DY", allow_hyphen_values = true)]
+    spacing: Option<String>,
+    /// Grid: smooth a scalar derived from a velocity field (a 2- or 3-component array, or
+    /// --u and --v).
+    #[arg(long, value_enum)]
+    derive: Option<Derive>,
+    /// Grid: x velocity component file (with --v and --derive, instead of an input file).
+    #[arg(long = "u", value_name = "FILE", requires_all = ["v", "derive"])]
+    u: Option<PathBuf>,
+    /// Grid: y velocity component file.
+    #[arg(long = "v", value_name = "FILE", requires = "u")]
+    v: Option<PathBuf>,
+    /// Fill missing samples (NaN, empty CSV cells) instead of refusing them: harmonically on
+    /// grids and meshes, linearly in x on series (ends: the nearest value); filled samples are
+    /// never kept extrema, and the output marks them (`filled`).
+    #[arg(long)]
+    fill_missing: bool,
+    /// Mesh: the field as one value per vertex and line of a text file (instead of --array;
+    /// `--array x|y|z` takes a coordinate).
+    #[arg(long, value_name = "FILE")]
+    values: Option<PathBuf>,
+}
+
+impl GridCli {
+    fn options(&self) -> Result<GridOptions> {
+        let spacing = match &self.spacing {
+            None => None,
+            Some(text) => {
+                let parts: Vec<f64> = text
+                    .split(',')
+                    .map(|p| p.trim().parse::<f64>())
+                    .collect::<std::result::Result<_, _>>()
+                    .map_err(|_| Error::Usage(format!("--spacing `{text}` is not two numbers dx,dy")))?;
+                match parts.as_slice() {
+                    [dx, dy] if [dx, dy].iter().all(|d| (MIN_SPACING..=MAX_SPACING).contains(&d.abs())) => {
+                        Some([*dx, *dy])
+                    }
+                    _ => {
+                        return Err(Error::Usage(format!(
+                            "--spacing `{text}` must be two numbers dx,dy with {MIN_SPACING:e} ≤ |d| ≤ {MAX_SPACING:e}"
+                        )))
+                    }
+                }
+            }
+        };
+        Ok(GridOptions {
+            array: self.array.clone(),
+            spacing,
+            derive: self.derive,
+            uv: self.u.clone().zip(self.v.clone()),
+            fill_missing: self.fill_missing,
+            values: self.values.clone(),
+        })
+    }
+}
+
+#[derive(Args)]
+struct CsvArgs {
+    /// Value column: header name or 0-based index (default: the last numeric column).
+    #[arg(long)]
+    column: Option<String>,
+    /// x column: header name, index or `none` (default: the first column if it holds dates
+    /// or is named x, t, time or date).
+    #[arg(long = "x", value_name = "COLUMN")]
+    x_column: Option<String>,
+}
+
+impl CsvArgs {
+    fn options(&self) -> SeriesCsvOptions {
+        SeriesCsvOptions { column: self.column.clone(), x_column: self.x_column.clone(), ..Default::default() }
+    }
+}
+
+fn parse_view(view: Option<&str>) -> Result<MeshView> {
+    match view {
+        None => Ok(MeshView::default()),
+        Some(text) => {
+            let parts: Vec<f64> = text.split(',').filter_map(|p| p.trim().parse().ok()).collect();
+            match parts.as_slice() {
+                [az, el] if az.is_finite() && el.is_finite() => Ok(MeshView { azimuth: *az, elevation: *el }),
+                _ => Err(Error::Usage(format!("--view `{text}` is not two angles AZ,EL in degrees"))),
+            }
+        }
+    }
+}
+
+#[derive(Args)]
+struct WeightsCli {
+    /// Mesh: .obj, .off, .ply, .vtu, .vtp (a planar mesh for 2D shapes).
+    input: PathBuf,
+    /// handles.json: points, bones, vertex lists, or a 2D cage (SPEC.md formats).
+    #[arg(long, value_name = "JSON")]
+    handles: PathBuf,
+    /// Output mesh (.vtu, .vtp, .ply) with weight_<name>, weight_<name>_raw, u_<name>, role_<name>.
+    #[arg(short, long)]
+    output: PathBuf,
+    /// Polyharmonic order k.
+    #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u8).range(1..=4))]
+    order: u8,
+    /// monotone: no spurious extremum (certified); bounded: BBW (0 ≤ w ≤ 1, partition of
+    /// unity); unconstrained: plain polyharmonic; harmonic: Laplace.
+    #[arg(long, value_enum, default_value_t = WeightMethod::Monotone)]
+    method: WeightMethod,
+    /// Also run the other three methods and report their spurious extrema.
+    #[arg(long)]
+    compare: bool,
+    /// Constraint set of the monotone method.
+    #[arg(long, value_enum, default_value_t = EdgeSet::Minimal)]
+    edges: EdgeSet,
+    /// Worker threads (the functions are independent).
+    #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u16).range(1..=256))]
+    threads: u16,
+    /// Picture: the normalised weights of up to 4 handles (with --compare: handle 0 by method).
+    #[arg(long, value_name = "PNG")]
+    plot: Option<PathBuf>,
+    /// Camera of the picture: azimuth and elevation in degrees.
+    #[arg(long, value_name = "AZ,EL")]
+    view: Option<String>,
+    /// JSON report: per function certificate, spurious extrema, iterations, seconds.
+    #[arg(long, value_name = "JSON")]
+    report: Option<PathBuf>,
+    /// Cages: the certified functions on the cage's triangulation [default: <output>_cage.vtu].
+    #[arg(long, value_name = "FILE")]
+    cage_output: Option<PathBuf>,
+    /// Cages: largest triangle area of the cage's triangulation [default: the shape's mean].
+    #[arg(long, value_name = "A")]
+    cage_max_area: Option<f64>,
+}
+
+#[derive(Args)]
+struct SmoothCli {
+    /// Input: a series (CSV), a grid (.vti, .vtk, .npy, CSV matrix, PNG, TIFF) or a mesh
+    /// (.obj, .off, .ply, .vtu, .vtp, legacy .vtk polydata).
+    #[arg(required_unless_present = "u")]
+    input: Option<PathBuf>,
+    /// Output: a series CSV (x,input,output,u,role); for grids .vti or .npz (verifiable:
+    /// input, smoothed, representative, role) or .npy / CSV (the smoothed array only); for
+    /// meshes .vtu, .vtp or .ply (verifiable, the same arrays). VTK outputs (.vti, .vtu, .vtp)
+    /// also carry every point and cell array of a VTK input, and give the smoothed field the
+    /// input array's name as the active scalars.
+    #[arg(short, long)]
+    output: PathBuf,
+    /// The name of the smoothed field in VTK outputs, instead of the input array's (which is
+    /// then carried through unchanged).
+    #[arg(long, value_name = "NAME")]
+    output_array: Option<String>,
+    /// The input's persistence diagram in TTK's layout (.vtu), pairs marked `Kept`.
+    #[arg(long, value_name = "VTU")]
+    diagram: Option<PathBuf>,
+    #[command(flatten)]
+    csv: CsvArgs,
+    #[command(flatten)]
+    grid: GridCli,
+    /// Grids and meshes: kept extrema, saddles and separatrices as VTK PolyData (.vtp).
+    #[arg(long, value_name = "VTP")]
+    complex: Option<PathBuf>,
+    /// Grids and meshes: representative function. Given, it is built or the run fails (exit 3
+    /// when the data cannot follow its order, 1 when it fails its own check); by default the
+    /// separatrix one, then harmonic, then flooded, each fallback reported.
+    #[arg(long, value_enum)]
+    representative: Option<RepresentativeChoice>,
+    /// Mesh plot: camera azimuth and elevation in degrees (y up).
+    #[arg(long, value_name = "AZ,EL", allow_hyphen_values = true)]
+    view: Option<String>,
+    /// Grid plot: number of isolines, 0 to 1000 (0: none; grids only).
+    #[arg(long, default_value_t = 0, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(0..=1000))]
+    isolines: usize,
+    /// Keep extrema of persistence ≥ T: `5%` of the range or an absolute value. [default: 5%]
+    #[arg(long, value_name = "T", conflicts_with_all = ["pairs", "minima", "keep_min", "keep_max"])]
+    persistence: Option<String>,
+    /// Series: keep the N most persistent (minimum, maximum) pairs besides the global minimum.
+    #[arg(long, value_name = "N", conflicts_with_all = ["minima", "keep_min", "keep_max"])]
+    pairs: Option<usize>,
+    /// Grids and meshes: keep the N most persistent minima (with --maxima).
+    #[arg(long, value_name = "N", requires = "maxima", conflicts_with_all = ["keep_min", "keep_max"])]
+    minima: Option<usize>,
+    /// Grids and meshes: keep the M most persistent maxima (with --minima).
+    #[arg(long, value_name = "M", requires = "minima")]
+    maxima: Option<usize>,
+    /// Surfaces: keep every maximum of persistence > 0 and only the global minimum (geodesic
+    /// distance from a source keeps its maxima).
+    #[arg(long, conflicts_with_all = ["persistence", "pairs", "minima", "keep_min", "keep_max", "keep_all_minima"])]
+    keep_all_maxima: bool,
+    /// Surfaces: keep every minimum of persistence > 0 and only the global maximum.
+    #[arg(long, conflicts_with_all = ["persistence", "pairs", "minima", "keep_min", "keep_max"])]
+    keep_all_minima: bool,
+    /// Keep exactly these minima (vertex indices, comma-separated; grids: row·nx + column);
+    /// needs --keep-max.
+    #[arg(long, value_name = "I,J", requires = "keep_max")]
+    keep_min: Option<String>,
+    /// Keep exactly these maxima (vertex indices); needs --keep-min.
+    #[arg(long, value_name = "K", requires = "keep_min")]
+    keep_max: Option<String>,
+    /// Polyharmonic order 1..4, or a blend like `1:0.2,2:1`.
+    #[arg(long, default_value = "2")]
+    order: String,
+    /// Samples where orders ≥ 2 are not penalised (a spike can stay C0).
+    #[arg(long, value_name = "I,J")]
+    sharp: Option<String>,
+    /// γD: weight of the data term.
+    #[arg(long, default_value_t = 1.0)]
+    data_weight: f64,
+    /// γL for every energy term (default: ℓ^(2k) with ℓ from --smooth-length).
+    #[arg(long, value_name = "W")]
+    smooth_weight: Option<f64>,
+    /// Smoothing length ℓ as a fraction of the domain's diameter (the series' extent); by
+    /// default max(2 mean edge lengths, 1 % of the diameter), on series at most 0.3 × the median
+    /// spacing of the kept extrema (the report gives ℓ and the rule).
+    #[arg(long, value_name = "FRACTION")]
+    smooth_length: Option<f64>,
+    /// Constraint set.
+    #[arg(long, value_enum, default_value_t = EdgeSet::Minimal)]
+    edges: EdgeSet,
+    /// Largest number of solver iterations (at least 1).
+    #[arg(long, default_value_t = 200, value_parser = clap::value_parser!(u32).range(1..))]
+    max_iter: u32,
+    /// QP solver: the structured interior-point method (Clarabel takes over if it fails), or
+    /// Clarabel alone.
+    #[arg(long, value_enum, default_value_t = Method::Structured)]
+    solver: Method,
+    /// How the energy enters the solver: assembled (normal equations in double precision),
+    /// factored (FᵀF, the paper's auxiliary variables: double-double normal equations in the
+    /// structured solver), or auto (factored when the condition estimate exceeds 1e9).
+    #[arg(long, value_enum, default_value_t = Formulation::Auto)]
+    formulation: Formulation,
+    /// Figure: series input (grey), output and kept extrema; grids as heat maps side by side.
+    #[arg(long, value_name = "PNG")]
+    plot: Option<PathBuf>,
+    /// JSON report: settings, kept extrema, seconds per stage, energy, deviations, certificate.
+    #[arg(long, value_name = "JSON")]
+    report: Option<PathBuf>,
+}
+
+fn smooth_args(c: SmoothCli) -> Result<SmoothArgs> {
+    let selection = match (&c.persistence, c.pairs, &c.keep_min, &c.keep_max) {
+        _ if c.keep_all_maxima => Selection::AllMaxima,
+        _ if c.keep_all_minima => Selection::AllMinima,
+        (Some(p), _, _, _) => commands::parse_persistence(p)?,
+        (None, Some(n), _, _) => Selection::Pairs(n),
+        (None, None, _, _) if c.minima.is_some() => {
+            Selection::Count { minima: c.minima.unwrap_or(1), maxima: c.maxima.unwrap_or(1) }
+        }
+        (None, None, Some(mn), Some(mx)) => {
+            Selection::Explicit { minima: commands::parse_indices(mn)?, maxima: commands::parse_indices(mx)? }
+        }
+        _ => commands::parse_persistence("5%")?,
+    };
+    let mut energy = Energy::parse(&c.order)?;
+    if let Some(s) = &c.sharp {
+        energy.sharp = commands::parse_indices(s)?;
+    }
+    let settings = SmoothSettings {
+        selection,
+        energy,
+        data_weight: c.data_weight,
+        smooth_weight: c.smooth_weight,
+        smooth_length: c.smooth_length,
+        edges: c.edges,
+        qp: QpSettings { max_iter: c.max_iter, method: c.solver, formulation: c.formulation, ..Default::default() },
+        representative: c.representative,
+    };
+    Ok(SmoothArgs {
+        input: c.input,
+        kind: c.grid.domain,
+        csv: c.csv.options(),
+        grid: c.grid.options()?,
+        complex: c.complex,
+        isolines: c.isolines,
+        view: parse_view(c.view.as_deref())?,
+        output: c.output,
+        settings,
+        plot: c.plot,
+        report: c.report,
+        output_array: c.output_array,
+        diagram: c.diagram,
+    })
+}
+
+fn run(cli: Cli) -> Result<String> {
+    match cli.command {
+        Command::Extrema { input, csv, grid, json, plot, diagram, persistence } => commands::extrema(&ExtremaArgs {
+            input,
+            kind: grid.domain,
+            csv: csv.options(),
+            grid: grid.options()?,
+            json,
+            plot,
+            diagram,
+            selection: commands::parse_persistence(&persistence)?,
+        }),
+        Command::Smooth(c) => commands::smooth(&smooth_args(*c)?),
+        Command::Geodesic { input, source, output, report } => commands::geodesic(&commands::GeodesicArgs {
+            input,
+            sources: commands::parse_indices(&source)?,
+            output,
+            report,
+        }),
+        Command::Weights(c) => commands::weights(&commands::WeightsArgs {
+            input: c.input,
+            handles: c.handles,
+            output: c.output,
+            settings: crate::apps::weights::WeightSettings {
+                order: c.order,
+                method: c.method,
+                edges: c.edges,
+                threads: usize::from(c.threads),
+                ..Default::default()
+            },
+            compare: c.compare,
+            plot: c.plot,
+            view: parse_view(c.view.as_deref())?,
+            report: c.report,
+            cage_output: c.cage_output,
+            cage_max_area: c.cage_max_area,
+        }),
+        Command::Deform { input, weights, transforms, output, skinning, plot, view } => {
+            commands::deform(&commands::DeformArgs {
+                input,
+                weights,
+                transforms,
+                output,
+                skinning,
+                plot,
+                view: parse_view(view.as_deref())?,
+            })
+        }
+        Command::Diffuse { input, colors, output, weights, order, method, plot, view, report } => {
+            commands::diffuse(&commands::DiffuseArgs {
+                input,
+                colors,
+                output,
+                weights,
+                settings: crate::apps::weights::WeightSettings { order, method, ..Default::default() },
+                plot,
+                report,
+                view: parse_view(view.as_deref())?,
+            })
+        }
+        Command::Mesh { input, output, max_area, min_angle, plot } => {
+            commands::mesh_outline(&commands::MeshOutlineArgs { input, output, max_area, min_angle, plot })
+        }
+        Command::Verify { file, input, csv, grid } => {
+            commands::verify(&VerifyArgs { file, input, csv: csv.options(), grid: grid.options()? })
+        }
+        Command::Bench { weights, weight_orders, .. } if !weights.is_empty() => {
+            commands::bench_weights(&weights, &weight_orders, 4)
+        }
+        Command::Bench { sizes, order, persistence, edges, seed, single, solver, representative, fields, .. } => {
+            let persistence = match commands::parse_persistence(&persistence)? {
+                Selection::Relative(r) => r,
+                _ => return Err(Error::Usage("bench takes --persistence as a percentage".into())),
+            };
+            commands::bench(&BenchArgs {
+                cases: sizes.iter().map(|s| commands::BenchCase::parse(s)).collect::<Result<_>>()?,
+                energy: Energy::parse(&order)?,
+                persistence,
+                edges,
+                seed,
+                single,
+                method: solver,
+                representative,
+                fields: fields as usize,
+            })
+        }
+    }
+}
+
+/// The tool's `main`: installs the panic hook and the interrupt handler, parses `args` (the
+/// program's name first), runs the command with progress on standard error and returns the
+/// exit status (SPEC.md), after printing the result or the error.
+pub fn main(args: impl IntoIterator<Item = std::ffi::OsString>) -> i32 {
+    commands::install_panic_hook();
+    commands::install_interrupt_handler();
+    let cli = Cli::parse_from(args);
+    // a benchmark's table is its progress
+    let quiet = cli.quiet || matches!(cli.command, Command::Bench { .. });
+    let mode = commands::progress::ProgressMode::detect(quiet);
+    commands::finish(commands::progress::with_progress(mode, || commands::catch_panics(|| run(cli))))
+}
+
+/// Runs one command in this process without progress, signal handlers or a panic hook (for
+/// the Python package: its interpreter keeps its own), returning what the tool would print on
+/// standard output. `args` are the arguments after the program's name.
+///
+/// # Errors
+/// A usage error with clap's message for arguments it refuses (`--help` and `--version`
+/// included: their text is the message), else the command's error.
+pub fn run_args(args: &[String]) -> Result<String> {
+    let argv = std::iter::once("toposmooth".to_string()).chain(args.iter().cloned());
+    let cli = Cli::try_parse_from(argv).map_err(|e| Error::Usage(e.render().to_string().trim_end().to_string()))?;
+    run(cli)
+}

@@ -349,15 +349,26 @@ struct WeightsCli {
 struct SmoothCli {
     /// Input: a series (CSV), a grid (.vti, .vtk, .npy, CSV matrix, PNG, TIFF) or a mesh
     /// (.obj, .off, .ply, .vtu, .vtp, legacy .vtk polydata).
-    #[arg(required_unless_present = "u")]
-    input: Option<PathBuf>,
+    /// Several inputs (or a ParaView collection, .pvd) are smoothed one by one into
+    /// `--out-dir`, each under its own file name, with a .pvd of the outputs; inputs on one
+    /// domain share its analysis.
+    #[arg(required_unless_present = "u", num_args = 1.., value_name = "INPUT")]
+    input: Vec<PathBuf>,
     /// Output: a series CSV (x,input,output,u,role); for grids .vti or .npz (verifiable:
     /// input, smoothed, representative, role) or .npy / CSV (the smoothed array only); for
     /// meshes .vtu, .vtp or .ply (verifiable, the same arrays). VTK outputs (.vti, .vtu, .vtp)
     /// also carry every point and cell array of a VTK input, and give the smoothed field the
     /// input array's name as the active scalars.
-    #[arg(short, long)]
-    output: PathBuf,
+    #[arg(short, long, required_unless_present = "out_dir", conflicts_with = "out_dir")]
+    output: Option<PathBuf>,
+    /// Directory for the outputs of several inputs (one each, the input's file name, or its
+    /// stem with `--out-format`), plus `collection.pvd` (or the input collection's name) when
+    /// the outputs are VTK files.
+    #[arg(long, value_name = "DIR")]
+    out_dir: Option<PathBuf>,
+    /// With `--out-dir`: the outputs' extension (e.g. vti, vtu, npz), instead of the inputs'.
+    #[arg(long, value_name = "EXT", requires = "out_dir")]
+    out_format: Option<String>,
     /// The name of the smoothed field in VTK outputs, instead of the input array's (which is
     /// then carried through unchanged).
     #[arg(long, value_name = "NAME")]
@@ -478,20 +489,36 @@ fn smooth_args(c: SmoothCli) -> Result<SmoothArgs> {
         representative: c.representative,
     };
     Ok(SmoothArgs {
-        input: c.input,
+        input: c.input.first().cloned(),
         kind: c.grid.domain,
         csv: c.csv.options(),
         grid: c.grid.options()?,
         complex: c.complex,
         isolines: c.isolines,
         view: parse_view(c.view.as_deref())?,
-        output: c.output,
+        output: c.output.unwrap_or_default(),
         settings,
         plot: c.plot,
         report: c.report,
         output_array: c.output_array,
         diagram: c.diagram,
     })
+}
+
+/// One input to `-o`, or several (a list or a `.pvd` collection) to `--out-dir`.
+fn smooth_command(c: SmoothCli) -> Result<String> {
+    let (inputs, out_dir, out_format) = (c.input.clone(), c.out_dir.clone(), c.out_format.clone());
+    let collection = inputs.len() == 1 && inputs[0].extension().is_some_and(|e| e.eq_ignore_ascii_case("pvd"));
+    let args = smooth_args(c)?;
+    match out_dir {
+        Some(dir) => commands::smooth_many(&args, &inputs, &dir, out_format.as_deref()),
+        None if inputs.len() > 1 || collection => Err(Error::Usage(format!(
+            "{} inputs{}: write them with --out-dir DIR (one output each), not -o",
+            inputs.len(),
+            if collection { " (a .pvd collection)" } else { "" }
+        ))),
+        None => commands::smooth(&args),
+    }
 }
 
 fn run(cli: Cli) -> Result<String> {
@@ -506,7 +533,7 @@ fn run(cli: Cli) -> Result<String> {
             diagram,
             selection: commands::parse_persistence(&persistence)?,
         }),
-        Command::Smooth(c) => commands::smooth(&smooth_args(*c)?),
+        Command::Smooth(c) => smooth_command(*c),
         Command::Geodesic { input, source, output, report } => commands::geodesic(&commands::GeodesicArgs {
             input,
             sources: commands::parse_indices(&source)?,

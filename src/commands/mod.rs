@@ -12,6 +12,7 @@ mod mesh_outline;
 pub mod progress;
 mod smooth;
 mod smooth_args;
+mod smooth_many;
 mod verify;
 mod weights;
 
@@ -23,6 +24,7 @@ pub use geodesic::{geodesic, GeodesicArgs};
 pub use mesh_outline::{mesh_outline, MeshOutlineArgs};
 pub use smooth::smooth;
 pub use smooth_args::SmoothArgs;
+pub use smooth_many::smooth_many;
 pub use verify::{verify, VerifyArgs};
 pub use weights::{weights, WeightsArgs};
 
@@ -243,15 +245,7 @@ fn wrote_line<'a>(paths: impl IntoIterator<Item = Option<&'a std::path::PathBuf>
 /// checked, and each output's temporary reserved ([`crate::io::reserve`]), before any work, so
 /// that a typo costs nothing and no output is half written.
 fn check_distinct(inputs: &[&Path], outputs: &[(&str, Option<&Path>)]) -> Result<()> {
-    let key = |p: &Path| {
-        std::fs::canonicalize(p)
-            .or_else(|_| {
-                // a new file: resolve its directory
-                let parent = p.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
-                std::fs::canonicalize(parent).map(|d| d.join(p.file_name().unwrap_or_default()))
-            })
-            .unwrap_or_else(|_| std::path::absolute(p).unwrap_or_else(|_| p.to_path_buf()))
-    };
+    let key = path_key;
     let mut seen: Vec<(&str, std::path::PathBuf)> = inputs.iter().map(|p| ("an input", key(p))).collect();
     let mut reserve = Vec::new();
     for (name, p) in outputs {
@@ -268,6 +262,18 @@ fn check_distinct(inputs: &[&Path], outputs: &[(&str, Option<&Path>)]) -> Result
         }
     }
     crate::io::reserve(&reserve)
+}
+
+/// A path with its links and its directory resolved (a new file: its directory's), to compare
+/// outputs with inputs.
+fn path_key(p: &Path) -> std::path::PathBuf {
+    std::fs::canonicalize(p)
+        .or_else(|_| {
+            // a new file: resolve its directory
+            let parent = p.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
+            std::fs::canonicalize(parent).map(|d| d.join(p.file_name().unwrap_or_default()))
+        })
+        .unwrap_or_else(|_| std::path::absolute(p).unwrap_or_else(|_| p.to_path_buf()))
 }
 
 /// Whether `path` is a character device (`/dev/null`): it can take several outputs.

@@ -10,6 +10,7 @@ use crate::io::export::{check_complex_output, check_output, check_written, stage
 use crate::io::Staged;
 use crate::pipeline::{smooth_any, Report, Smoothed};
 use crate::plot::{plot_grid_fields, plot_mesh_fields, plot_series, GridMarker, GridPanel, GridPlotOptions, Marker};
+use crate::smoother::AnySmoother;
 use crate::topology::Role;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -59,6 +60,32 @@ struct RunReport<'a> {
 
 /// Runs `smooth`; returns the summary printed on standard output.
 pub fn smooth(args: &SmoothArgs) -> Result<String> {
+    smooth_shared(args, None)
+}
+
+/// The domain of the previous input of `smooth_many` and its smoother, reused when the next
+/// input is on the same domain (the results are those of one-off runs).
+pub(super) struct Shared {
+    domain: AnyDomain,
+    smoother: AnySmoother,
+}
+
+/// Whether two domains are the same: the same series coordinates, grid geometry or mesh.
+fn same_domain(a: &AnyDomain, b: &AnyDomain) -> bool {
+    match (a, b) {
+        (AnyDomain::Series(a), AnyDomain::Series(b)) => a == b,
+        (AnyDomain::Grid(a), AnyDomain::Grid(b)) => a == b,
+        (AnyDomain::Mesh(a), AnyDomain::Mesh(b)) => {
+            let bits =
+                |m: &crate::domain::TriMesh| m.positions().iter().flatten().map(|v| v.to_bits()).collect::<Vec<_>>();
+            a.faces() == b.faces() && bits(a) == bits(b)
+        }
+        _ => false,
+    }
+}
+
+/// [`smooth`], reusing `shared`'s smoother when given (inputs of `smooth_many`).
+pub(super) fn smooth_shared(args: &SmoothArgs, shared: Option<&mut Option<Shared>>) -> Result<String> {
     check_png_name(args.plot.as_deref())?;
     let input_path = args.input.clone().or_else(|| args.grid.uv.as_ref().map(|(u, _)| u.clone())).unwrap_or_default();
     let mut inputs: Vec<&Path> = args.input.iter().map(PathBuf::as_path).collect();
@@ -96,7 +123,18 @@ pub fn smooth(args: &SmoothArgs) -> Result<String> {
     let filled_samples: Vec<usize> =
         field.filled.as_ref().map(|m| (0..m.len()).filter(|&i| m[i]).collect()).unwrap_or_default();
     check_explicit_not_filled(&field, &args.settings.selection, &filled_samples)?;
-    let result = smooth_any(&field.domain, &field.values, &args.settings).map_err(|e| e.in_file(&field.path))?;
+    let result = match shared {
+        None => smooth_any(&field.domain, &field.values, &args.settings),
+        Some(slot) => {
+            if !slot.as_ref().is_some_and(|s| same_domain(&s.domain, &field.domain)) {
+                let smoother = AnySmoother::new(field.domain.clone(), args.settings.clone())
+                    .map_err(|e| e.in_file(&field.path))?;
+                *slot = Some(Shared { domain: field.domain.clone(), smoother });
+            }
+            slot.as_mut().expect("set above").smoother.smooth(&field.values)
+        }
+    }
+    .map_err(|e| e.in_file(&field.path))?;
     if let (AnyDomain::Series(_), Some(&i)) =
         (&field.domain, filled_samples.iter().find(|&&i| matches!(result.roles[i], Role::Min | Role::Max)))
     {

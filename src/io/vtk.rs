@@ -12,6 +12,7 @@
 //! Spacing is written as given, negative included: VTK 9 reads a negative spacing as a grid
 //! laid out in the negative direction of that axis (older readers may refuse it).
 
+mod collection;
 mod data;
 mod decode;
 mod image;
@@ -20,6 +21,7 @@ mod legacy_write;
 mod write;
 mod xml;
 
+pub use collection::{read_pvd, stage_pvd, CollectionEntry};
 pub use data::{cell, Cells, Dataset, ImageData, ImageGeometry, PointArray, Scalar};
 pub use legacy_write::{stage_legacy, LegacyGeometry};
 pub use write::{

@@ -577,6 +577,23 @@ fn main(py: Python<'_>, argv: Vec<String>) -> i32 {
     py.detach(|| toposmooth::commands::cli::main(argv.into_iter().map(std::ffi::OsString::from)))
 }
 
+/// Handles in the JSON format of `toposmooth weights --handles` (SPEC.md: points, bones,
+/// vertex lists) resolved on a mesh: their names and vertex sets.
+#[pyfunction]
+fn resolve_handles(py: Python<'_>, domain: &Domain, json: &str) -> PyResult<(Vec<String>, Vec<Vec<usize>>)> {
+    use toposmooth::apps::handles::{parse_handles, resolve, HandleFile};
+    let AnyDomain::Mesh(mesh) = &domain.inner else {
+        return Err(usage(py, format!("handles are placed on a mesh, got a {}", domain.kind())));
+    };
+    match parse_handles(json).map_err(|e| to_py(py, e))? {
+        HandleFile::Handles(list) => {
+            let sets = resolve(mesh, &list).map_err(|e| to_py(py, e))?;
+            Ok((list.into_iter().map(|h| h.name).collect(), sets))
+        }
+        HandleFile::Cage(_) => Err(usage(py, "a cage: use the CLI (`toposmooth weights --handles cage.json`)".into())),
+    }
+}
+
 /// The library's version.
 #[pyfunction]
 fn version() -> &'static str {
@@ -592,6 +609,7 @@ fn _toposmooth(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(geodesic, m)?)?;
     m.add_function(wrap_pyfunction!(weights, m)?)?;
     m.add_function(wrap_pyfunction!(fill_missing, m)?)?;
+    m.add_function(wrap_pyfunction!(resolve_handles, m)?)?;
     m.add_function(wrap_pyfunction!(run, m)?)?;
     m.add_function(wrap_pyfunction!(main, m)?)?;
     m.add_function(wrap_pyfunction!(version, m)?)?;

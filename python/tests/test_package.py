@@ -276,3 +276,63 @@ def test_results_do_not_depend_on_the_thread_count(datasets):
     assert np.array_equal(s1.smooth(g).smoothed, s2.smooth(g).smoothed)
     with pytest.raises(toposmooth.UsageError):
         toposmooth.smooth(g, threads=0)
+
+
+def read_obj(path):
+    v, f = [], []
+    for line in open(path):
+        p = line.split()
+        if p and p[0] == "v":
+            v.append([float(x) for x in p[1:4]])
+        elif p and p[0] == "f":
+            f.append([int(x.split("/")[0]) - 1 for x in p[1:4]])
+    return np.array(v), np.array(f)
+
+
+def vtu_arrays(path):
+    from vtkmodules.util.numpy_support import vtk_to_numpy
+    from vtkmodules.vtkIOXML import vtkXMLUnstructuredGridReader
+
+    r = vtkXMLUnstructuredGridReader()
+    r.SetFileName(str(path))
+    r.Update()
+    pd = r.GetOutput().GetPointData()
+    return {pd.GetArrayName(i): vtk_to_numpy(pd.GetArray(i)) for i in range(pd.GetNumberOfArrays())}
+
+
+def test_meshes_are_bit_identical_to_the_cli(datasets, cli, tmp_path):
+    pytest.importorskip("vtkmodules")
+    bunny = datasets / "bunny.obj"
+    v, f = read_obj(bunny)
+    g = tmp_path / "g.vtu"
+    cli("geodesic", bunny, "--source", "0", "-o", g)
+    d = toposmooth.geodesic(v, f, [0])
+    assert np.array_equal(d, vtu_arrays(g)["distance"])
+    # the distance smoothed keeping its maxima, as the paper's geodesic application does
+    s = tmp_path / "s.vtu"
+    cli("smooth", g, "--keep-all-maxima", "-o", s)
+    r = toposmooth.smooth(d, vertices=v, faces=f, keep_all_maxima=True)
+    out = vtu_arrays(s)
+    assert np.array_equal(r.smoothed, out["smoothed"]) and np.array_equal(r.roles, out["role"].astype(np.int8))
+    # weights for the bundled handles, given as the JSON format's dict
+    import json
+
+    penguin = datasets / "penguin.obj"
+    pv, pf = read_obj(penguin)
+    handles = json.loads((datasets / "penguin_handles.json").read_text())
+    w = tmp_path / "w.vtu"
+    cli("weights", penguin, "--handles", datasets / "penguin_handles.json", "-o", w)
+    got = toposmooth.weights(pv, pf, handles)
+    ref = vtu_arrays(w)
+    assert got["certified"] and len(got["names"]) == len(handles["handles"])
+    for name, raw, norm in zip(got["names"], got["raw"], got["weights"]):
+        assert np.array_equal(raw, ref[f"weight_{name}_raw"]), name
+        assert np.array_equal(norm, ref[f"weight_{name}"]), name
+
+
+def test_extrema_pairs_as_birth_and_death():
+    h = np.array([0.0, 3.0, 1.0, 2.0, -1.0])
+    e = toposmooth.extrema(h, persistence=0.5)
+    by_vertex = {int(v): (b, d) for v, b, d in zip(e["vertex"], e["birth"], e["death"])}
+    assert by_vertex[2] == (1.0, 2.0), "the minimum 1 dies at the maximum 2"
+    assert by_vertex[4][0] == -1.0 and np.isinf(by_vertex[4][1]), "the essential minimum never dies"

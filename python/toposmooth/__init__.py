@@ -564,12 +564,23 @@ def extrema(
         ``vertex`` (int64 flat index), ``is_max`` (bool), ``endpoint`` (bool, a series'
         end), ``value`` (float64), ``persistence`` (float64, inf for each part's essential
         extrema), ``partner`` (int64, the vertex it pairs with, -1 for none), ``strict``
-        (bool, no equal neighbour) and ``kept`` (bool, kept by the selection).
+        (bool, no equal neighbour), ``kept`` (bool, kept by the selection), and the pair as
+        ``birth`` and ``death`` values (a minimum is born at its value, a maximum dies at its
+        value; essential extrema have death inf, resp. birth -inf).
     """
     domain, flat, _ = _domain(values, x, spacing, origin, vertices, faces)
     flat, _ = _fill(domain, flat, fill_missing)
     sel = _selection_kwargs(persistence, minima, maxima, pairs, keep_min, keep_max, keep_all_maxima, keep_all_minima)
-    return dict(_toposmooth.extrema(domain, flat, sel))
+    out = dict(_toposmooth.extrema(domain, flat, sel))
+    # each extremum's persistence pair: a minimum is born at its value and dies at its partner's,
+    # a maximum the other way round; essential extrema never die (death ±inf)
+    partner_value = np.where(out["partner"] >= 0, flat[np.maximum(out["partner"], 0)], np.nan)
+    is_max, essential = out["is_max"], ~np.isfinite(out["persistence"])
+    out["birth"] = np.where(is_max, partner_value, out["value"])
+    out["death"] = np.where(is_max, out["value"], partner_value)
+    out["birth"][essential & is_max] = -np.inf
+    out["death"][essential & ~is_max] = np.inf
+    return out
 
 
 def verify(
@@ -625,7 +636,7 @@ def geodesic(vertices: Any, faces: Any, sources: Sequence[int]) -> np.ndarray:
 def weights(
     vertices: Any,
     faces: Any,
-    handles: Sequence[Sequence[int]],
+    handles: Any,
     *,
     order: int = 2,
     method: str = "monotone",
@@ -638,8 +649,11 @@ def weights(
     ----------
     vertices, faces
         The mesh, as in :func:`smooth`.
-    handles : sequence of sequences of int
-        Each handle's vertices (a point handle is one vertex); weight 1 there, 0 on the others.
+    handles : sequence of sequences of int, or dict
+        Each handle's vertices (a point handle is one vertex; weight 1 there, 0 on the others),
+        or handles in the JSON format of ``toposmooth weights --handles`` as a dict
+        (``{"handles": [{"name": "head", "point": [x, y, z]}, {"name": "arm", "bone": [a, b]},
+        ...]}``), placed on the mesh as the CLI places them.
     order : int
         Polyharmonic order k (1-4).
     method : {"monotone", "bounded", "unconstrained", "harmonic"}
@@ -652,12 +666,19 @@ def weights(
     -------
     dict
         ``weights`` (list of float64 arrays: a partition of unity), ``raw`` (as certified),
-        ``certified`` (bool) and ``max_normalisation_change`` (float).
+        ``names`` (the handles' names: "0", "1", ... for vertex lists), ``handles`` (each
+        handle's vertices), ``certified`` (bool) and ``max_normalisation_change`` (float).
     """
     domain, _, _ = _domain(np.zeros(np.asarray(vertices).shape[0]), vertices=vertices, faces=faces)
-    sets = [[int(v) for v in h] for h in handles]
+    if isinstance(handles, dict):
+        names, sets = _toposmooth.resolve_handles(domain, json.dumps(handles))
+    else:
+        sets = [[int(v) for v in np.atleast_1d(h)] for h in handles]
+        names = [str(k) for k in range(len(sets))]
     settings = {"order": int(order), "method": method, "edges": edges, "threads": int(threads)}
-    return dict(_toposmooth.weights(domain, sets, settings))
+    out = dict(_toposmooth.weights(domain, sets, settings))
+    out.update(names=list(names), handles=sets)
+    return out
 
 
 def _flags(settings: Dict[str, Any]) -> List[str]:

@@ -100,3 +100,13 @@ def test_cli_in_process_raises_the_package_errors(tmp_path):
     with pytest.raises(toposmooth.IoError) as e:
         toposmooth.cli("extrema", tmp_path / "missing.csv")
     assert "missing.csv" in str(e.value) and e.value.exit_code == 3
+
+
+def test_xarray_fills_missing_samples_in_every_chunk():
+    frames = vortex_street(steps=6, seed=3)
+    frames[:, 5, 7] = np.nan
+    da = xr.DataArray(frames, dims=("time", "y", "x")).chunk({"time": 2})
+    out = toposmooth.xarray.smooth(da, fill_missing=True, **SETTINGS).compute(scheduler="synchronous")
+    assert not np.isnan(out.values).any()
+    ref = [toposmooth.smooth(f, fill_missing=True, **SETTINGS).smoothed for f in frames]
+    assert np.array_equal(out.values, np.array(ref))

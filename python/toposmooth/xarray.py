@@ -64,6 +64,7 @@ def _smooth_stack(
 ) -> np.ndarray:
     """Smooths every field of ``arr`` (leading dims, then the core dims) with one Smoother."""
     out = np.empty(arr.shape, dtype=np.int8 if output == "roles" else np.float64)
+    settings = dict(settings)  # every chunk of a process gets the same dict
     fill = settings.pop("fill_missing", False)
     smoother = Smoother(core, fill_missing=fill, **domain, **settings)
     for idx in np.ndindex(*arr.shape[: arr.ndim - len(core)]):

@@ -38,6 +38,15 @@ pub fn with_threads<R>(n: usize, f: impl FnOnce() -> R) -> R {
     f()
 }
 
+/// faer's parallelism for a dense or supernodal kernel under the cap: sequential for one
+/// thread, else at most the cap's threads of faer's global setting.
+pub fn faer_par() -> faer::Par {
+    match (threads(), faer::get_global_parallelism()) {
+        (n, faer::Par::Rayon(global)) if n >= 2 => faer::Par::rayon(n.min(global.get())),
+        _ => faer::Par::Seq,
+    }
+}
+
 /// Runs `a` on this thread and `b` on another when two threads are allowed (the cap is split
 /// between them), else `a` then `b` here. A panic in either is propagated.
 pub fn join<RA, RB: Send>(a: impl FnOnce() -> RA, b: impl FnOnce() -> RB + Send) -> (RA, RB) {
@@ -71,5 +80,7 @@ mod tests {
         let r = std::panic::catch_unwind(|| with_threads(3, || -> usize { panic!("inside") }));
         assert!(r.is_err());
         assert_eq!(threads(), DEFAULT_THREADS, "restored after a panic");
+        // faer's kernels follow the cap: one thread is sequential
+        assert_eq!(with_threads(1, faer_par), faer::Par::Seq);
     }
 }

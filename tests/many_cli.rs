@@ -102,3 +102,43 @@ fn misuse_is_refused_before_any_work() {
     assert_eq!(o.status.code(), Some(3), "{}", text(&o));
     assert!(text(&o).contains("fake.pvd") && text(&o).contains("not a ParaView collection"), "{}", text(&o));
 }
+
+/// A ParaView series as ParaView saves it (`name.pvd` beside `name/name_0.vti`): written into
+/// the collection's own directory, the new collection would replace the input one — refused.
+/// With `--out-format`, a numbered stem keeps its dots (`flow.0001.npy` → `flow.0001.vti`).
+#[test]
+fn a_collection_is_never_replaced_and_numbered_names_keep_their_dots() {
+    let dir = scratch("many_pvd");
+    let data = dir.join("name");
+    std::fs::create_dir_all(&data).unwrap();
+    let steps = steps(&data);
+    let numbered: Vec<PathBuf> = steps
+        .iter()
+        .enumerate()
+        .map(|(t, p)| {
+            let q = data.join(format!("flow.{:04}.npy", t + 1));
+            std::fs::rename(p, &q).unwrap();
+            q
+        })
+        .collect();
+    let out = dir.join("out");
+    std::fs::create_dir_all(&out).unwrap();
+    let mut args = vec!["smooth".to_string()];
+    args.extend(numbered.iter().map(|p| s(p)));
+    args.extend(["--out-dir", &s(&out), "--out-format", "vti"].map(String::from));
+    let argv: Vec<&str> = args.iter().map(String::as_str).collect();
+    let o = toposmooth(&argv);
+    assert!(o.status.success(), "{}", text(&o));
+    for t in 1..=4 {
+        assert!(out.join(format!("flow.{t:04}.vti")).exists(), "flow.{t:04}.vti");
+    }
+    // the collection, its files in name/, smoothed into the collection's own directory
+    let pvd = dir.join("name.pvd");
+    let listed: String = (1..=4).map(|t| format!("<DataSet timestep=\"{t}\" file=\"out/flow.{t:04}.vti\"/>")).collect();
+    std::fs::write(&pvd, format!("<VTKFile type=\"Collection\"><Collection>{listed}</Collection></VTKFile>")).unwrap();
+    let before = std::fs::read(&pvd).unwrap();
+    let o = toposmooth(&["smooth", &s(&pvd), "--out-dir", &s(&dir), "--array", "smoothed"]);
+    assert_eq!(o.status.code(), Some(2), "{}", text(&o));
+    assert!(text(&o).contains("name.pvd") && text(&o).contains("also an input"), "{}", text(&o));
+    assert_eq!(std::fs::read(&pvd).unwrap(), before, "the input collection is untouched");
+}

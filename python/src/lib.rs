@@ -7,7 +7,7 @@
 //! (`toposmooth.errors`), one per [`ErrorKind`], with the library's message, the kind, the
 //! CLI's exit status and the file when one is known.
 
-use numpy::{PyArray1, PyReadonlyArray1, PyReadonlyArray2};
+use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyType};
 use toposmooth::apps::weights::{WeightMethod, WeightSettings};
@@ -394,7 +394,18 @@ fn extrema<'py>(
         PyArray1::from_vec(py, table.iter().map(|e| e.kind != ExtremumKind::Min).collect::<Vec<_>>()),
     )?;
     out.set_item("value", PyArray1::from_vec(py, col(&|e| e.value)))?;
-    out.set_item("persistence", PyArray1::from_vec(py, col(&|e| e.persistence.unwrap_or(f64::INFINITY))))?;
+    out.set_item(
+        "persistence",
+        PyArray1::from_vec(
+            py,
+            col(&|e| match (e.persistence, e.kind) {
+                (Some(p), _) => p,
+                // a series' endpoint maximum never merges components: no persistence
+                (None, ExtremumKind::End) => f64::NAN,
+                (None, _) => f64::INFINITY,
+            }),
+        ),
+    )?;
     out.set_item(
         "partner",
         PyArray1::from_vec(py, table.iter().map(|e| e.partner.map_or(-1, |p| p as i64)).collect::<Vec<_>>()),
@@ -406,6 +417,52 @@ fn extrema<'py>(
         ExtremumKind::Max | ExtremumKind::End => kept.roles[e.index] == Role::Max,
     };
     out.set_item("kept", PyArray1::from_vec(py, table.iter().map(is_kept).collect::<Vec<_>>()))?;
+    Ok(out)
+}
+
+/// The persistence pairs of `h` in TTK's terms (`toposmooth::io::ttk::diagram_of`: each
+/// connected part's essential pair first): a dict of arrays `vertices` (k, 2) int64 (birth,
+/// death), `types` (k, 2) int32 (TTK's CriticalType), `pair_type` int32, `values` (k, 2),
+/// `finite` and `kept` (by `settings`' selection) bool.
+#[pyfunction]
+fn diagram<'py>(
+    py: Python<'py>,
+    domain: &Domain,
+    h: PyReadonlyArray1<'py, f64>,
+    settings: &Bound<'py, PyDict>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let sel = selection(py, settings)?;
+    let h = values(py, "values", &h)?;
+    let d = &domain.inner;
+    if h.len() != d.n_vertices() {
+        return Err(to_py(
+            py,
+            Error::input(format!("values has {} entries, the domain {} vertices", h.len(), d.n_vertices())),
+        ));
+    }
+    let (pairs, kept) = py
+        .detach(|| -> toposmooth::Result<_> {
+            let kept = match d {
+                AnyDomain::Series(s) => select(s, h, &sel)?,
+                AnyDomain::Grid(g) => select(g, h, &sel)?,
+                AnyDomain::Mesh(m) => select(m, h, &sel)?,
+            };
+            Ok((toposmooth::io::ttk::diagram_of(d, h), kept))
+        })
+        .map_err(|e| to_py(py, e))?;
+    let k = pairs.len();
+    let flat =
+        |f: &dyn Fn(&toposmooth::io::ttk::DiagramPair) -> [f64; 2]| pairs.iter().flat_map(f).collect::<Vec<f64>>();
+    let out = PyDict::new(py);
+    let vertices: Vec<i64> = pairs.iter().flat_map(|p| p.vertices.map(|v| v as i64)).collect();
+    let types: Vec<i32> = pairs.iter().flat_map(|p| p.types).collect();
+    out.set_item("vertices", PyArray1::from_vec(py, vertices).reshape([k, 2])?)?;
+    out.set_item("types", PyArray1::from_vec(py, types).reshape([k, 2])?)?;
+    out.set_item("values", PyArray1::from_vec(py, flat(&|p| p.values)).reshape([k, 2])?)?;
+    out.set_item("pair_type", PyArray1::from_vec(py, pairs.iter().map(|p| p.pair_type).collect::<Vec<i32>>()))?;
+    out.set_item("finite", PyArray1::from_vec(py, pairs.iter().map(|p| p.finite).collect::<Vec<bool>>()))?;
+    let is_kept = |p: &toposmooth::io::ttk::DiagramPair| kept.roles.get(p.extremum).is_some_and(|r| r.is_fixed());
+    out.set_item("kept", PyArray1::from_vec(py, pairs.iter().map(is_kept).collect::<Vec<bool>>()))?;
     Ok(out)
 }
 
@@ -606,6 +663,7 @@ fn _toposmooth(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Smoother>()?;
     m.add_function(wrap_pyfunction!(extrema, m)?)?;
     m.add_function(wrap_pyfunction!(certify, m)?)?;
+    m.add_function(wrap_pyfunction!(diagram, m)?)?;
     m.add_function(wrap_pyfunction!(geodesic, m)?)?;
     m.add_function(wrap_pyfunction!(weights, m)?)?;
     m.add_function(wrap_pyfunction!(fill_missing, m)?)?;

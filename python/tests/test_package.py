@@ -336,3 +336,39 @@ def test_extrema_pairs_as_birth_and_death():
     by_vertex = {int(v): (b, d) for v, b, d in zip(e["vertex"], e["birth"], e["death"])}
     assert by_vertex[2] == (1.0, 2.0), "the minimum 1 dies at the maximum 2"
     assert by_vertex[4][0] == -1.0 and np.isinf(by_vertex[4][1]), "the essential minimum never dies"
+
+
+def test_review_findings_on_the_python_side(tmp_path):
+    # a series' endpoint maximum has no persistence (not an essential extremum)
+    e = toposmooth.extrema(np.array([5.0, 1.0, 3.0, 0.0]), persistence=0.1)
+    end = list(e["vertex"]).index(0)
+    assert e["endpoint"][end] and np.isnan(e["persistence"][end]) and np.isnan(e["birth"][end])
+    # a kept extremum named explicitly may not be a filled sample, as in the CLI
+    h = np.array([0.0, 2.0, np.nan, 3.0, 1.0, 4.0])
+    with pytest.raises(toposmooth.InputError) as err:
+        toposmooth.smooth(h, keep_min=[0, 2], keep_max=[5], fill_missing=True)
+    assert "missing sample 2" in str(err.value)
+    # dates as x for a Smoother, numpy values inside dict handles, negative indices
+    pd = pytest.importorskip("pandas")
+    days = pd.date_range("2020-01-01", periods=6, freq="D")
+    s = toposmooth.Smoother(x=days, pairs=1)
+    series = pd.Series([0.0, 2.0, 1.0, 3.0, 0.5, 4.0], index=days)
+    assert np.array_equal(s.smooth(series.to_numpy()).smoothed, toposmooth.smooth(series, pairs=1).smoothed)
+    with pytest.raises(toposmooth.UsageError):
+        toposmooth.geodesic(np.eye(3), [[0, 1, 2]], [-1])
+    # .pvd times from numpy are numbers, files relative to the collection
+    files = [tmp_path / f"a{k}.vti" for k in range(2)]
+    pvd = toposmooth.dask.write_pvd(tmp_path / "c.pvd", files, times=np.arange(2) * 0.5)
+    text = pvd.read_text()
+    assert 'timestep="0.5"' in text and 'file="a1.vti"' in text, text
+
+
+def test_float32_coordinates_are_uniform_to_their_precision():
+    xr = pytest.importorskip("xarray")
+    lon = np.arange(0, 3.6, 0.1, dtype=np.float32)
+    y = np.arange(20, dtype=np.float32)
+    da = xr.DataArray(np.sin(lon[None, :] * 2) * np.cos(y[:, None] / 3), dims=("y", "lon"), coords={"y": y, "lon": lon})
+    out = toposmooth.xarray.smooth(da, dims=("y", "lon"), persistence="20%")
+    assert out.shape == da.shape
+    over = toposmooth.xarray.smooth(da, dims=("y", "lon"), spacing=(0.5, 0.5), persistence="20%")
+    assert over.shape == da.shape

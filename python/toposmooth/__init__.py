@@ -89,6 +89,14 @@ def _float64(name: str, a: Any, ndim: Optional[int] = None) -> np.ndarray:
     return arr
 
 
+def _indices(name: str, values: Any) -> List[int]:
+    """Vertex indices as Python ints; a negative or non-integer one is a usage error."""
+    a = np.asarray(values)
+    if a.size and (a.dtype.kind not in "iu" or a.min() < 0):
+        raise UsageError(f"{name} must be non-negative vertex indices, got {values!r}")
+    return [int(i) for i in a.reshape(-1)]
+
+
 def _days_since_epoch(index: Any) -> np.ndarray:
     """Days since 1970-01-01 of a pandas DatetimeIndex, computed as the CLI computes them
     from the timestamps' text: (whole seconds + nanoseconds * 1e-9) / 86400, in UTC."""
@@ -102,6 +110,10 @@ def _days_since_epoch(index: Any) -> np.ndarray:
 
 def _series_x(values: Any, x: Any) -> Optional[np.ndarray]:
     if x is not None:
+        if np.asarray(x).dtype.kind == "M" or hasattr(x, "asi8"):
+            import pandas as pd
+
+            return _days_since_epoch(pd.DatetimeIndex(x))
         return _float64("x", x, 1)
     index = getattr(values, "index", None)
     if index is None:
@@ -307,7 +319,8 @@ class Smoother:
             raise UsageError("Smoother needs shape= (series or grid), x= (series) or vertices=, faces= (mesh)")
         self._domain, _, _ = _domain(np.zeros(self._shape), x, spacing, origin, vertices, faces)
         self._fill_missing = bool(fill_missing)
-        self._inner = _toposmooth.Smoother(self._domain, _resolve(settings))
+        self._settings = _resolve(settings)
+        self._inner = _toposmooth.Smoother(self._domain, self._settings)
 
     @property
     def domain(self) -> Any:
@@ -319,7 +332,7 @@ class Smoother:
         h = _float64("values", values)
         if h.shape != self._shape:
             raise InputError(f"values has shape {h.shape}, the smoother's domain {self._shape}")
-        flat, filled = _fill(self._domain, h.reshape(-1), self._fill_missing)
+        flat, filled = _fill(self._domain, h.reshape(-1), self._fill_missing, self._settings)
         return SmoothResult(self._inner.smooth(flat), self._shape, filled)
 
 
@@ -379,10 +392,19 @@ def _resolve(settings: Dict[str, Any]) -> Dict[str, Any]:
     return out
 
 
-def _fill(domain: Any, flat: np.ndarray, fill_missing: bool) -> "tuple[np.ndarray, Optional[np.ndarray]]":
+def _fill(
+    domain: Any, flat: np.ndarray, fill_missing: bool, settings: Optional[Dict[str, Any]] = None
+) -> "tuple[np.ndarray, Optional[np.ndarray]]":
+    """The values with their NaN filled when asked, and the mask of filled samples. A kept
+    extremum given explicitly may not be a filled sample (its value is not the input's), as in
+    the CLI."""
     if not fill_missing or not np.isnan(flat).any():
         return flat, None
     filled, mask = _toposmooth.fill_missing(domain, flat)
+    for key in ("keep_min", "keep_max"):
+        bad = [i for i in (settings or {}).get(key) or [] if 0 <= i < mask.size and mask[i]]
+        if bad:
+            raise InputError(f"{key} names the missing sample {bad[0]}: a kept extremum must have an input value")
     return filled, mask
 
 
@@ -526,7 +548,7 @@ def smooth(
             threads=threads,
         )
     )
-    flat, filled = _fill(domain, flat, fill_missing)
+    flat, filled = _fill(domain, flat, fill_missing, settings)
     raw = _toposmooth.Smoother(domain, settings).smooth(flat)
     return SmoothResult(raw, shape, filled)
 
@@ -560,11 +582,12 @@ def extrema(
 
     Returns
     -------
-    dict of ndarray, one entry per extremum in (value, index) order
+    dict of ndarray, one entry per extremum in vertex order
         ``vertex`` (int64 flat index), ``is_max`` (bool), ``endpoint`` (bool, a series'
         end), ``value`` (float64), ``persistence`` (float64, inf for each part's essential
-        extrema), ``partner`` (int64, the vertex it pairs with, -1 for none), ``strict``
-        (bool, no equal neighbour), ``kept`` (bool, kept by the selection), and the pair as
+        extrema, NaN for a series' endpoint maximum, which pairs with nothing),
+        ``partner`` (int64, the vertex it pairs with, -1 for none), ``strict`` (bool, no
+        equal neighbour), ``kept`` (bool, kept by the selection), and the pair as
         ``birth`` and ``death`` values (a minimum is born at its value, a maximum dies at its
         value; essential extrema have death inf, resp. birth -inf).
     """
@@ -575,11 +598,15 @@ def extrema(
     # each extremum's persistence pair: a minimum is born at its value and dies at its partner's,
     # a maximum the other way round; essential extrema never die (death ±inf)
     partner_value = np.where(out["partner"] >= 0, flat[np.maximum(out["partner"], 0)], np.nan)
-    is_max, essential = out["is_max"], ~np.isfinite(out["persistence"])
+    is_max, essential = out["is_max"], np.isinf(out["persistence"])
     out["birth"] = np.where(is_max, partner_value, out["value"])
     out["death"] = np.where(is_max, out["value"], partner_value)
     out["birth"][essential & is_max] = -np.inf
     out["death"][essential & ~is_max] = np.inf
+    # a series' endpoint maximum pairs with nothing (persistence NaN)
+    unpaired = np.isnan(out["persistence"])
+    out["birth"][unpaired] = np.nan
+    out["death"][unpaired] = np.nan
     return out
 
 
@@ -630,7 +657,7 @@ def geodesic(vertices: Any, faces: Any, sources: Sequence[int]) -> np.ndarray:
         The distance, 0 at the sources.
     """
     domain, _, _ = _domain(np.zeros(np.asarray(vertices).shape[0]), vertices=vertices, faces=faces)
-    return _toposmooth.geodesic(domain, [int(s) for s in sources])
+    return _toposmooth.geodesic(domain, _indices("sources", sources))
 
 
 def weights(
@@ -671,9 +698,11 @@ def weights(
     """
     domain, _, _ = _domain(np.zeros(np.asarray(vertices).shape[0]), vertices=vertices, faces=faces)
     if isinstance(handles, dict):
-        names, sets = _toposmooth.resolve_handles(domain, json.dumps(handles))
+        # numpy values (a vertex position V[3], an np.float32) as JSON numbers
+        text = json.dumps(handles, default=lambda o: o.tolist() if hasattr(o, "tolist") else str(o))
+        names, sets = _toposmooth.resolve_handles(domain, text)
     else:
-        sets = [[int(v) for v in np.atleast_1d(h)] for h in handles]
+        sets = [_indices(f"handle {k}", np.atleast_1d(h)) for k, h in enumerate(handles)]
         names = [str(k) for k in range(len(sets))]
     settings = {"order": int(order), "method": method, "edges": edges, "threads": int(threads)}
     out = dict(_toposmooth.weights(domain, sets, settings))

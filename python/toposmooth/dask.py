@@ -32,7 +32,8 @@ def write_pvd(path: os.PathLike, files: Sequence[os.PathLike], times: Optional[S
     lines = ['<?xml version="1.0"?>', '<VTKFile type="Collection" version="0.1" byte_order="LittleEndian">', "  <Collection>"]
     for t, f in zip(times, files):
         rel = os.path.relpath(Path(f).resolve(), path.resolve().parent)
-        lines.append(f'    <DataSet timestep="{t!r}" group="" part="0" file="{rel}"/>')
+        rel = rel.replace("&", "&amp;").replace('"', "&quot;").replace("<", "&lt;")
+        lines.append(f'    <DataSet timestep="{float(t)!r}" group="" part="0" file="{rel}"/>')
     lines += ["  </Collection>", "</VTKFile>", ""]
     tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
     tmp.write_text("\n".join(lines))
@@ -78,7 +79,9 @@ def smooth_files(
     out_dir = Path(out_dir)
     if not out_dir.is_dir():
         raise UsageError(f"{out_dir}: the output directory does not exist")
-    paths = [Path(p) for p in paths]
+    # resolved here: a worker on another node has another working directory
+    paths = [Path(p).resolve() for p in paths]
+    out_dir = out_dir.resolve()
     names = [p.name for p in paths]
     seen = {}
     for p, n in zip(paths, names):

@@ -22,12 +22,12 @@ import numpy as np
 from vtkmodules.util import numpy_support
 from vtkmodules.util.vtkAlgorithm import VTKPythonAlgorithmBase
 from vtkmodules.vtkCommonCore import (
-    vtkDoubleArray,
-    vtkFloatArray,
-    vtkIntArray,
+    VTK_DOUBLE,
+    VTK_FLOAT,
+    VTK_INT,
+    VTK_UNSIGNED_CHAR,
     vtkPoints,
     vtkStringArray,
-    vtkUnsignedCharArray,
 )
 from vtkmodules.vtkCommonDataModel import (
     VTK_LINE,
@@ -80,7 +80,8 @@ def domain_of(data: Any) -> Dict[str, Any]:
         if nz != 1:
             raise toposmooth.InputError(f"a {nx} × {ny} × {nz} volume: only 2D images (one point along z) for now")
         sx, sy, _ = data.GetSpacing()
-        ox, oy, _ = data.GetOrigin()
+        # the first point, not the origin: an extent need not start at 0 (Extract Subset)
+        ox, oy, _ = data.GetPoint(0)
         return {"spacing": (sx, sy), "origin": (ox, oy), "shape": (ny, nx)}
     if isinstance(data, (vtkPolyData, vtkUnstructuredGrid)):
         points = numpy_support.vtk_to_numpy(data.GetPoints().GetData()).astype(np.float64)
@@ -232,78 +233,51 @@ class PersistenceDiagram(_Settings, VTKPythonAlgorithmBase):
         _, values = _scalars(self, inInfo[0], inp)
         geometry = domain_of(inp)
         shape = geometry.pop("shape")
-        e = toposmooth.extrema(values.reshape(shape), **geometry, **self._selection())
-        # pairs: (birth vertex, death vertex, pair type, finite, kept)
-        pairs = []
-        vertex, partner, is_max, kept = e["vertex"], e["partner"], e["is_max"], e["kept"]
-        finite = np.isfinite(e["persistence"])
-        essential_min = [int(v) for v, f, m in zip(vertex, finite, is_max) if not f and not m]
-        essential_max = [int(v) for v, f, m in zip(vertex, finite, is_max) if not f and m]
-        for lo, hi in zip(essential_min, essential_max):
-            pairs.append((lo, hi, 0, False, True))
-        for v, p, m, f, k in zip(vertex, partner, is_max, finite, kept):
-            if not f or p < 0:
-                continue
-            pairs.append((int(p), int(v), 1, True, bool(k)) if m else (int(v), int(p), 0, True, bool(k)))
-        surface = len(shape) == 2 or "faces" in geometry
+        domain, flat, _ = toposmooth._domain(values.reshape(shape), **geometry)
+        selection = toposmooth._selection_kwargs(None, None, None, None, None, None, False, False)
+        selection.update(self._selection())
+        d = toposmooth._toposmooth.diagram(domain, flat, selection)
+        k = len(d["pair_type"])
+        b, dv = d["values"][:, 0], d["values"][:, 1]
+        xy = np.zeros((2 * k, 3))
+        xy[0::2, 0], xy[0::2, 1] = b, b
+        xy[1::2, 0], xy[1::2, 1] = b, dv
         points = vtkPoints()
-        ids, ctype, coords = [], [], []
-        cell_id, cell_type, pers, birth, fin, kep = [], [], [], [], [], []
-        minimum, saddle, maximum = 0, 1, 3
-        for k, (b, d, t, f, kp) in enumerate(pairs):
-            vb, vd = values[b], values[d]
-            points.InsertNextPoint(vb, vb, 0.0)
-            points.InsertNextPoint(vb, vd, 0.0)
-            if not f:
-                types = (minimum, maximum)  # the essential pair
-            elif t == 0:
-                types = (minimum, saddle if surface else maximum)
-            else:
-                types = (saddle, maximum)
-            ids += [b, d]
-            ctype += list(types)
-            coords += [geometry_point(geometry, shape, b), geometry_point(geometry, shape, d)]
-            cell_id.append(k)
-            cell_type.append(t)
-            pers.append(vd - vb)
-            birth.append(vb)
-            fin.append(1 if f else 0)
-            kep.append(1 if kp else 0)
+        points.SetData(numpy_support.numpy_to_vtk(xy, deep=1))
         out.SetPoints(points)
-        out.Allocate(len(pairs) + 1)
-        for k in range(len(pairs)):
-            out.InsertNextCell(VTK_LINE, 2, [2 * k, 2 * k + 1])
-        if pairs:
-            top = max(range(len(pairs)), key=lambda k: values[pairs[k][0]])
-            out.InsertNextCell(VTK_LINE, 2, [0, 2 * top])
-            cell_id.append(-1)
-            cell_type.append(-1)
-            pers.append(2 * pers[0] if pers else 0.0)
-            birth.append(birth[0])
-            fin.append(0)
-            kep.append(0)
+        out.Allocate(k + 1)
+        for i in range(k):
+            out.InsertNextCell(VTK_LINE, 2, [2 * i, 2 * i + 1])
+        persistence, birth = list(dv - b), list(b)
+        ids, pair_type = list(range(k)), [int(t) for t in d["pair_type"]]
+        finite, kept = [int(f) for f in d["finite"]], [int(x) for x in d["kept"]]
+        if k:
+            # the diagonal, as TTK draws it: from the first point to the highest birth
+            out.InsertNextCell(VTK_LINE, 2, [0, 2 * int(np.argmax(b))])
+            ids.append(-1)
+            pair_type.append(-1)
+            persistence.append(2.0 * persistence[0])
+            birth.append(0.0)
+            finite.append(0)
+            kept.append(0)
+        vertices = d["vertices"].reshape(-1)
+        coords = np.array([geometry_point(geometry, shape, int(v)) for v in vertices]).reshape(-1, 3)
 
-        def add(target: Any, name: str, data: Any, array_type: Any, components: int = 1) -> None:
-            a = array_type()
+        def add(target: Any, name: str, data: Any, vtk_type: int) -> None:
+            a = numpy_support.numpy_to_vtk(np.ascontiguousarray(data), deep=1, array_type=vtk_type)
             a.SetName(name)
-            a.SetNumberOfComponents(components)
-            for row in data:
-                if components == 1:
-                    a.InsertNextValue(row)
-                else:
-                    a.InsertNextTuple(row)
             target.AddArray(a)
 
         pd, cd = out.GetPointData(), out.GetCellData()
-        add(pd, "ttkVertexScalarField", ids, vtkIntArray)
-        add(pd, "CriticalType", ctype, vtkIntArray)
-        add(pd, "Coordinates", coords, vtkFloatArray, 3)
-        add(cd, "PairIdentifier", cell_id, vtkIntArray)
-        add(cd, "PairType", cell_type, vtkIntArray)
-        add(cd, "Persistence", pers, vtkDoubleArray)
-        add(cd, "Birth", birth, vtkDoubleArray)
-        add(cd, "IsFinite", fin, vtkUnsignedCharArray)
-        add(cd, "Kept", kep, vtkUnsignedCharArray)
+        add(pd, "ttkVertexScalarField", vertices.astype(np.int32), VTK_INT)
+        add(pd, "CriticalType", d["types"].reshape(-1).astype(np.int32), VTK_INT)
+        add(pd, "Coordinates", coords.astype(np.float32), VTK_FLOAT)
+        add(cd, "PairIdentifier", np.array(ids, dtype=np.int32), VTK_INT)
+        add(cd, "PairType", np.array(pair_type, dtype=np.int32), VTK_INT)
+        add(cd, "Persistence", np.array(persistence, dtype=np.float64), VTK_DOUBLE)
+        add(cd, "Birth", np.array(birth, dtype=np.float64), VTK_DOUBLE)
+        add(cd, "IsFinite", np.array(finite, dtype=np.uint8), VTK_UNSIGNED_CHAR)
+        add(cd, "Kept", np.array(kept, dtype=np.uint8), VTK_UNSIGNED_CHAR)
         return 1
 
 

@@ -24,11 +24,14 @@ __all__ = ["smooth", "geometry"]
 
 def _uniform(name: str, c: np.ndarray) -> Tuple[float, float]:
     """(first value, step) of a uniformly spaced coordinate."""
+    dtype = np.asarray(c).dtype
     c = np.asarray(c, dtype=np.float64)
     if c.size < 2:
         raise UsageError(f"coordinate `{name}` needs at least 2 values")
     step = (c[-1] - c[0]) / (c.size - 1)
-    if step == 0 or not np.allclose(np.diff(c), step, rtol=1e-9, atol=0):
+    # float32 coordinates (np.arange(0, 36, 0.1, dtype=float32)) are uniform to their precision
+    rtol = 1e-9 if dtype.itemsize >= 8 else 1e-4
+    if step == 0 or not np.allclose(np.diff(c), step, rtol=rtol, atol=0):
         raise UsageError(f"coordinate `{name}` is not uniformly spaced: a grid needs a constant spacing")
     return float(c[0]), float(step)
 
@@ -112,6 +115,10 @@ def smooth(
     if missing:
         raise UsageError(f"dims {missing} are not dimensions of the array, which has {tuple(da.dims)}")
     domain = geometry(da, dims)
+    # explicit geometry overrides the coordinates'
+    for key in ("spacing", "origin", "x"):
+        if key in settings:
+            domain[key] = settings.pop(key)
     core = tuple(da.sizes[d] for d in dims)
     if da.chunks is not None:
         da = da.chunk({d: -1 for d in dims})

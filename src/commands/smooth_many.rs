@@ -33,7 +33,13 @@ fn expand(inputs: &[PathBuf]) -> Result<(Vec<CollectionEntry>, String)> {
 fn output_of(input: &Path, dir: &Path, format: Option<&str>) -> Result<PathBuf> {
     let name = match format {
         None => input.file_name().map(PathBuf::from),
-        Some(ext) => input.file_stem().map(|s| PathBuf::from(s).with_extension(ext.trim_start_matches('.'))),
+        // the stem's own dots stay (flow.0001.vti -> flow.0001.vtu)
+        Some(ext) => input.file_stem().map(|s| {
+            let mut name = s.to_os_string();
+            name.push(".");
+            name.push(ext.trim_start_matches('.'));
+            PathBuf::from(name)
+        }),
     };
     name.map(|n| dir.join(n)).ok_or_else(|| Error::Usage(format!("{}: not a file name", input.display())))
 }
@@ -84,7 +90,9 @@ pub fn smooth_many(args: &SmoothArgs, inputs: &[PathBuf], dir: &Path, format: Op
     });
     let pvd = dir.join(&pvd_name);
     // every output against every input, and the collection, before any work
-    let ins: Vec<&Path> = entries.iter().map(|e| e.file.as_path()).collect();
+    let mut ins: Vec<&Path> = entries.iter().map(|e| e.file.as_path()).collect();
+    // a .pvd input is an input too: the new collection may not replace it
+    ins.extend(inputs.iter().map(PathBuf::as_path));
     let input_keys: Vec<PathBuf> = ins.iter().map(|p| path_key(p)).collect();
     if let Some(j) = keys.iter().position(|k| input_keys.contains(k)) {
         return Err(Error::Usage(format!("the output {} is also an input", outputs[j].display())));

@@ -64,7 +64,7 @@ pub(crate) fn parallelism_for(s: &SymbolicCholesky<usize>) -> Par {
     if factor_flops(s) < 2e10 {
         Par::Seq
     } else {
-        faer::get_global_parallelism()
+        crate::parallel::faer_par()
     }
 }
 

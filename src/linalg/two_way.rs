@@ -196,7 +196,7 @@ impl TwoWay {
                 work: vec![0.0; m],
             });
         }
-        let par = faer::get_global_parallelism();
+        let par = crate::parallel::faer_par();
         let sigma_mem = MemBuffer::try_new(faer::linalg::cholesky::llt::factor::cholesky_in_place_scratch::<f64>(
             ls,
             par,
@@ -244,7 +244,7 @@ impl TwoWay {
         faer::linalg::cholesky::llt::factor::cholesky_in_place(
             self.sigma.as_mut(),
             LltRegularization::default(),
-            faer::get_global_parallelism(),
+            crate::parallel::faer_par(),
             MemStack::new(&mut self.sigma_mem),
             Spec::default(),
         )

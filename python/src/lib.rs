@@ -51,6 +51,29 @@ fn values<'a>(py: Python<'_>, name: &str, a: &'a PyReadonlyArray1<'_, f64>) -> P
     a.as_slice().map_err(|_| usage(py, format!("{name} must be a contiguous float64 array")))
 }
 
+/// [`values`] of a field on `domain`: one per vertex, or an input error.
+fn field<'a>(py: Python<'_>, domain: &AnyDomain, name: &str, a: &'a PyReadonlyArray1<'_, f64>) -> PyResult<&'a [f64]> {
+    let h = values(py, name, a)?;
+    if h.len() != domain.n_vertices() {
+        let msg = format!("{name} has {} entries, the domain {} vertices", h.len(), domain.n_vertices());
+        return Err(to_py(py, Error::input(msg)));
+    }
+    Ok(h)
+}
+
+/// The extremum table of `h` and the kept set of `sel`, on a domain chosen at run time.
+fn table_and_kept(
+    d: &AnyDomain,
+    h: &[f64],
+    sel: &Selection,
+) -> toposmooth::Result<(Vec<toposmooth::topology::ExtremumInfo>, toposmooth::topology::KeptSet)> {
+    Ok(match d {
+        AnyDomain::Series(s) => (extrema_table(s, h), select(s, h, sel)?),
+        AnyDomain::Grid(g) => (extrema_table(g, h), select(g, h, sel)?),
+        AnyDomain::Mesh(m) => (extrema_table(m, h), select(m, h, sel)?),
+    })
+}
+
 /// A domain: a series, a regular grid or a triangle mesh (validated).
 #[pyclass(module = "toposmooth._toposmooth", frozen)]
 struct Domain {
@@ -336,7 +359,8 @@ impl Smoother {
         let h = values(py, "values", &h)?;
         let n = self.inner.n_vertices();
         if h.len() != n {
-            return Err(to_py(py, Error::input(format!("values has {} entries, the domain {n} vertices", h.len()))));
+            let msg = format!("values has {} entries, the domain {n} vertices", h.len());
+            return Err(to_py(py, Error::input(msg)));
         }
         let (inner, threads) = (&mut self.inner, self.threads);
         let out =
@@ -369,23 +393,9 @@ fn extrema<'py>(
     settings: &Bound<'py, PyDict>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let sel = selection(py, settings)?;
-    let h = values(py, "values", &h)?;
     let d = &domain.inner;
-    if h.len() != d.n_vertices() {
-        return Err(to_py(
-            py,
-            Error::input(format!("values has {} entries, the domain {} vertices", h.len(), d.n_vertices())),
-        ));
-    }
-    let (table, kept) = py
-        .detach(|| -> toposmooth::Result<_> {
-            Ok(match d {
-                AnyDomain::Series(s) => (extrema_table(s, h), select(s, h, &sel)?),
-                AnyDomain::Grid(g) => (extrema_table(g, h), select(g, h, &sel)?),
-                AnyDomain::Mesh(m) => (extrema_table(m, h), select(m, h, &sel)?),
-            })
-        })
-        .map_err(|e| to_py(py, e))?;
+    let h = field(py, d, "values", &h)?;
+    let (table, kept) = py.detach(|| table_and_kept(d, h, &sel)).map_err(|e| to_py(py, e))?;
     let out = PyDict::new(py);
     let col = |f: &dyn Fn(&toposmooth::topology::ExtremumInfo) -> f64| table.iter().map(f).collect::<Vec<f64>>();
     out.set_item("vertex", PyArray1::from_vec(py, table.iter().map(|e| e.index as i64).collect::<Vec<_>>()))?;
@@ -432,22 +442,12 @@ fn diagram<'py>(
     settings: &Bound<'py, PyDict>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let sel = selection(py, settings)?;
-    let h = values(py, "values", &h)?;
     let d = &domain.inner;
-    if h.len() != d.n_vertices() {
-        return Err(to_py(
-            py,
-            Error::input(format!("values has {} entries, the domain {} vertices", h.len(), d.n_vertices())),
-        ));
-    }
+    let h = field(py, d, "values", &h)?;
     let (pairs, kept) = py
         .detach(|| -> toposmooth::Result<_> {
-            let kept = match d {
-                AnyDomain::Series(s) => select(s, h, &sel)?,
-                AnyDomain::Grid(g) => select(g, h, &sel)?,
-                AnyDomain::Mesh(m) => select(m, h, &sel)?,
-            };
-            Ok((toposmooth::io::ttk::diagram_of(d, h), kept))
+            let (table, kept) = table_and_kept(d, h, &sel)?;
+            Ok((toposmooth::io::ttk::diagram_from_table(d, h, &table), kept))
         })
         .map_err(|e| to_py(py, e))?;
     let k = pairs.len();
@@ -576,14 +576,8 @@ type Filled<'py> = (Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<bool>>);
 /// the filled copy and the mask of filled samples; infinities are refused.
 #[pyfunction]
 fn fill_missing<'py>(py: Python<'py>, domain: &Domain, h: PyReadonlyArray1<'py, f64>) -> PyResult<Filled<'py>> {
-    let mut v = values(py, "values", &h)?.to_vec();
     let d = &domain.inner;
-    if v.len() != d.n_vertices() {
-        return Err(to_py(
-            py,
-            Error::input(format!("values has {} entries, the domain {} vertices", v.len(), d.n_vertices())),
-        ));
-    }
+    let mut v = field(py, d, "values", &h)?.to_vec();
     if let Some(i) = v.iter().position(|x| x.is_infinite()) {
         return Err(to_py(py, Error::input(format!("values[{i}] is infinite: only NaN samples are filled"))));
     }

@@ -249,33 +249,6 @@ class SmoothResult:
         )
 
 
-def _settings(
-    order: Union[int, str],
-    data_weight: float,
-    smooth_length: Optional[float],
-    smooth_weight: Optional[float],
-    edges: str,
-    representative: Optional[str],
-    max_iter: int,
-    solver: str,
-    formulation: str,
-    selection: Dict[str, Any],
-) -> Dict[str, Any]:
-    s = dict(selection)
-    s.update(
-        order=str(order),
-        data_weight=float(data_weight),
-        smooth_length=None if smooth_length is None else float(smooth_length),
-        smooth_weight=None if smooth_weight is None else float(smooth_weight),
-        edges=edges,
-        representative=representative,
-        max_iter=int(max_iter),
-        solver=solver,
-        formulation=formulation,
-    )
-    return s
-
-
 class Smoother:
     """Many fields on one domain with one set of settings (time steps, ensemble members).
 
@@ -373,17 +346,17 @@ def _resolve(settings: Dict[str, Any]) -> Dict[str, Any]:
         s["keep_all_maxima"],
         s["keep_all_minima"],
     )
-    out = _settings(
-        s["order"],
-        s["data_weight"],
-        s["smooth_length"],
-        s["smooth_weight"],
-        s["edges"],
-        s["representative"],
-        s["max_iter"],
-        s["solver"],
-        s["formulation"],
+    out = dict(
         selection,
+        order=str(s["order"]),
+        data_weight=float(s["data_weight"]),
+        smooth_length=None if s["smooth_length"] is None else float(s["smooth_length"]),
+        smooth_weight=None if s["smooth_weight"] is None else float(s["smooth_weight"]),
+        edges=s["edges"],
+        representative=s["representative"],
+        max_iter=int(s["max_iter"]),
+        solver=s["solver"],
+        formulation=s["formulation"],
     )
     if s["threads"] is not None:
         if int(s["threads"]) < 1:

@@ -163,13 +163,20 @@ pub fn check_diagram_output(path: &Path) -> Result<()> {
 
 /// [`diagram_pairs`] of `h` on a domain chosen at run time.
 pub fn diagram_of(domain: &AnyDomain, h: &[f64]) -> Vec<DiagramPair> {
-    fn on<D: Domain>(d: &D, h: &[f64], surface: bool) -> Vec<DiagramPair> {
-        diagram_pairs(d, h, &crate::topology::extrema_table(d, h), surface)
-    }
+    let table = match domain {
+        AnyDomain::Series(d) => crate::topology::extrema_table(d, h),
+        AnyDomain::Grid(d) => crate::topology::extrema_table(d, h),
+        AnyDomain::Mesh(d) => crate::topology::extrema_table(d, h),
+    };
+    diagram_from_table(domain, h, &table)
+}
+
+/// [`diagram_pairs`] on a domain chosen at run time, from its extremum table.
+pub fn diagram_from_table(domain: &AnyDomain, h: &[f64], table: &[ExtremumInfo]) -> Vec<DiagramPair> {
     match domain {
-        AnyDomain::Series(d) => on(d, h, false),
-        AnyDomain::Grid(d) => on(d, h, true),
-        AnyDomain::Mesh(d) => on(d, h, true),
+        AnyDomain::Series(d) => diagram_pairs(d, h, table, false),
+        AnyDomain::Grid(d) => diagram_pairs(d, h, table, true),
+        AnyDomain::Mesh(d) => diagram_pairs(d, h, table, true),
     }
 }
 

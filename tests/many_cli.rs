@@ -88,6 +88,7 @@ fn misuse_is_refused_before_any_work() {
         (vec!["smooth", &a, &b, "--out-dir", &missing], "does not exist"),
         (vec!["smooth", &a, &b, "--out-dir", &inputs_dir], "is also an input"),
         (vec!["smooth", &a, &b, "--out-dir", &o_dir, "-o", "x.vti"], "cannot be used with"),
+        (vec!["smooth", &a, "-o", "x.vti", "--out-format", "vti"], "--out-format"),
     ];
     for (args, needle) in cases {
         let o = toposmooth(&args);

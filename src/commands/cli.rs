@@ -510,6 +510,10 @@ fn smooth_command(c: SmoothCli) -> Result<String> {
     let (inputs, out_dir, out_format) = (c.input.clone(), c.out_dir.clone(), c.out_format.clone());
     let collection = inputs.len() == 1 && inputs[0].extension().is_some_and(|e| e.eq_ignore_ascii_case("pvd"));
     let args = smooth_args(c)?;
+    if out_format.is_some() && out_dir.is_none() {
+        // clap's `requires` is not checked when -o, which conflicts with --out-dir, is given
+        return Err(Error::Usage("--out-format names the outputs of --out-dir; with -o the name is -o's".into()));
+    }
     match out_dir {
         Some(dir) => commands::smooth_many(&args, &inputs, &dir, out_format.as_deref()),
         None if inputs.len() > 1 || collection => Err(Error::Usage(format!(

@@ -20,8 +20,11 @@
 //! assert!(vorticity(&g, &u, &v).iter().all(|w| (w - 2.0).abs() < 1e-12));
 //! # Ok::<(), toposmooth::Error>(())
 //! ```
+//!
+//! On a volume, [`curl`] gives the vorticity vector ∇ × (u, v, w) with the same differences
+//! along x, y and z.
 
-use crate::domain::Grid2d;
+use crate::domain::{Grid2d, Grid3d};
 use crate::error::{Error, Result};
 use crate::operators::{dirichlet_solve, grid_stiffness};
 
@@ -61,6 +64,53 @@ pub fn vorticity(grid: &Grid2d, u: &[f64], v: &[f64]) -> Vec<f64> {
 /// Speed |(u, v)|.
 pub fn magnitude(u: &[f64], v: &[f64]) -> Vec<f64> {
     u.iter().zip(v).map(|(a, b)| a.hypot(*b)).collect()
+}
+
+/// ∂f/∂x_a along each axis a of a volume (signed spacing; central inside, one-sided at the
+/// boundary).
+pub fn gradient3(grid: &Grid3d, f: &[f64]) -> [Vec<f64>; 3] {
+    let n = grid.dims();
+    let h = grid.spacing();
+    let stride = [1, n[0], n[0] * n[1]];
+    let mut out = [vec![0.0; f.len()], vec![0.0; f.len()], vec![0.0; f.len()]];
+    for (v, _) in f.iter().enumerate() {
+        let p = grid.ijk(v);
+        for a in 0..3 {
+            let s = stride[a];
+            out[a][v] = if p[a] == 0 {
+                (f[v + s] - f[v]) / h[a]
+            } else if p[a] + 1 == n[a] {
+                (f[v] - f[v - s]) / h[a]
+            } else {
+                (f[v + s] - f[v - s]) / (2.0 * h[a])
+            };
+        }
+    }
+    out
+}
+
+/// The curl ∇ × (u, v, w) of a volume's velocity, component by component (x, y, z); NaN
+/// wherever a vector its stencils use is missing.
+pub fn curl(grid: &Grid3d, [u, v, w]: [&[f64]; 3]) -> [Vec<f64>; 3] {
+    let [ux, uy, uz] = gradient3(grid, u);
+    let [vx, vy, vz] = gradient3(grid, v);
+    let [wx, wy, wz] = gradient3(grid, w);
+    let _ = (ux, vy, wz);
+    let missing = |i: usize| u[i].is_nan() || v[i].is_nan() || w[i].is_nan();
+    let masked = |c: Vec<f64>| -> Vec<f64> {
+        c.into_iter().enumerate().map(|(i, x)| if missing(i) { f64::NAN } else { x }).collect()
+    };
+    let n = u.len();
+    [
+        masked((0..n).map(|i| wy[i] - vz[i]).collect()),
+        masked((0..n).map(|i| uz[i] - wx[i]).collect()),
+        masked((0..n).map(|i| vx[i] - uy[i]).collect()),
+    ]
+}
+
+/// |(u, v, w)|.
+pub fn magnitude3([u, v, w]: [&[f64]; 3]) -> Vec<f64> {
+    (0..u.len()).map(|i| (u[i] * u[i] + v[i] * v[i] + w[i] * w[i]).sqrt()).collect()
 }
 
 /// The first few missing samples as `(row r, column c)` text.

@@ -2,7 +2,7 @@
 //! same over a domain chosen at run time (for bindings that cannot be generic).
 
 pub use crate::domain::AnyDomain;
-use crate::domain::{Domain, Grid2d, Series, TriMesh};
+use crate::domain::{Domain, Grid2d, Grid3d, Series, TriMesh};
 use crate::error::Result;
 use crate::linalg::Analyses;
 #[cfg(doc)]
@@ -84,6 +84,20 @@ pub enum AnySmoother {
     Grid(Smoother<Grid2d>),
     /// On a mesh.
     Mesh(Smoother<TriMesh>),
+    /// On a volume grid.
+    Volume(Smoother<Grid3d>),
+}
+
+/// Runs `$body` with `$s` bound to the [`Smoother`] inside an [`AnySmoother`].
+macro_rules! with_smoother {
+    ($any:expr, $s:ident => $body:expr) => {
+        match $any {
+            AnySmoother::Series($s) => $body,
+            AnySmoother::Grid($s) => $body,
+            AnySmoother::Mesh($s) => $body,
+            AnySmoother::Volume($s) => $body,
+        }
+    };
 }
 
 impl AnySmoother {
@@ -96,6 +110,7 @@ impl AnySmoother {
             AnyDomain::Series(d) => AnySmoother::Series(Smoother::new(d, settings)?),
             AnyDomain::Grid(d) => AnySmoother::Grid(Smoother::new(d, settings)?),
             AnyDomain::Mesh(d) => AnySmoother::Mesh(Smoother::new(d, settings)?),
+            AnyDomain::Volume(d) => AnySmoother::Volume(Smoother::new(d, settings)?),
         })
     }
 
@@ -104,28 +119,16 @@ impl AnySmoother {
     /// # Errors
     /// As [`Smoother::smooth`].
     pub fn smooth(&mut self, h: &[f64]) -> Result<Smoothed> {
-        match self {
-            AnySmoother::Series(s) => s.smooth(h),
-            AnySmoother::Grid(s) => s.smooth(h),
-            AnySmoother::Mesh(s) => s.smooth(h),
-        }
+        with_smoother!(self, s => s.smooth(h))
     }
 
     /// Vertices of the domain (the length a field must have).
     pub fn n_vertices(&self) -> usize {
-        match self {
-            AnySmoother::Series(s) => s.domain().n_vertices(),
-            AnySmoother::Grid(s) => s.domain().n_vertices(),
-            AnySmoother::Mesh(s) => s.domain().n_vertices(),
-        }
+        with_smoother!(self, s => s.domain().n_vertices())
     }
 
     /// The settings.
     pub fn settings(&self) -> &SmoothSettings {
-        match self {
-            AnySmoother::Series(s) => s.settings(),
-            AnySmoother::Grid(s) => s.settings(),
-            AnySmoother::Mesh(s) => s.settings(),
-        }
+        with_smoother!(self, s => s.settings())
     }
 }

@@ -174,12 +174,7 @@ pub fn certify<D: Domain>(domain: &D, f: &[f64], roles: &[Role], input: Option<&
 
 /// [`certify`] on a domain chosen at run time.
 pub fn certify_any(domain: &crate::domain::AnyDomain, f: &[f64], roles: &[Role], input: Option<&[f64]>) -> Certificate {
-    use crate::domain::AnyDomain;
-    match domain {
-        AnyDomain::Series(d) => certify(d, f, roles, input),
-        AnyDomain::Grid(d) => certify(d, f, roles, input),
-        AnyDomain::Mesh(d) => certify(d, f, roles, input),
-    }
+    crate::with_domain!(domain, d => certify(d, f, roles, input))
 }
 
 /// What a connected set of fixed vertices with one prescribed value must be (no-data mode).

@@ -11,7 +11,7 @@ use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyType};
 use toposmooth::apps::weights::{WeightMethod, WeightSettings};
-use toposmooth::domain::{AnyDomain, Domain as _, Grid2d, Series, TriMesh};
+use toposmooth::domain::{AnyDomain, Domain as _, Grid2d, Grid3d, Series, TriMesh};
 use toposmooth::topology::{extrema_table, select, ExtremumKind, Role, Selection};
 use toposmooth::{
     AnySmoother, EdgeSet, Energy, Error, ErrorKind, Formulation, Method, QpSettings, RepresentativeChoice,
@@ -67,11 +67,7 @@ fn table_and_kept(
     h: &[f64],
     sel: &Selection,
 ) -> toposmooth::Result<(Vec<toposmooth::topology::ExtremumInfo>, toposmooth::topology::KeptSet)> {
-    Ok(match d {
-        AnyDomain::Series(s) => (extrema_table(s, h), select(s, h, sel)?),
-        AnyDomain::Grid(g) => (extrema_table(g, h), select(g, h, sel)?),
-        AnyDomain::Mesh(m) => (extrema_table(m, h), select(m, h, sel)?),
-    })
+    Ok(toposmooth::with_domain!(d, g => (extrema_table(g, h), select(g, h, sel)?)))
 }
 
 /// A domain: a series, a regular grid or a triangle mesh (validated).
@@ -104,6 +100,14 @@ impl Domain {
     fn grid(py: Python<'_>, nx: usize, ny: usize, spacing: [f64; 2], origin: [f64; 2]) -> PyResult<Self> {
         let grid = Grid2d::with_geometry(nx, ny, spacing, origin).map_err(|e| to_py(py, e))?;
         Ok(Domain { inner: AnyDomain::Grid(grid) })
+    }
+
+    /// An `nx × ny × nz` volume grid, vertex (i, j, k) at `origin + (i·dx, j·dy, k·dz)` with
+    /// flat index `i + nx·(j + ny·k)` (a C-order array of shape (nz, ny, nx), flattened).
+    #[staticmethod]
+    fn volume(py: Python<'_>, nx: usize, ny: usize, nz: usize, spacing: [f64; 3], origin: [f64; 3]) -> PyResult<Self> {
+        let grid = Grid3d::with_geometry([nx, ny, nz], spacing, origin).map_err(|e| to_py(py, e))?;
+        Ok(Domain { inner: AnyDomain::Volume(grid) })
     }
 
     /// A triangle mesh from `vertices` (n, 2|3) float64 and `faces` (m, 3) int64.
@@ -144,6 +148,7 @@ impl Domain {
             AnyDomain::Series(_) => "series",
             AnyDomain::Grid(_) => "grid",
             AnyDomain::Mesh(_) => "mesh",
+            AnyDomain::Volume(_) => "volume",
         }
     }
 
@@ -154,6 +159,14 @@ impl Domain {
                 format!("Domain.grid({} × {}, spacing {:?}, origin {:?})", g.nx(), g.ny(), g.spacing(), g.origin())
             }
             AnyDomain::Mesh(m) => format!("Domain.mesh({} vertices, {} triangles)", m.n_vertices(), m.faces().len()),
+            AnyDomain::Volume(g) => format!(
+                "Domain.volume({} × {} × {}, spacing {:?}, origin {:?})",
+                g.nx(),
+                g.ny(),
+                g.nz(),
+                g.spacing(),
+                g.origin()
+            ),
         }
     }
 }
@@ -550,11 +563,10 @@ fn weights<'py>(
     let cap = ws.threads;
     let w = py
         .detach(|| {
-            toposmooth::parallel::with_threads(cap, || match d {
-                AnyDomain::Series(s) => toposmooth::apps::weights::weights(s, &handles, &ws),
-                AnyDomain::Grid(g) => toposmooth::apps::weights::weights(g, &handles, &ws),
-                AnyDomain::Mesh(m) => toposmooth::apps::weights::weights(m, &handles, &ws),
-            })
+            toposmooth::parallel::with_threads(
+                cap,
+                || toposmooth::with_domain!(d, g => toposmooth::apps::weights::weights(g, &handles, &ws)),
+            )
         })
         .map_err(|e| to_py(py, e))?;
     let out = PyDict::new(py);
@@ -592,6 +604,10 @@ fn fill_missing<'py>(py: Python<'py>, domain: &Domain, h: PyReadonlyArray1<'py, 
                             AnyDomain::Grid(g) => toposmooth::derive::fill_missing(g, &mut v)?,
                             AnyDomain::Mesh(m) => {
                                 let k = toposmooth::operators::positive_cotan_stiffness(m.positions(), m.faces());
+                                toposmooth::derive::fill_missing_with(&k, &mut v)?
+                            }
+                            AnyDomain::Volume(g) => {
+                                let k = toposmooth::operators::volume_stiffness(g);
                                 toposmooth::derive::fill_missing_with(&k, &mut v)?
                             }
                             AnyDomain::Series(_) => unreachable!("handled above"),

@@ -215,8 +215,9 @@ struct GridCli {
     /// with --derive the only vector array); on a mesh also `x`, `y` or `z`.
     #[arg(long, value_name = "NAME")]
     array: Option<String>,
-    /// Grid spacing `dx,dy` (overrides the file's; may be negative, e.g. rows running down).
-    #[arg(long, value_name = "DX,DY", allow_hyphen_values = true)]
+    /// Grid spacing `dx,dy`, volume spacing `dx,dy,dz` (overrides the file's; may be negative,
+    /// e.g. rows running down).
+    #[arg(long, value_name = "DX,DY[,DZ]", allow_hyphen_values = true)]
     spacing: Option<String>,
     /// Grid: smooth a scalar derived from a velocity field (a 2- or 3-component array, or
     /// --u and --v).
@@ -244,21 +245,23 @@ impl GridCli {
         let spacing = match &self.spacing {
             None => None,
             Some(text) => {
+                let bad = || {
+                    Error::Usage(format!(
+                        "--spacing `{text}` must be two numbers dx,dy (grids) or three dx,dy,dz (volumes) with \
+                         {MIN_SPACING:e} ≤ |d| ≤ {MAX_SPACING:e}"
+                    ))
+                };
                 let parts: Vec<f64> = text
                     .split(',')
                     .map(|p| p.trim().parse::<f64>())
                     .collect::<std::result::Result<_, _>>()
-                    .map_err(|_| Error::Usage(format!("--spacing `{text}` is not two numbers dx,dy")))?;
-                match parts.as_slice() {
-                    [dx, dy] if [dx, dy].iter().all(|d| (MIN_SPACING..=MAX_SPACING).contains(&d.abs())) => {
-                        Some([*dx, *dy])
-                    }
-                    _ => {
-                        return Err(Error::Usage(format!(
-                            "--spacing `{text}` must be two numbers dx,dy with {MIN_SPACING:e} ≤ |d| ≤ {MAX_SPACING:e}"
-                        )))
-                    }
+                    .map_err(|_| bad())?;
+                if !(2..=3).contains(&parts.len())
+                    || parts.iter().any(|d| !(MIN_SPACING..=MAX_SPACING).contains(&d.abs()))
+                {
+                    return Err(bad());
                 }
+                Some(parts)
             }
         };
         Ok(GridOptions {

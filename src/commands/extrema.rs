@@ -81,6 +81,11 @@ fn place(field: &Field, i: usize) -> serde_json::Map<String, serde_json::Value> 
         AnyDomain::Mesh(mesh) => {
             m.insert("position".into(), json!(mesh.positions()[i]));
         }
+        AnyDomain::Volume(g) => {
+            let ijk = g.ijk(i);
+            m.insert("ijk".into(), json!(ijk));
+            m.insert("position".into(), json!(g.world(i)));
+        }
     }
     m
 }
@@ -95,11 +100,7 @@ pub fn extrema(args: &ExtremaArgs) -> Result<String> {
     }
     let path = args.input.clone().unwrap_or_default();
     let field = read_field(args.input.as_deref(), args.kind, &args.csv, &args.grid)?.into_field(&path)?;
-    let text = match &field.domain {
-        AnyDomain::Series(d) => list(args, &field, d)?,
-        AnyDomain::Grid(d) => list(args, &field, d)?,
-        AnyDomain::Mesh(d) => list(args, &field, d)?,
-    };
+    let text = crate::with_domain!(&field.domain, d => list(args, &field, d)?);
     if args.json {
         return Ok(text);
     }
@@ -118,6 +119,10 @@ fn label(field: &Field, i: usize) -> String {
             let p = m.positions()[i];
             format!("({},{},{})", sig6(p[0]), sig6(p[1]), sig6(p[2]))
         }
+        AnyDomain::Volume(g) => {
+            let [a, b, c] = g.ijk(i);
+            format!("({a},{b},{c})")
+        }
     }
 }
 
@@ -129,6 +134,7 @@ fn list<D: Domain>(args: &ExtremaArgs, field: &Field, domain: &D) -> Result<Stri
     };
     let mesh = match &field.domain {
         AnyDomain::Mesh(m) => Some(format!("mesh of {}", m.describe())),
+        AnyDomain::Volume(_) => Some(field.domain.describe()),
         _ => None,
     };
     let label = |i: usize| label(field, i);

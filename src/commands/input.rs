@@ -2,8 +2,8 @@
 //! CSV matrix, PNG, TIFF, or two velocity components), with the grid options `--array`,
 //! `--spacing`, `--derive` and `--fill-missing` applied.
 
-use crate::derive::{describe_missing, fill_missing, magnitude, vorticity};
-use crate::domain::{Domain, Grid2d, TriMesh};
+use crate::derive::{describe_missing, fill_missing, fill_missing_with, magnitude, vorticity};
+use crate::domain::{Domain, Grid2d, Grid3d, TriMesh};
 use crate::error::{Error, Result};
 use crate::io::export::Carried;
 use crate::io::grid::{raster_grid, read_grid_csv, read_raster, GridField};
@@ -11,7 +11,7 @@ use crate::io::mesh::is_mesh_file;
 pub use crate::io::mesh::read_trimesh;
 use crate::io::npy_input::{is_numpy, read_numpy, NumpyField, Wanted};
 use crate::io::series_csv::{read_series, SeriesCsv, SeriesCsvOptions};
-use crate::io::vtk::read_image;
+use crate::io::vtk::{read_any_image, AnyImage};
 use crate::series_fill::fill_missing_series;
 use std::path::{Path, PathBuf};
 
@@ -36,10 +36,40 @@ pub enum DomainKind {
 #[serde(rename_all = "lowercase")]
 #[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 pub enum Derive {
-    /// ω = ∂v/∂x − ∂u/∂y.
+    /// ω = ∂v/∂x − ∂u/∂y (2D grids).
     Vorticity,
-    /// |(u, v)|.
+    /// |(u, v)| or |(u, v, w)|.
     Magnitude,
+    /// |∇ × (u, v, w)| (volumes).
+    #[serde(rename = "vorticity-magnitude")]
+    #[cfg_attr(feature = "cli", value(name = "vorticity-magnitude"))]
+    VorticityMagnitude,
+    /// (∇ × (u, v, w))ₓ = ∂w/∂y − ∂v/∂z (volumes).
+    #[serde(rename = "vorticity-x")]
+    #[cfg_attr(feature = "cli", value(name = "vorticity-x"))]
+    VorticityX,
+    /// (∇ × (u, v, w))_y = ∂u/∂z − ∂w/∂x (volumes).
+    #[serde(rename = "vorticity-y")]
+    #[cfg_attr(feature = "cli", value(name = "vorticity-y"))]
+    VorticityY,
+    /// (∇ × (u, v, w))_z = ∂v/∂x − ∂u/∂y (volumes).
+    #[serde(rename = "vorticity-z")]
+    #[cfg_attr(feature = "cli", value(name = "vorticity-z"))]
+    VorticityZ,
+}
+
+impl Derive {
+    /// The derivation's name as the command line spells it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Derive::Vorticity => "vorticity",
+            Derive::Magnitude => "magnitude",
+            Derive::VorticityMagnitude => "vorticity-magnitude",
+            Derive::VorticityX => "vorticity-x",
+            Derive::VorticityY => "vorticity-y",
+            Derive::VorticityZ => "vorticity-z",
+        }
+    }
 }
 
 /// How to read a grid.
@@ -48,8 +78,8 @@ pub struct GridOptions {
     /// Point array to read from a VTK file (default: the only scalar array, or with
     /// `derive` the only vector array).
     pub array: Option<String>,
-    /// Spacing `(dx, dy)`, overriding the file's.
-    pub spacing: Option<[f64; 2]>,
+    /// Spacing `(dx, dy)` or, for a volume, `(dx, dy, dz)`, overriding the file's.
+    pub spacing: Option<Vec<f64>>,
     /// Derive a scalar from a velocity field.
     pub derive: Option<Derive>,
     /// Velocity components from two grid files (with `derive`).
@@ -72,6 +102,23 @@ pub struct GridInput {
     /// Samples filled by `--fill-missing` (1) or not (0), when any were.
     pub filled: Option<Vec<bool>>,
     /// The file the grid came from (the first velocity file with `--u/--v`).
+    pub path: PathBuf,
+    /// A VTK image's arrays, for outputs that carry them through.
+    pub carried: Option<Carried>,
+}
+
+/// A volume field ready to smooth.
+#[derive(Clone, Debug)]
+pub struct VolumeInput {
+    /// The volume grid with its spacing and origin.
+    pub grid: Grid3d,
+    /// The values to smooth (after deriving and filling).
+    pub values: Vec<f64>,
+    /// What the values are: the array read or the derivation.
+    pub description: String,
+    /// Samples filled by `--fill-missing`, when any were.
+    pub filled: Option<Vec<bool>>,
+    /// The file the volume came from.
     pub path: PathBuf,
     /// A VTK image's arrays, for outputs that carry them through.
     pub carried: Option<Carried>,
@@ -114,6 +161,8 @@ pub enum FieldInput {
     Grid(GridInput),
     /// A field on a triangle mesh.
     Mesh(MeshInput),
+    /// A volume.
+    Volume(VolumeInput),
 }
 
 /// Reads the field on a mesh: `--values FILE`, `--array NAME` (a vertex array or the
@@ -326,6 +375,7 @@ pub fn read_field(
     match read_field_from(Some(&once.tmp), kind, csv, grid) {
         Ok(FieldInput::Grid(g)) => Ok(FieldInput::Grid(GridInput { path: name, ..g })),
         Ok(FieldInput::Mesh(m)) => Ok(FieldInput::Mesh(MeshInput { path: name, ..m })),
+        Ok(FieldInput::Volume(v)) => Ok(FieldInput::Volume(VolumeInput { path: name, ..v })),
         Ok(series) => Ok(series),
         Err(e) => Err(e.renamed(&once.tmp, &name)),
     }
@@ -372,9 +422,9 @@ fn read_field_from(
         Some(p) if grid.uv.is_some() => {
             Err(Error::Usage(format!("give either an input file ({}) or --u and --v, not both", p.display())))
         }
-        Some(p) => Ok(FieldInput::Grid(read_grid(p, grid)?)),
+        Some(p) => read_grid(p, grid),
         None => match &grid.uv {
-            Some(_) => Ok(FieldInput::Grid(read_grid(Path::new(""), grid)?)),
+            Some(_) => read_grid(Path::new(""), grid),
             None => Err(Error::Usage("no input file".into())),
         },
     }
@@ -438,9 +488,31 @@ fn numpy_series(
     Ok(Some(SeriesInput { data, filled }))
 }
 
+/// The points of an image as read: a 2D grid or a volume.
+#[derive(Clone, Debug, PartialEq)]
+enum Geometry {
+    Flat(Grid2d),
+    Volume(Grid3d),
+}
+
+impl Geometry {
+    fn dims_text(&self) -> String {
+        match self {
+            Geometry::Flat(g) => format!("{} × {}", g.nx(), g.ny()),
+            Geometry::Volume(g) => format!("{} × {} × {}", g.nx(), g.ny(), g.nz()),
+        }
+    }
+    fn dims(&self) -> Vec<usize> {
+        match self {
+            Geometry::Flat(g) => vec![g.nx(), g.ny()],
+            Geometry::Volume(g) => g.dims().to_vec(),
+        }
+    }
+}
+
 /// One array of a raw read: name, components, values.
 struct Raw {
-    grid: Grid2d,
+    geometry: Geometry,
     arrays: Vec<(String, usize, Vec<f64>)>,
     /// Arrays of the file that are not numeric: "`name` (type)".
     skipped: Vec<String>,
@@ -453,7 +525,7 @@ struct Raw {
 fn read_raw(path: &Path, array: Option<&str>) -> Result<Raw> {
     let from_field = |f: GridField| Raw {
         arrays: vec![(f.array, 1, f.values)],
-        grid: f.grid,
+        geometry: Geometry::Flat(f.grid),
         skipped: Vec::new(),
         active: None,
         carried: None,
@@ -461,14 +533,30 @@ fn read_raw(path: &Path, array: Option<&str>) -> Result<Raw> {
     crate::io::content::check_extension(path)?;
     match extension(path).as_str() {
         "vti" | "vtk" => {
-            let img = read_image(path)?;
-            let grid = Grid2d::with_geometry(img.nx, img.ny, img.spacing, img.origin).map_err(|e| e.in_file(path))?;
-            let arrays = img.arrays.iter().map(|a| (a.name.clone(), a.components, a.values.clone())).collect();
-            let carried = Carried { point: img.arrays, cells: None, cell: img.cell_arrays, source: None };
-            Ok(Raw { grid, arrays, skipped: img.skipped, active: img.active_scalars, carried: Some(carried) })
+            let (geometry, arrays, cell, skipped, active) = match read_any_image(path)? {
+                AnyImage::Flat(img) => {
+                    let grid =
+                        Grid2d::with_geometry(img.nx, img.ny, img.spacing, img.origin).map_err(|e| e.in_file(path))?;
+                    (Geometry::Flat(grid), img.arrays, img.cell_arrays, img.skipped, img.active_scalars)
+                }
+                AnyImage::Volume(v) => {
+                    let grid = Grid3d::with_geometry(v.dims, v.spacing, v.origin).map_err(|e| e.in_file(path))?;
+                    (Geometry::Volume(grid), v.arrays, v.cell_arrays, v.skipped, v.active_scalars)
+                }
+            };
+            let listed = arrays.iter().map(|a| (a.name.clone(), a.components, a.values.clone())).collect();
+            let carried = Carried { point: arrays, cells: None, cell, source: None };
+            Ok(Raw { geometry, arrays: listed, skipped, active, carried: Some(carried) })
         }
         "npy" | "npz" => match read_numpy(path, array, Wanted::Grid)? {
             NumpyField::Grid(f) => Ok(from_field(f)),
+            NumpyField::Volume { name, grid, values } => Ok(Raw {
+                arrays: vec![(name, 1, values)],
+                geometry: Geometry::Volume(grid),
+                skipped: Vec::new(),
+                active: None,
+                carried: None,
+            }),
             NumpyField::Series { name, .. } => {
                 Err(Error::input(format!("array `{name}` is 1-D: a series, not a grid")).in_file(path))
             }
@@ -478,13 +566,32 @@ fn read_raw(path: &Path, array: Option<&str>) -> Result<Raw> {
     }
 }
 
-/// The grid with `--spacing` applied: the file's origin kept, except for a raster, whose spacing
-/// is its pixel size with the top row kept at the top ([`raster_grid`]).
-fn with_spacing(path: &Path, grid: &Grid2d, spacing: Option<[f64; 2]>) -> Result<Grid2d> {
-    match spacing {
-        Some(s) if is_raster(path) => raster_grid(grid.nx(), grid.ny(), s).map_err(|e| e.in_file(path)),
-        Some(s) => Grid2d::with_geometry(grid.nx(), grid.ny(), s, grid.origin()).map_err(|e| e.in_file(path)),
-        None => Ok(grid.clone()),
+/// The geometry with `--spacing` applied: the file's origin kept, except for a raster, whose
+/// spacing is its pixel size with the top row kept at the top ([`raster_grid`]).
+fn with_spacing(path: &Path, geometry: &Geometry, spacing: Option<&[f64]>) -> Result<Geometry> {
+    let Some(s) = spacing else {
+        return Ok(geometry.clone());
+    };
+    match (geometry, s) {
+        (Geometry::Flat(grid), &[dx, dy]) if is_raster(path) => {
+            raster_grid(grid.nx(), grid.ny(), [dx, dy]).map(Geometry::Flat).map_err(|e| e.in_file(path))
+        }
+        (Geometry::Flat(grid), &[dx, dy]) => Grid2d::with_geometry(grid.nx(), grid.ny(), [dx, dy], grid.origin())
+            .map(Geometry::Flat)
+            .map_err(|e| e.in_file(path)),
+        (Geometry::Volume(grid), &[dx, dy, dz]) => Grid3d::with_geometry(grid.dims(), [dx, dy, dz], grid.origin())
+            .map(Geometry::Volume)
+            .map_err(|e| e.in_file(path)),
+        (Geometry::Flat(_), _) => Err(Error::Usage(format!(
+            "{}: --spacing takes two numbers dx,dy for a 2D grid, got {}",
+            path.display(),
+            s.len()
+        ))),
+        (Geometry::Volume(_), _) => Err(Error::Usage(format!(
+            "{}: --spacing takes three numbers dx,dy,dz for a volume, got {}",
+            path.display(),
+            s.len()
+        ))),
     }
 }
 
@@ -528,33 +635,41 @@ fn pick<'a>(path: &Path, raw: &'a Raw, name: Option<&str>, vector: bool) -> Resu
     }
 }
 
-/// Reads a grid with its options applied: array choice, spacing, derivation, NaN policy.
+/// Reads a grid or a volume with its options applied: array choice, spacing, derivation,
+/// NaN policy.
 ///
 /// # Errors
 /// Input errors naming the file (unreadable, missing array, different grid sizes of `--u`
-/// and `--v`, NaN without `--fill-missing`), usage errors for contradictory options.
-pub fn read_grid(path: &Path, opts: &GridOptions) -> Result<GridInput> {
+/// and `--v`, NaN without `--fill-missing`, a derivation the domain has not), usage errors
+/// for contradictory options.
+pub fn read_grid(path: &Path, opts: &GridOptions) -> Result<FieldInput> {
     let mut carried = None;
-    let (grid, mut values, description, source) = match (&opts.uv, opts.derive) {
+    let spacing = opts.spacing.as_deref();
+    let (geometry, mut values, description, source) = match (&opts.uv, opts.derive) {
         (Some(_), None) => return Err(Error::Usage("--u and --v need --derive vorticity|magnitude".into())),
         (Some((pu, pv)), Some(d)) => {
             let (ru, rv) = (read_raw(pu, opts.array.as_deref())?, read_raw(pv, opts.array.as_deref())?);
-            if (ru.grid.nx(), ru.grid.ny()) != (rv.grid.nx(), rv.grid.ny()) {
+            if ru.geometry.dims() != rv.geometry.dims() {
                 return Err(Error::input(format!(
-                    "{} is {} × {} but {} is {} × {}",
+                    "{} is {} but {} is {}",
                     pu.display(),
-                    ru.grid.nx(),
-                    ru.grid.ny(),
+                    ru.geometry.dims_text(),
                     pv.display(),
-                    rv.grid.nx(),
-                    rv.grid.ny()
+                    rv.geometry.dims_text()
+                )));
+            }
+            if let Geometry::Volume(_) = ru.geometry {
+                return Err(Error::Usage(format!(
+                    "{}: --u and --v give a 2D velocity; a volume's velocity is one 3-component array",
+                    pu.display()
                 )));
             }
             let a = pick(pu, &ru, opts.array.as_deref(), false)?;
             let b = pick(pv, &rv, opts.array.as_deref(), false)?;
-            let grid = with_spacing(pu, &ru.grid, opts.spacing)?;
-            let values = derive(&grid, d, &a.2, &b.2);
-            (grid, values, format!("{d:?} of ({}, {})", pu.display(), pv.display()).to_lowercase(), pu.clone())
+            let geometry = with_spacing(pu, &ru.geometry, spacing)?;
+            let Geometry::Flat(grid) = &geometry else { unreachable!("checked above") };
+            let values = derive(pu, grid, d, &a.2, &b.2)?;
+            (geometry, values, format!("{} of ({}, {})", d.name(), pu.display(), pv.display()), pu.clone())
         }
         (None, Some(d)) => {
             let raw = read_raw(path, opts.array.as_deref())?;
@@ -566,33 +681,53 @@ pub fn read_grid(path: &Path, opts: &GridOptions) -> Result<GridInput> {
                 ))
                 .in_file(path));
             }
-            let u: Vec<f64> = a.2.iter().step_by(a.1).copied().collect();
-            let v: Vec<f64> = a.2.iter().skip(1).step_by(a.1).copied().collect();
-            let grid = with_spacing(path, &raw.grid, opts.spacing)?;
-            let values = derive(&grid, d, &u, &v);
-            let description = format!("{} of {}", if d == Derive::Vorticity { "vorticity" } else { "magnitude" }, a.0);
+            let component = |k: usize| -> Vec<f64> { a.2.iter().skip(k).step_by(a.1).copied().collect() };
+            let geometry = with_spacing(path, &raw.geometry, spacing)?;
+            let values = match &geometry {
+                Geometry::Flat(grid) => derive(path, grid, d, &component(0), &component(1))?,
+                Geometry::Volume(grid) => {
+                    if a.1 != 3 {
+                        return Err(Error::input(format!(
+                            "--derive on a volume needs a 3-component vector array; `{}` has {}",
+                            a.0, a.1
+                        ))
+                        .in_file(path));
+                    }
+                    derive_volume(path, grid, d, [&component(0), &component(1), &component(2)])?
+                }
+            };
+            let description = format!("{} of {}", d.name(), a.0);
             // the file's arrays move into the output's carried arrays, not copied
             carried = raw.carried;
-            (grid, values, description, path.to_path_buf())
+            (geometry, values, description, path.to_path_buf())
         }
         (None, None) => {
             let raw = read_raw(path, opts.array.as_deref())?;
             let a = pick(path, &raw, opts.array.as_deref(), false)?;
             if a.1 != 1 {
                 return Err(Error::input(format!(
-                    "`{}` has {} components; smooth a scalar array, or use --derive vorticity|magnitude",
-                    a.0, a.1
+                    "`{}` has {} components; smooth a scalar array, or use --derive ({})",
+                    a.0,
+                    a.1,
+                    match raw.geometry {
+                        Geometry::Flat(_) => "vorticity or magnitude",
+                        Geometry::Volume(_) => "vorticity-magnitude, vorticity-x|y|z or magnitude",
+                    }
                 ))
                 .in_file(path));
             }
-            let grid = with_spacing(path, &raw.grid, opts.spacing)?;
+            let geometry = with_spacing(path, &raw.geometry, spacing)?;
             let (name, values) = (a.0.clone(), a.2.clone());
             carried = raw.carried.map(|c| Carried { source: Some(name.clone()), ..c });
-            (grid, values, name, path.to_path_buf())
+            (geometry, values, name, path.to_path_buf())
         }
     };
+    let missing = match &geometry {
+        Geometry::Flat(grid) => describe_missing(grid, &values, 5),
+        Geometry::Volume(grid) => describe_missing_in_volume(grid, &values, 5),
+    };
     let mut filled = None;
-    if let Some(what) = describe_missing(&grid, &values, 5) {
+    if let Some(what) = missing {
         if !opts.fill_missing {
             let whose = if opts.derive.is_some() {
                 format!(
@@ -606,17 +741,78 @@ pub fn read_grid(path: &Path, opts: &GridOptions) -> Result<GridInput> {
             );
         }
         let mask: Vec<bool> = values.iter().map(|v| v.is_nan()).collect();
-        fill_missing(&grid, &mut values).map_err(|e| e.in_file(&source))?;
+        match &geometry {
+            Geometry::Flat(grid) => fill_missing(grid, &mut values),
+            Geometry::Volume(grid) => fill_missing_with(&crate::operators::volume_stiffness(grid), &mut values),
+        }
+        .map_err(|e| e.in_file(&source))?;
         filled = Some(mask);
     }
-    Ok(GridInput { grid, values, description, filled, path: source, carried })
+    Ok(match geometry {
+        Geometry::Flat(grid) => {
+            FieldInput::Grid(GridInput { grid, values, description, filled, path: source, carried })
+        }
+        Geometry::Volume(grid) => {
+            FieldInput::Volume(VolumeInput { grid, values, description, filled, path: source, carried })
+        }
+    })
 }
 
-fn derive(grid: &Grid2d, d: Derive, u: &[f64], v: &[f64]) -> Vec<f64> {
-    match d {
-        Derive::Vorticity => vorticity(grid, u, v),
-        Derive::Magnitude => magnitude(u, v),
+/// The first few missing samples of a volume as `(i, j, k)` text.
+fn describe_missing_in_volume(grid: &Grid3d, values: &[f64], limit: usize) -> Option<String> {
+    let missing: Vec<usize> = values.iter().enumerate().filter(|(_, v)| v.is_nan()).map(|(i, _)| i).collect();
+    if missing.is_empty() {
+        return None;
     }
+    let first: Vec<String> = missing
+        .iter()
+        .take(limit)
+        .map(|&v| {
+            let [i, j, k] = grid.ijk(v);
+            format!("(i {i}, j {j}, k {k})")
+        })
+        .collect();
+    Some(format!(
+        "{} missing (NaN) samples, the first at {}{}",
+        missing.len(),
+        first.join(", "),
+        if missing.len() > limit { ", …" } else { "" }
+    ))
+}
+
+/// A 2D grid's derived scalar.
+fn derive(path: &Path, grid: &Grid2d, d: Derive, u: &[f64], v: &[f64]) -> Result<Vec<f64>> {
+    match d {
+        Derive::Vorticity => Ok(vorticity(grid, u, v)),
+        Derive::Magnitude => Ok(magnitude(u, v)),
+        _ => Err(Error::Usage(format!(
+            "{}: --derive {} is for volumes; on a 2D grid use vorticity (the signed ∂v/∂x − ∂u/∂y) or magnitude",
+            path.display(),
+            d.name()
+        ))),
+    }
+}
+
+/// A volume's derived scalar (central differences, one-sided at the boundary, signed spacing).
+fn derive_volume(path: &Path, grid: &Grid3d, d: Derive, uvw: [&[f64]; 3]) -> Result<Vec<f64>> {
+    use crate::derive::{curl, magnitude3};
+    Ok(match d {
+        Derive::Magnitude => magnitude3(uvw),
+        Derive::VorticityMagnitude => {
+            let w = curl(grid, uvw);
+            magnitude3([&w[0], &w[1], &w[2]])
+        }
+        Derive::VorticityX => curl(grid, uvw)[0].clone(),
+        Derive::VorticityY => curl(grid, uvw)[1].clone(),
+        Derive::VorticityZ => curl(grid, uvw)[2].clone(),
+        Derive::Vorticity => {
+            return Err(Error::Usage(format!(
+                "{}: --derive vorticity is the signed 2D vorticity; on a volume use vorticity-magnitude or \
+                 vorticity-x, vorticity-y, vorticity-z (the curl's components)",
+                path.display()
+            )))
+        }
+    })
 }
 
 /// The x axis of a series as read: coordinates, their text and where they came from.
@@ -680,6 +876,16 @@ impl FieldInput {
                 notes: Vec::new(),
                 axis: None,
                 carried: g.carried,
+            },
+            FieldInput::Volume(v) => Field {
+                domain: AnyDomain::Volume(v.grid),
+                values: v.values,
+                path: v.path,
+                description: v.description,
+                filled: v.filled,
+                notes: Vec::new(),
+                axis: None,
+                carried: v.carried,
             },
             FieldInput::Mesh(m) => Field {
                 domain: AnyDomain::Mesh(m.mesh),

@@ -36,6 +36,11 @@ enum DomainFacts<'a> {
         negative_cotangent_edges: usize,
         reading_notes: &'a [String],
     },
+    Volume {
+        dims: [usize; 3],
+        spacing: [f64; 3],
+        origin: [f64; 3],
+    },
 }
 
 /// The JSON report of a run: the files, the domain, the seconds around the pipeline's.
@@ -75,6 +80,7 @@ fn same_domain(a: &AnyDomain, b: &AnyDomain) -> bool {
     match (a, b) {
         (AnyDomain::Series(a), AnyDomain::Series(b)) => a == b,
         (AnyDomain::Grid(a), AnyDomain::Grid(b)) => a == b,
+        (AnyDomain::Volume(a), AnyDomain::Volume(b)) => a == b,
         (AnyDomain::Mesh(a), AnyDomain::Mesh(b)) => {
             let bits =
                 |m: &crate::domain::TriMesh| m.positions().iter().flatten().map(|v| v.to_bits()).collect::<Vec<_>>();
@@ -115,6 +121,9 @@ pub(super) fn smooth_shared(args: &SmoothArgs, shared: Option<&mut Option<Shared
     }
     check_output(&args.output, &field.domain)?;
     check_output_array(args.output_array.as_deref())?;
+    if args.plot.is_some() && matches!(field.domain, AnyDomain::Volume(_)) {
+        return Err(Error::setting("plot", "is not drawn for volumes yet (write a .vti and open it in ParaView)"));
+    }
     if args.isolines > 0 && !matches!(field.domain, AnyDomain::Grid(_)) {
         return Err(Error::setting("isolines", "draws on a grid's figure only; this input is not a grid"));
     }
@@ -304,6 +313,7 @@ fn facts(field: &Field, negative: usize) -> DomainFacts<'_> {
             negative_cotangent_edges: negative,
             reading_notes: &field.notes,
         },
+        AnyDomain::Volume(g) => DomainFacts::Volume { dims: g.dims(), spacing: g.spacing(), origin: g.origin() },
     }
 }
 
@@ -319,6 +329,14 @@ fn read_line(field: &Field) -> String {
             "{path}: mesh of {} vertices and {} triangles, field `{}`",
             m.n_vertices(),
             m.faces().len(),
+            field.description
+        ),
+        AnyDomain::Volume(g) => format!(
+            "{path}: volume {} × {} × {} ({} vertices) of `{}`",
+            g.nx(),
+            g.ny(),
+            g.nz(),
+            g.n_vertices(),
             field.description
         ),
     }
@@ -363,6 +381,20 @@ fn input_line(field: &Field, r: &Report, filled: usize, negative: usize) -> Stri
             m.describe(),
             negative,
         ),
+        AnyDomain::Volume(g) => {
+            let s = g.spacing();
+            format!(
+                "{path}: {} of a {} × {} × {} volume (spacing {}, {}, {}){}; {extrema} (SoS, boundary included)\n",
+                field.description,
+                g.nx(),
+                g.ny(),
+                g.nz(),
+                sig6(s[0]),
+                sig6(s[1]),
+                sig6(s[2]),
+                if filled > 0 { format!(", {filled} missing samples filled harmonically") } else { String::new() },
+            )
+        }
     }
 }
 
@@ -440,6 +472,9 @@ fn stage_figure(path: &Path, args: &SmoothArgs, field: &Field, result: &Smoothed
                 )?;
                 Ok(())
             })?
+        }
+        AnyDomain::Volume(_) => {
+            return Err(Error::setting("plot", "is not drawn for volumes yet (write a .vti and open it in ParaView)"))
         }
     };
     Ok((staged, hidden))

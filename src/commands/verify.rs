@@ -136,7 +136,14 @@ fn compare_input(args: &VerifyArgs, orig: &Path, out: &Stored) -> Result<Option<
         AnyDomain::Grid(g) => {
             let vti = args.file.extension().is_some_and(|e| e.eq_ignore_ascii_case("vti"));
             if opts.spacing.is_none() && vti {
-                opts.spacing = Some(g.spacing());
+                opts.spacing = Some(g.spacing().to_vec());
+            }
+            DomainKind::Grid
+        }
+        AnyDomain::Volume(g) => {
+            let vti = args.file.extension().is_some_and(|e| e.eq_ignore_ascii_case("vti"));
+            if opts.spacing.is_none() && vti {
+                opts.spacing = Some(g.spacing().to_vec());
             }
             DomainKind::Grid
         }
@@ -147,6 +154,7 @@ fn compare_input(args: &VerifyArgs, orig: &Path, out: &Stored) -> Result<Option<
     let same = match (&original.domain, &out.domain) {
         (AnyDomain::Series(a), AnyDomain::Series(b)) => a.n_vertices() == b.n_vertices(),
         (AnyDomain::Grid(a), AnyDomain::Grid(b)) => (a.nx(), a.ny()) == (b.nx(), b.ny()),
+        (AnyDomain::Volume(a), AnyDomain::Volume(b)) => a.dims() == b.dims(),
         (AnyDomain::Mesh(a), AnyDomain::Mesh(b)) => a.n_vertices() == b.n_vertices() && a.faces() == b.faces(),
         _ => false,
     };

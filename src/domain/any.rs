@@ -1,6 +1,6 @@
 //! A domain chosen at run time: what a file holds, a command runs on, or a binding passes.
 
-use super::{Domain, Grid2d, Series, TriMesh};
+use super::{Domain, Grid2d, Grid3d, Series, TriMesh};
 
 /// A domain chosen at run time.
 #[derive(Clone, Debug)]
@@ -11,16 +11,34 @@ pub enum AnyDomain {
     Grid(Grid2d),
     /// A triangle mesh.
     Mesh(TriMesh),
+    /// An implicit volume grid.
+    Volume(Grid3d),
+}
+
+/// Runs `$body` with `$d` bound to the concrete domain inside an [`AnyDomain`] (every
+/// variant implements [`Domain`] and the pipeline's `Smoothable`).
+///
+/// ```
+/// use toposmooth::domain::{AnyDomain, Domain, Grid3d};
+/// let d = AnyDomain::Volume(Grid3d::new(2, 3, 4).unwrap());
+/// assert_eq!(toposmooth::with_domain!(&d, g => g.n_vertices()), 24);
+/// ```
+#[macro_export]
+macro_rules! with_domain {
+    ($any:expr, $d:ident => $body:expr) => {
+        match $any {
+            $crate::domain::AnyDomain::Series($d) => $body,
+            $crate::domain::AnyDomain::Grid($d) => $body,
+            $crate::domain::AnyDomain::Mesh($d) => $body,
+            $crate::domain::AnyDomain::Volume($d) => $body,
+        }
+    };
 }
 
 impl AnyDomain {
     /// Vertices of the domain (the length a field must have).
     pub fn n_vertices(&self) -> usize {
-        match self {
-            AnyDomain::Series(d) => d.n_vertices(),
-            AnyDomain::Grid(d) => d.n_vertices(),
-            AnyDomain::Mesh(d) => d.n_vertices(),
-        }
+        crate::with_domain!(self, d => d.n_vertices())
     }
 
     /// A vertex as a reader finds it: `sample i`, `(row r, column c)` or `vertex i`.
@@ -32,6 +50,10 @@ impl AnyDomain {
                 format!("(row {r}, column {c})")
             }
             AnyDomain::Mesh(_) => format!("vertex {v}"),
+            AnyDomain::Volume(g) => {
+                let [i, j, k] = g.ijk(v);
+                format!("(i {i}, j {j}, k {k})")
+            }
         }
     }
 
@@ -41,6 +63,7 @@ impl AnyDomain {
             AnyDomain::Series(s) => format!("{} samples", s.n_vertices()),
             AnyDomain::Grid(g) => format!("{} × {} grid", g.nx(), g.ny()),
             AnyDomain::Mesh(m) => format!("mesh of {}", m.describe()),
+            AnyDomain::Volume(g) => format!("{} × {} × {} volume", g.nx(), g.ny(), g.nz()),
         }
     }
 }

@@ -16,12 +16,14 @@ mod mesh;
 mod order;
 mod series;
 pub mod vec3;
+mod volume;
 
 pub use any::AnyDomain;
 pub use grid::{Grid2d, MAX_SPACING, MIN_SPACING};
 pub use mesh::{shapes, triangle_area, TriMesh};
 pub use order::{sos_greater, sos_less, sos_sort, sos_untied, value_range};
 pub use series::Series;
+pub use volume::{Grid3d, NEIGHBOUR_OFFSETS};
 
 /// How persistence pairs are formed on a domain (SPEC.md, "Persistence").
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

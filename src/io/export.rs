@@ -5,14 +5,14 @@
 
 use super::grid::stage_grid_csv;
 use super::mesh::{read_trimesh, stage_ply, MeshData};
-use super::npz::{read_npz, stage_npy, stage_npz};
+use super::npz::{read_npz_nd, stage_npy, stage_npy_shaped, stage_npz, stage_npz_shaped};
 use super::series_csv::{read_series_output, stage_series_output, SeriesOutput};
 use super::vtk::{
-    read_dataset, read_image, stage_legacy, stage_vti_arrays, stage_vtp, stage_vtp_cells, stage_vtu_cells,
-    triangle_cells, Cells, LegacyGeometry, OutArray, PointArray, PolyData, Scalar,
+    read_any_image, read_dataset, stage_legacy, stage_vti_arrays, stage_vtp, stage_vtp_cells, stage_vtu_cells,
+    triangle_cells, AnyImage, Cells, ImageBox, LegacyGeometry, OutArray, PointArray, PolyData, Scalar,
 };
 use super::Staged;
-use crate::domain::{AnyDomain, Domain, Grid2d, Series, TriMesh};
+use crate::domain::{AnyDomain, Domain, Grid2d, Grid3d, Series, TriMesh};
 use crate::error::{Error, Result};
 use crate::topology::morse_smale::MorseSmale;
 use crate::topology::Role;
@@ -24,6 +24,8 @@ pub const SERIES_OUTPUTS: &[&str] = &["csv"];
 pub const GRID_OUTPUTS: &[&str] = &["vti", "vtk", "npz", "npy", "csv"];
 /// Extensions of a mesh's output.
 pub const MESH_OUTPUTS: &[&str] = &["vtu", "vtp", "vtk", "ply"];
+/// Extensions of a volume's output (`.npy` holds the smoothed array only, shape (nz, ny, nx)).
+pub const VOLUME_OUTPUTS: &[&str] = &["vti", "vtk", "npz", "npy"];
 
 fn extension(path: &Path) -> String {
     path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase()
@@ -39,7 +41,7 @@ fn format_of(path: &Path, domain: &AnyDomain) -> String {
     }
     match domain {
         AnyDomain::Series(_) => "csv".into(),
-        AnyDomain::Grid(_) => "npy".into(),
+        AnyDomain::Grid(_) | AnyDomain::Volume(_) => "npy".into(),
         AnyDomain::Mesh(_) => e,
     }
 }
@@ -50,6 +52,7 @@ fn formats(domain: &AnyDomain) -> (&'static [&'static str], &'static str) {
         AnyDomain::Series(_) => (SERIES_OUTPUTS, "a series"),
         AnyDomain::Grid(_) => (GRID_OUTPUTS, "a grid"),
         AnyDomain::Mesh(_) => (MESH_OUTPUTS, "a mesh"),
+        AnyDomain::Volume(_) => (VOLUME_OUTPUTS, "a volume"),
     }
 }
 
@@ -100,6 +103,9 @@ pub fn check_mesh_output(path: &Path) -> Result<()> {
 pub fn check_complex_output(path: &Path, domain: &AnyDomain) -> Result<()> {
     if let AnyDomain::Series(_) = domain {
         return Err(Error::setting("complex", "is for grids and meshes (a series has no separatrices)"));
+    }
+    if let AnyDomain::Volume(_) = domain {
+        return Err(Error::setting("complex", "is for grids and triangle meshes: volumes have no complex yet"));
     }
     check_extension(path, &["vtp"], "the complex")
 }
@@ -250,12 +256,11 @@ pub fn stage_results(
                 let plan = vtk_point_plan(&arrays, r.carried, r.output_array);
                 let point = planned(&plan, &arrays, r.smoothed, r.carried);
                 let cells: Vec<OutArray> = carried_cells(r.carried);
-                let (nx, ny, spacing, origin) = (g.nx(), g.ny(), g.spacing(), g.origin());
+                let b = ImageBox::flat(g.nx(), g.ny(), g.spacing(), g.origin());
                 if e == "vti" {
-                    stage_vti_arrays(path, (nx, ny, spacing, origin), &point, &cells, Some(active_of(&plan)))
+                    stage_vti_arrays(path, b, &point, &cells, Some(active_of(&plan)))
                 } else {
-                    let geometry = LegacyGeometry::Image { nx, ny, spacing, origin };
-                    stage_legacy(path, &geometry, (&point, &cells), Some(active_of(&plan)))
+                    stage_legacy(path, &LegacyGeometry::Image(b), (&point, &cells), Some(active_of(&plan)))
                 }
             }
             "npz" => stage_npz(path, g.ny(), g.nx(), &arrays),
@@ -285,6 +290,21 @@ pub fn stage_results(
                 }
             }
             _ => stage_mesh(path, m, &arrays),
+        },
+        AnyDomain::Volume(g) => match format_of(path, domain).as_str() {
+            e @ ("vti" | "vtk") => {
+                let plan = vtk_point_plan(&arrays, r.carried, r.output_array);
+                let point = planned(&plan, &arrays, r.smoothed, r.carried);
+                let cells: Vec<OutArray> = carried_cells(r.carried);
+                let b = ImageBox { dims: g.dims(), spacing: g.spacing(), origin: g.origin() };
+                if e == "vti" {
+                    stage_vti_arrays(path, b, &point, &cells, Some(active_of(&plan)))
+                } else {
+                    stage_legacy(path, &LegacyGeometry::Image(b), (&point, &cells), Some(active_of(&plan)))
+                }
+            }
+            "npz" => stage_npz_shaped(path, &[g.nz(), g.ny(), g.nx()], &arrays),
+            _ => stage_npy_shaped(path, &[g.nz(), g.ny(), g.nx()], r.smoothed),
         },
     }
 }
@@ -325,6 +345,14 @@ pub fn check_written(staged: &Staged, domain: &AnyDomain, r: &Results) -> Result
     let smoothed_only = match (domain, format_of(target, domain).as_str()) {
         (AnyDomain::Grid(_), "npy") => Some(super::grid::read_npy(tmp).map_err(reread)?.values),
         (AnyDomain::Grid(_), "csv") => Some(super::grid::read_grid_csv(tmp).map_err(reread)?.values),
+        (AnyDomain::Volume(g), "npy") => {
+            let bytes = std::fs::read(tmp).map_err(|source| reread(Error::Io { path: tmp.to_path_buf(), source }))?;
+            let (shape, values) = super::npz::decode_npy_nd(&bytes).map_err(reread)?;
+            if shape != [g.nz(), g.ny(), g.nx()] {
+                return Err(fail(&format!("shape {}", super::npz::shape_text(&shape)), None));
+            }
+            Some(values)
+        }
         _ => None,
     };
     if let Some(values) = smoothed_only {
@@ -448,6 +476,7 @@ pub fn stage_complex(path: &Path, domain: &AnyDomain, h: &[f64], roles: &[Role],
         AnyDomain::Series(_) => [v as f64, 0.0, 0.0],
         AnyDomain::Grid(g) => grid_point(g, v),
         AnyDomain::Mesh(m) => m.point(v),
+        AnyDomain::Volume(g) => g.world(v),
     };
     // each vertex's critical type and diagram pair (the first pair that names it)
     let mut critical_of: std::collections::BTreeMap<usize, (i32, usize)> = std::collections::BTreeMap::new();
@@ -545,24 +574,48 @@ pub fn read_results(path: &Path) -> Result<Stored> {
     let legacy_image = extension(path) == "vtk" && read_dataset(path)?.image.is_some();
     match extension(path).as_str() {
         "vti" | "vtk" if extension(path) == "vti" || legacy_image => {
-            let img = read_image(path)?;
-            let grid = Grid2d::with_geometry(img.nx, img.ny, img.spacing, img.origin).map_err(|e| e.in_file(path))?;
-            let names = img.arrays.iter().map(|a| a.name.clone()).collect();
-            let arrays = img.arrays.into_iter().filter(|a| a.components == 1).map(|a| (a.name, a.values)).collect();
-            stored(path, AnyDomain::Grid(grid), names, arrays)
+            let (domain, arrays) = match read_any_image(path)? {
+                AnyImage::Flat(img) => {
+                    let grid =
+                        Grid2d::with_geometry(img.nx, img.ny, img.spacing, img.origin).map_err(|e| e.in_file(path))?;
+                    (AnyDomain::Grid(grid), img.arrays)
+                }
+                AnyImage::Volume(v) => {
+                    let grid = Grid3d::with_geometry(v.dims, v.spacing, v.origin).map_err(|e| e.in_file(path))?;
+                    (AnyDomain::Volume(grid), v.arrays)
+                }
+            };
+            let names = arrays.iter().map(|a| a.name.clone()).collect();
+            let arrays = arrays.into_iter().filter(|a| a.components == 1).map(|a| (a.name, a.values)).collect();
+            stored(path, domain, names, arrays)
         }
         "npz" => {
-            let arrays = read_npz(path)?;
-            let Some((_, [ny, nx], _)) = arrays.first() else {
+            let arrays = read_npz_nd(path)?;
+            let Some((_, shape, _)) = arrays.first() else {
                 return Err(Error::input("the archive holds no arrays").in_file(path));
             };
-            let grid = Grid2d::new(*nx, *ny).map_err(|e| e.in_file(path))?;
-            if let Some((name, shape, _)) = arrays.iter().find(|(_, s, _)| *s != [*ny, *nx]) {
-                return Err(Error::input(format!("array `{name}` has shape {shape:?}, the first {:?}", [*ny, *nx]))
-                    .in_file(path));
+            let shape = shape.clone();
+            let domain = match shape.as_slice() {
+                [ny, nx] => AnyDomain::Grid(Grid2d::new(*nx, *ny).map_err(|e| e.in_file(path))?),
+                [nz, ny, nx] => AnyDomain::Volume(Grid3d::new(*nx, *ny, *nz).map_err(|e| e.in_file(path))?),
+                _ => {
+                    return Err(Error::input(format!(
+                        "the arrays have shape {}: a verifiable archive holds 2D (ny, nx) or 3D (nz, ny, nx) arrays",
+                        super::npz::shape_text(&shape)
+                    ))
+                    .in_file(path))
+                }
+            };
+            if let Some((name, s, _)) = arrays.iter().find(|(_, s, _)| *s != shape) {
+                return Err(Error::input(format!(
+                    "array `{name}` has shape {}, the first {}",
+                    super::npz::shape_text(s),
+                    super::npz::shape_text(&shape)
+                ))
+                .in_file(path));
             }
             let names = arrays.iter().map(|(n, _, _)| n.clone()).collect();
-            stored(path, AnyDomain::Grid(grid), names, arrays.into_iter().map(|(n, _, v)| (n, v)).collect())
+            stored(path, domain, names, arrays.into_iter().map(|(n, _, v)| (n, v)).collect())
         }
         e if MESH_OUTPUTS.contains(&e) => {
             let (mesh, data) = read_trimesh(path)?;

@@ -31,6 +31,15 @@ pub enum NumpyField {
     },
     /// A 2-D array.
     Grid(GridField),
+    /// A 3-D array of shape (nz, ny, nx), at least 2 along each axis.
+    Volume {
+        /// The array's name.
+        name: String,
+        /// The grid (unit spacing, origin 0).
+        grid: crate::domain::Grid3d,
+        /// The values, x fastest.
+        values: Vec<f64>,
+    },
 }
 
 /// Whether a path names a NumPy file (`.npy`, `.npz`).
@@ -76,8 +85,10 @@ pub fn read_numpy(path: &Path, name: Option<&str>, wanted: Wanted) -> Result<Num
             let dims = |d: usize| (0..all.len()).filter(|&i| all[i].1.len() == d).collect::<Vec<_>>();
             let fits = match wanted {
                 Wanted::Series => dims(1),
-                Wanted::Grid => dims(2),
+                Wanted::Grid if !dims(2).is_empty() => dims(2),
+                Wanted::Grid => dims(3),
                 Wanted::Any if !dims(2).is_empty() => dims(2),
+                Wanted::Any if !dims(3).is_empty() => dims(3),
                 Wanted::Any => dims(1),
             };
             match fits.as_slice() {
@@ -85,8 +96,8 @@ pub fn read_numpy(path: &Path, name: Option<&str>, wanted: Wanted) -> Result<Num
                 [] => {
                     let what = match wanted {
                         Wanted::Series => "no 1-D array (a series)",
-                        Wanted::Grid => "no 2-D array (a grid)",
-                        Wanted::Any => "no 1-D (series) or 2-D (grid) array",
+                        Wanted::Grid => "no 2-D (grid) or 3-D (volume) array",
+                        Wanted::Any => "no 1-D (series), 2-D (grid) or 3-D (volume) array",
                     };
                     return Err(err(format!("{what}; the file has {}", listing(&all))));
                 }
@@ -105,7 +116,17 @@ pub fn read_numpy(path: &Path, name: Option<&str>, wanted: Wanted) -> Result<Num
     if let Some(i) = values.iter().position(|v| v.is_infinite()) {
         return Err(err(format!("array `{name}`: value {} at flat index {i} is infinite", values[i])));
     }
+    // SPEC.md: a volume with one axis of extent 1 is a 2D grid over the other two, with two a
+    // series (the C-order layout is unchanged by dropping unit axes)
+    let mut shape = shape;
+    if shape.len() == 3 && shape.contains(&1) && shape.iter().product::<usize>() > 1 {
+        shape.retain(|&d| d != 1);
+    }
     match (shape.as_slice(), wanted) {
+        (&[nz, ny, nx], Wanted::Any | Wanted::Grid) => {
+            let grid = crate::domain::Grid3d::new(nx, ny, nz).map_err(|e| e.in_file(path))?;
+            Ok(NumpyField::Volume { name, grid, values })
+        }
         (&[n], Wanted::Any | Wanted::Series) => {
             if n < 2 {
                 return Err(err(format!("array `{name}`: a series needs at least 2 samples, found {n}")));
@@ -120,11 +141,12 @@ pub fn read_numpy(path: &Path, name: Option<&str>, wanted: Wanted) -> Result<Num
             let is = match s.len() {
                 1 => "1-D (a series)",
                 2 => "2-D (a grid)",
-                _ => "neither 1-D (a series) nor 2-D (a grid)",
+                3 => "3-D (a volume)",
+                _ => "neither 1-D (a series), 2-D (a grid) nor 3-D (a volume)",
             };
             let want = match wanted {
                 Wanted::Series => "; a series is read from a 1-D array",
-                Wanted::Grid => "; a grid is read from a 2-D array",
+                Wanted::Grid => "; a grid is read from a 2-D array, a volume from a 3-D one",
                 Wanted::Any => "",
             };
             Err(err(format!("array `{name}` has shape {}: {is}{want}", shape_text(s))))

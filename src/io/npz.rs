@@ -14,17 +14,17 @@ fn input(path: &Path, msg: impl Into<String>) -> Error {
     Error::input(msg).in_file(path)
 }
 
-fn check_shape(path: &Path, what: &str, ny: usize, nx: usize, len: usize) -> Result<()> {
-    if ny.checked_mul(nx) != Some(len) {
-        return Err(input(path, format!("{what} has {len} values for shape ({ny}, {nx})")));
+fn check_shape(path: &Path, what: &str, shape: &[usize], len: usize) -> Result<()> {
+    if shape.iter().try_fold(1usize, |a, &d| a.checked_mul(d)) != Some(len) {
+        return Err(input(path, format!("{what} has {len} values for shape {}", shape_text(shape))));
     }
     Ok(())
 }
 
-fn write_npy(w: &mut dyn Write, ny: usize, nx: usize, values: &[f64]) -> std::io::Result<()> {
+fn write_npy(w: &mut dyn Write, shape: &[usize], values: &[f64]) -> std::io::Result<()> {
     use npyz::WriterBuilder;
-    let mut writer =
-        npyz::WriteOptions::<f64>::new().default_dtype().shape(&[ny as u64, nx as u64]).writer(w).begin_nd()?;
+    let shape: Vec<u64> = shape.iter().map(|&d| d as u64).collect();
+    let mut writer = npyz::WriteOptions::<f64>::new().default_dtype().shape(&shape).writer(w).begin_nd()?;
     writer.extend(values.iter().copied())?;
     writer.finish()
 }
@@ -34,8 +34,17 @@ fn write_npy(w: &mut dyn Write, ny: usize, nx: usize, values: &[f64]) -> std::io
 /// # Errors
 /// An input error when `values.len() != ny · nx`; I/O errors while writing.
 pub fn stage_npy(path: &Path, ny: usize, nx: usize, values: &[f64]) -> Result<Staged> {
-    check_shape(path, "the array", ny, nx, values.len())?;
-    stage(path, |w| write_npy(w, ny, nx, values))
+    stage_npy_shaped(path, &[ny, nx], values)
+}
+
+/// Stages a `.npy` file: a little-endian float64 array of the given shape, C order (a
+/// volume: `(nz, ny, nx)`).
+///
+/// # Errors
+/// An input error when `values.len()` is not the shape's product; I/O errors while writing.
+pub fn stage_npy_shaped(path: &Path, shape: &[usize], values: &[f64]) -> Result<Staged> {
+    check_shape(path, "the array", shape, values.len())?;
+    stage(path, |w| write_npy(w, shape, values))
 }
 
 #[cfg(feature = "io-npz")]
@@ -47,6 +56,15 @@ pub fn stage_npy(path: &Path, ny: usize, nx: usize, values: &[f64]) -> Result<St
 /// Input errors: an array whose length is not `ny · nx`, an empty, duplicate or path-like
 /// name. I/O errors while writing.
 pub fn stage_npz(path: &Path, ny: usize, nx: usize, arrays: &[(&str, &[f64])]) -> Result<Staged> {
+    stage_npz_shaped(path, &[ny, nx], arrays)
+}
+
+#[cfg(feature = "io-npz")]
+/// [`stage_npz`] with arrays of any one shape (a volume: `(nz, ny, nx)`).
+///
+/// # Errors
+/// As [`stage_npz`].
+pub fn stage_npz_shaped(path: &Path, shape: &[usize], arrays: &[(&str, &[f64])]) -> Result<Staged> {
     let mut seen: Vec<&str> = Vec::new();
     for (name, values) in arrays {
         if name.is_empty() || name.contains(['/', '\\', '\0']) {
@@ -56,7 +74,7 @@ pub fn stage_npz(path: &Path, ny: usize, nx: usize, arrays: &[(&str, &[f64])]) -
             return Err(input(path, format!("two arrays are named `{name}`")));
         }
         seen.push(name);
-        check_shape(path, &format!("array `{name}`"), ny, nx, values.len())?;
+        check_shape(path, &format!("array `{name}`"), shape, values.len())?;
     }
     super::stage_with(path, |w| {
         use zip::write::SimpleFileOptions;
@@ -66,7 +84,7 @@ pub fn stage_npz(path: &Path, ny: usize, nx: usize, arrays: &[(&str, &[f64])]) -
                 .compression_method(zip::CompressionMethod::Deflated)
                 .large_file(values.len() as u64 * 8 + 4096 >= u64::from(u32::MAX));
             zip.start_file(npyz::npz::file_name_from_array_name(name), options)?;
-            write_npy(&mut zip, ny, nx, values)?;
+            write_npy(&mut zip, shape, values)?;
         }
         zip.finish()?;
         Ok(())

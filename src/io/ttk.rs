@@ -163,11 +163,7 @@ pub fn check_diagram_output(path: &Path) -> Result<()> {
 
 /// [`diagram_pairs`] of `h` on a domain chosen at run time.
 pub fn diagram_of(domain: &AnyDomain, h: &[f64]) -> Vec<DiagramPair> {
-    let table = match domain {
-        AnyDomain::Series(d) => crate::topology::extrema_table(d, h),
-        AnyDomain::Grid(d) => crate::topology::extrema_table(d, h),
-        AnyDomain::Mesh(d) => crate::topology::extrema_table(d, h),
-    };
+    let table = crate::with_domain!(domain, d => crate::topology::extrema_table(d, h));
     diagram_from_table(domain, h, &table)
 }
 
@@ -177,16 +173,13 @@ pub fn diagram_from_table(domain: &AnyDomain, h: &[f64], table: &[ExtremumInfo])
         AnyDomain::Series(d) => diagram_pairs(d, h, table, false),
         AnyDomain::Grid(d) => diagram_pairs(d, h, table, true),
         AnyDomain::Mesh(d) => diagram_pairs(d, h, table, true),
+        AnyDomain::Volume(d) => diagram_pairs(d, h, table, true),
     }
 }
 
 /// The position of vertex `v`.
 fn point_of(domain: &AnyDomain, v: usize) -> [f64; 3] {
-    match domain {
-        AnyDomain::Series(d) => d.point(v),
-        AnyDomain::Grid(d) => d.point(v),
-        AnyDomain::Mesh(d) => d.point(v),
-    }
+    crate::with_domain!(domain, d => d.point(v))
 }
 
 /// Stages the diagram of `pairs` at `path` (`.vtu`) in TTK's layout; `roles` marks the kept

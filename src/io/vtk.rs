@@ -22,11 +22,11 @@ mod write;
 mod xml;
 
 pub use collection::{read_pvd, stage_pvd, CollectionEntry};
-pub use data::{cell, Cells, Dataset, ImageData, ImageGeometry, PointArray, Scalar};
+pub use data::{cell, AnyImage, Cells, Dataset, ImageData, ImageGeometry, PointArray, Scalar, VolumeData};
 pub use legacy_write::{stage_legacy, LegacyGeometry};
 pub use write::{
-    stage_vti, stage_vti_arrays, stage_vtp, stage_vtp_cells, stage_vtu, stage_vtu_cells, triangle_cells, OutArray,
-    PolyData,
+    stage_vti, stage_vti_arrays, stage_vtp, stage_vtp_cells, stage_vtu, stage_vtu_cells, triangle_cells, ImageBox,
+    OutArray, PolyData,
 };
 
 use crate::error::{Error, Result};
@@ -46,6 +46,16 @@ use std::path::Path;
 pub fn read_image(path: &Path) -> Result<ImageData> {
     let ds = read_dataset(path)?;
     image::image_of(ds).map_err(|e| e.in_file(path))
+}
+
+/// Reads a 2D image or a volume (as [`read_image`], with more than one point along z
+/// allowed): a volume when every axis has at least 2 points.
+///
+/// # Errors
+/// As [`read_image`], except for the number of points along z.
+pub fn read_any_image(path: &Path) -> Result<AnyImage> {
+    let ds = read_dataset(path)?;
+    image::any_image_of(ds).map_err(|e| e.in_file(path))
 }
 
 /// Reads any VTK data set the readers know (XML or legacy, recognised from the content).

@@ -85,12 +85,7 @@ pub fn smooth<D: Smoothable + Sync>(domain: &D, h: &[f64], settings: &SmoothSett
 /// # Errors
 /// As [`smooth`].
 pub fn smooth_any(domain: &crate::domain::AnyDomain, h: &[f64], settings: &SmoothSettings) -> Result<Smoothed> {
-    use crate::domain::AnyDomain;
-    match domain {
-        AnyDomain::Series(d) => smooth(d, h, settings),
-        AnyDomain::Grid(d) => smooth(d, h, settings),
-        AnyDomain::Mesh(d) => smooth(d, h, settings),
-    }
+    crate::with_domain!(domain, d => smooth(d, h, settings))
 }
 
 /// [`smooth`] with the harmonic fills' analysis taken from `analyses` (made, for instance, by

@@ -1,12 +1,12 @@
 //! What a domain supplies to the pipeline: its operators and its representative function
 //! (the series' linear one, the surfaces' separatrix, harmonic and flooded constructions).
 
-use crate::domain::{Domain, Grid2d, Series, TriMesh};
+use crate::domain::{Domain, Grid2d, Grid3d, Series, TriMesh};
 use crate::error::{Error, Result};
 use crate::linalg::Analyses;
 use crate::operators::{
     cotan_stiffness, dirichlet_solve, edge_factor, gradient_factor, grid_mass, grid_stiffness, lumped_mass,
-    positive_cotan_stiffness, series_mass, series_stiffness, Factor, Sparse,
+    positive_cotan_stiffness, series_mass, series_stiffness, volume_mass, volume_stiffness, Factor, Sparse,
 };
 use crate::representative::{flooded_representative, separatrix_representative, series_representative, Repairs};
 use crate::topology::morse_smale::MorseSmale;
@@ -120,7 +120,7 @@ pub trait Smoothable: Domain {
     where
         Self: Sized,
     {
-        surface_representative(self, h, kept, choice, fill, excluded, analyses)
+        surface_representative(self, h, kept, choice, fill, excluded, analyses, Cells::Triangles)
     }
 }
 
@@ -195,11 +195,22 @@ fn separatrix_name(one_sided_saddles: usize, r: Repairs) -> String {
     name
 }
 
+/// The cells a domain's representative is built on.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Cells {
+    /// Triangles: the Morse–Smale complex and the separatrix construction exist.
+    Triangles,
+    /// Tetrahedra: the flooded and harmonic constructions only (docs/volumes.md says why).
+    Tetrahedra,
+}
+
 /// The representative on a triangulated surface (the complex is built either way, for
-/// `--complex`). A construction the user chose is built or refused (its check failing is an
-/// error naming the vertices); the automatic choice tries the separatrix one, then the
-/// harmonic one, then the flooded one (NOTES.md 9), and records why each one before was not
-/// used. `k` is the Laplacian of the harmonic fills (non-negative weights).
+/// `--complex`) or a volume. A construction the user chose is built or refused (its check
+/// failing is an error naming the vertices); the automatic choice tries, on surfaces, the
+/// separatrix one, then the harmonic one, then the flooded one (NOTES.md 9), on volumes the
+/// flooded one, then the harmonic one, and records why each one before was not used. `k` is
+/// the Laplacian of the harmonic fills (non-negative weights).
+#[allow(clippy::too_many_arguments)]
 fn surface_representative<D: Domain>(
     domain: &D,
     h: &[f64],
@@ -208,13 +219,29 @@ fn surface_representative<D: Domain>(
     k: &Sparse,
     excluded: &[(RepresentativeKind, String)],
     analyses: &mut Analyses,
+    cells: Cells,
 ) -> Result<Representative> {
+    if cells == Cells::Tetrahedra && choice == Some(RepresentativeChoice::Separatrix) {
+        return Err(Error::Usage(
+            "--representative separatrix is for series, grids and triangle meshes: on volumes use flooded or harmonic \
+             (docs/volumes.md)"
+                .into(),
+        ));
+    }
     let analyses = std::cell::RefCell::new(analyses);
     let mut why: Vec<String> = excluded.iter().map(|(kind, e)| format!("{kind} representative: {e}")).collect();
     let skip = |kind: RepresentativeKind| excluded.iter().any(|(x, _)| *x == kind);
     let stage = crate::progress::Stage::begin("complex");
-    let complex = match MorseSmale::new(domain, h, kept) {
-        Ok(ms) => {
+    let built = match cells {
+        Cells::Triangles => MorseSmale::new(domain, h, kept).map(Some),
+        Cells::Tetrahedra => Ok(None),
+    };
+    let complex = match built {
+        Ok(None) => {
+            stage.end(|| "not built on volumes".into());
+            None
+        }
+        Ok(Some(ms)) => {
             stage.end(|| {
                 format!(
                     "{} saddles, {} descending and {} ascending separatrices",
@@ -293,9 +320,12 @@ fn surface_representative<D: Domain>(
         u
     };
     use RepresentativeKind::{Flooded, Harmonic, Separatrix};
-    let automatic = [Separatrix, Harmonic, Flooded];
+    let automatic = match cells {
+        Cells::Triangles => vec![Separatrix, Harmonic, Flooded],
+        Cells::Tetrahedra => vec![Flooded, Harmonic],
+    };
     let order: Vec<RepresentativeKind> = match choice {
-        None => automatic.to_vec(),
+        None => automatic,
         Some(c) => vec![c.into()],
     };
     if choice.is_some() {
@@ -354,5 +384,27 @@ impl Smoothable for Grid2d {
     }
     fn mass(&self) -> Vec<f64> {
         grid_mass(self)
+    }
+}
+
+/// The volume grid: the 7-point stencil (its weights are ≥ 0, so it is also the fills'
+/// Laplacian and has an edge factor) and the flooded or harmonic representative.
+impl Smoothable for Grid3d {
+    fn stiffness(&self) -> Sparse {
+        volume_stiffness(self)
+    }
+    fn mass(&self) -> Vec<f64> {
+        volume_mass(self)
+    }
+    fn representative(
+        &self,
+        h: &[f64],
+        kept: &KeptSet,
+        choice: Option<RepresentativeChoice>,
+        fill: &Sparse,
+        excluded: &[(RepresentativeKind, String)],
+        analyses: &mut Analyses,
+    ) -> Result<Representative> {
+        surface_representative(self, h, kept, choice, fill, excluded, analyses, Cells::Tetrahedra)
     }
 }

@@ -30,6 +30,38 @@ pub struct ImageData {
     pub active_scalars: Option<String>,
 }
 
+/// A 3D image read from a VTK file: `dims[0] × dims[1] × dims[2]` points, x fastest (flat
+/// index `i + nx·(j + ny·k)`), its axes along the physical x, y and z (a `Direction` that
+/// permutes or flips them has been applied: arrays reordered, flips as negative spacings).
+#[derive(Clone, Debug, PartialEq)]
+pub struct VolumeData {
+    /// Points along x, y and z.
+    pub dims: [usize; 3],
+    /// Spacing along x, y and z (negative where the file's axis runs the other way).
+    pub spacing: [f64; 3],
+    /// Position of point (0, 0, 0).
+    pub origin: [f64; 3],
+    /// Point data arrays, in file order.
+    pub arrays: Vec<PointArray>,
+    /// Cell data arrays: `(nx − 1)(ny − 1)(nz − 1)` tuples, x fastest.
+    pub cell_arrays: Vec<PointArray>,
+    /// What reading did.
+    pub notes: Vec<String>,
+    /// Point arrays that are not numeric, not read: "`name` (type)".
+    pub skipped: Vec<String>,
+    /// The active scalars, if the file names them.
+    pub active_scalars: Option<String>,
+}
+
+/// An image as a domain sees it: flat (2D) or a volume.
+#[derive(Clone, Debug, PartialEq)]
+pub enum AnyImage {
+    /// One point along one axis: a 2D image.
+    Flat(ImageData),
+    /// At least two points along every axis.
+    Volume(VolumeData),
+}
+
 /// A VTK data set as the file holds it, before it becomes a domain.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Dataset {

@@ -5,7 +5,7 @@
 //! the physical position VTK gives it. An oblique direction (a rotation that is not a
 //! multiple of 90°) is an error: a grid's axes run along x and y.
 
-use super::data::{list_names, Dataset, ImageData, PointArray};
+use super::data::{list_names, AnyImage, Dataset, ImageData, PointArray, VolumeData};
 use crate::error::{Error, Result};
 
 /// The 2D image a data set holds.
@@ -91,6 +91,102 @@ pub(super) fn image_of(ds: Dataset) -> Result<ImageData> {
         skipped: ds.skipped,
         active_scalars: ds.active_scalars,
     })
+}
+
+/// The image a data set holds: a volume when every axis has at least 2 points, else as
+/// [`image_of`].
+///
+/// # Errors
+/// As [`image_of`], without its limit on z.
+pub(super) fn any_image_of(ds: Dataset) -> Result<AnyImage> {
+    let Some(g) = ds.image.as_ref() else {
+        return image_of(ds).map(AnyImage::Flat);
+    };
+    let dims = g.dims();
+    if dims.iter().any(|&d| d < 2) {
+        return image_of(ds).map(AnyImage::Flat);
+    }
+    let g = g.clone();
+    let axes = axes_of(&g.direction)?;
+    let mut arrays = ds.point_data;
+    let mut cell_arrays = ds.cell_data;
+    if arrays.is_empty() {
+        return Err(if !cell_arrays.is_empty() {
+            let names: Vec<&str> = cell_arrays.iter().map(|a| a.name.as_str()).collect();
+            Error::input(format!(
+                "the file has cell data only ({}); point data is needed (ParaView: Cell Data to Point Data)",
+                list_names(&names)
+            ))
+        } else if !ds.skipped.is_empty() {
+            Error::input(format!("the file's point arrays are not numeric: {}", ds.skipped.join(", ")))
+        } else {
+            Error::input("the file has no point data arrays")
+        });
+    }
+    let ext = g.extent;
+    // physical axis p is index axis `index_of[p]`
+    let mut index_of = [0usize; 3];
+    for (a, &(p, _)) in axes.iter().enumerate() {
+        index_of[p] = a;
+    }
+    let out_dims = [0, 1, 2].map(|p| dims[index_of[p]]);
+    let spacing = [0, 1, 2].map(|p| axes[index_of[p]].1 * g.spacing[index_of[p]]);
+    let origin =
+        [0, 1, 2].map(|p| g.origin[p] + axes[index_of[p]].1 * ext[2 * index_of[p]] as f64 * g.spacing[index_of[p]]);
+    let mut notes = Vec::new();
+    if index_of != [0, 1, 2] {
+        for a in &mut arrays {
+            *a = permuted(a, dims, index_of);
+        }
+        let cells = dims.map(|d| d - 1);
+        for a in &mut cell_arrays {
+            *a = permuted(a, cells, index_of);
+        }
+        notes.push(format!(
+            "the Direction `{}` permutes the axes: the arrays are reordered so that the grid's axes are x, y and z",
+            text(&g.direction)
+        ));
+    }
+    let flips: Vec<&str> =
+        [(0, "x"), (1, "y"), (2, "z")].iter().filter(|(p, _)| axes[index_of[*p]].1 < 0.0).map(|(_, n)| *n).collect();
+    if !flips.is_empty() {
+        notes.push(format!(
+            "the Direction `{}` flips {}: written as a negative spacing",
+            text(&g.direction),
+            flips.join(" and ")
+        ));
+    }
+    Ok(AnyImage::Volume(VolumeData {
+        dims: out_dims,
+        spacing,
+        origin,
+        arrays,
+        cell_arrays,
+        notes,
+        skipped: ds.skipped,
+        active_scalars: ds.active_scalars,
+    }))
+}
+
+/// The array with its index axes reordered: output axis p is input axis `index_of[p]`.
+fn permuted(a: &PointArray, dims: [usize; 3], index_of: [usize; 3]) -> PointArray {
+    let c = a.components;
+    let out_dims = [0, 1, 2].map(|p| dims[index_of[p]]);
+    let stride = [1, dims[0], dims[0] * dims[1]];
+    let mut values = Vec::with_capacity(a.values.len());
+    for k in 0..out_dims[2] {
+        for j in 0..out_dims[1] {
+            for i in 0..out_dims[0] {
+                let q = [i, j, k];
+                let mut src = 0;
+                for p in 0..3 {
+                    src += q[p] * stride[index_of[p]];
+                }
+                values.extend_from_slice(&a.values[src * c..src * c + c]);
+            }
+        }
+    }
+    PointArray { name: a.name.clone(), components: c, values, ty: a.ty }
 }
 
 /// For each index axis, the physical axis it runs along and its sign, if the direction is a

@@ -15,7 +15,7 @@ use std::path::Path;
 pub enum LegacyGeometry<'a> {
     /// `nx × ny` points from `origin` with `spacing` (x fastest).
     #[allow(missing_docs)]
-    Image { nx: usize, ny: usize, spacing: [f64; 2], origin: [f64; 2] },
+    Image(super::write::ImageBox),
     /// Points and cells.
     #[allow(missing_docs)]
     Unstructured { points: &'a [[f64; 3]], cells: &'a Cells },
@@ -80,7 +80,7 @@ pub fn stage_legacy(
     active: Option<&str>,
 ) -> Result<Staged> {
     let (n, m) = match geometry {
-        LegacyGeometry::Image { nx, ny, .. } => (nx * ny, nx.saturating_sub(1).max(1) * ny.saturating_sub(1).max(1)),
+        LegacyGeometry::Image(b) => (b.points(), b.cells()),
         LegacyGeometry::Unstructured { points, cells } => (points.len(), cells.len()),
     };
     for (what, arrays, tuples) in [("point", point, n), ("cell", cell, m)] {
@@ -110,11 +110,12 @@ pub fn stage_legacy(
         writeln!(w, "written by toposmooth {}", env!("CARGO_PKG_VERSION"))?;
         writeln!(w, "BINARY")?;
         match geometry {
-            LegacyGeometry::Image { nx, ny, spacing, origin } => {
+            LegacyGeometry::Image(b) => {
+                let ([nx, ny, nz], s, o) = (b.dims, b.spacing, b.origin);
                 writeln!(w, "DATASET STRUCTURED_POINTS")?;
-                writeln!(w, "DIMENSIONS {nx} {ny} 1")?;
-                writeln!(w, "SPACING {} {} 1", f(spacing[0]), f(spacing[1]))?;
-                writeln!(w, "ORIGIN {} {} 0", f(origin[0]), f(origin[1]))?;
+                writeln!(w, "DIMENSIONS {nx} {ny} {nz}")?;
+                writeln!(w, "SPACING {} {} {}", f(s[0]), f(s[1]), f(s[2]))?;
+                writeln!(w, "ORIGIN {} {} {}", f(o[0]), f(o[1]), f(o[2]))?;
             }
             LegacyGeometry::Unstructured { points, cells } => {
                 writeln!(w, "DATASET UNSTRUCTURED_GRID")?;

@@ -182,41 +182,72 @@ pub fn stage_vti(
     arrays: &[(&str, &[f64])],
 ) -> Result<Staged> {
     let (point, active) = float64_arrays(arrays);
-    stage_vti_arrays(path, (nx, ny, spacing, origin), &point, &[], active)
+    stage_vti_arrays(path, ImageBox::flat(nx, ny, spacing, origin), &point, &[], active)
 }
 
-/// Stages a `.vti` image with point and cell arrays of any type (cells: `(nx − 1)·(ny − 1)`
+/// The points of an image: counts, spacing and origin along x, y and z (a 2D image has one
+/// point along z).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ImageBox {
+    /// Points along x, y and z.
+    pub dims: [usize; 3],
+    /// Spacing along x, y and z.
+    pub spacing: [f64; 3],
+    /// Position of point (0, 0, 0).
+    pub origin: [f64; 3],
+}
+
+impl ImageBox {
+    /// A 2D image in the plane z = 0.
+    pub fn flat(nx: usize, ny: usize, spacing: [f64; 2], origin: [f64; 2]) -> ImageBox {
+        ImageBox { dims: [nx, ny, 1], spacing: [spacing[0], spacing[1], 1.0], origin: [origin[0], origin[1], 0.0] }
+    }
+    /// Points.
+    pub fn points(&self) -> usize {
+        self.dims.iter().product()
+    }
+    /// Cells: the product over the axes of `n − 1`, an axis of one point counting as 1.
+    pub fn cells(&self) -> usize {
+        self.dims.iter().map(|&d| d.saturating_sub(1).max(1)).product()
+    }
+}
+
+/// Stages a `.vti` image with point and cell arrays of any type (cells: [`ImageBox::cells`]
 /// tuples, x fastest); `active` names the active scalars.
 ///
 /// # Errors
 /// As [`stage_vti`].
 pub fn stage_vti_arrays(
     path: &Path,
-    (nx, ny, spacing, origin): (usize, usize, [f64; 2], [f64; 2]),
+    b: ImageBox,
     point: &[OutArray],
     cells: &[OutArray],
     active: Option<&str>,
 ) -> Result<Staged> {
-    if nx == 0 || ny == 0 {
-        return Err(input(path, format!("cannot write an image of {nx} × {ny} points")));
+    let [nx, ny, nz] = b.dims;
+    if nx == 0 || ny == 0 || nz == 0 {
+        return Err(input(path, format!("cannot write an image of {nx} × {ny} × {nz} points")));
     }
+    let (spacing, origin) = (b.spacing, b.origin);
     if spacing.iter().chain(&origin).any(|v| !v.is_finite()) {
         return Err(input(path, format!("spacing {spacing:?} and origin {origin:?} must be finite")));
     }
-    check_section(path, "point", point, nx * ny)?;
-    check_section(path, "cell", cells, nx.saturating_sub(1).max(1) * ny.saturating_sub(1).max(1))?;
+    check_section(path, "point", point, b.points())?;
+    check_section(path, "cell", cells, b.cells())?;
     let f = crate::io::format_f64;
     stage(path, |w| {
         writeln!(w, "{XML_HEAD}")?;
         writeln!(w, "{}", file_open("ImageData"))?;
-        let extent = format!("0 {} 0 {} 0 0", nx - 1, ny - 1);
+        let extent = format!("0 {} 0 {} 0 {}", nx - 1, ny - 1, nz - 1);
         writeln!(
             w,
-            "  <ImageData WholeExtent=\"{extent}\" Origin=\"{} {} 0\" Spacing=\"{} {} 1\" Direction=\"1 0 0 0 1 0 0 0 1\">",
+            "  <ImageData WholeExtent=\"{extent}\" Origin=\"{} {} {}\" Spacing=\"{} {} {}\" Direction=\"1 0 0 0 1 0 0 0 1\">",
             f(origin[0]),
             f(origin[1]),
+            f(origin[2]),
             f(spacing[0]),
-            f(spacing[1])
+            f(spacing[1]),
+            f(spacing[2])
         )?;
         writeln!(w, "    <Piece Extent=\"{extent}\">")?;
         write_section(w, "PointData", point, active)?;

@@ -139,6 +139,8 @@ pub enum Location {
     Vertex(usize),
     /// A triangle (face) of a mesh, 0-based in file order.
     Triangle(usize),
+    /// A tetrahedron of a volume mesh, 0-based in file order.
+    Tetrahedron(usize),
     /// A line of a text file, 1-based.
     Line(usize),
     /// A byte offset in a file, 0-based.

@@ -15,6 +15,7 @@ mod grid;
 mod mesh;
 mod order;
 mod series;
+mod tet_mesh;
 pub mod vec3;
 mod volume;
 
@@ -24,6 +25,7 @@ pub use mesh::{shapes, triangle_area, TriMesh};
 pub use order::{sos_greater, sos_less, sos_sort, sos_untied, value_range};
 pub use series::Series;
 pub use volume::{Grid3d, NEIGHBOUR_OFFSETS};
+pub use tet_mesh::TetMesh;
 
 /// How persistence pairs are formed on a domain (SPEC.md, "Persistence").
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -37,18 +37,7 @@ pub fn positive_cotan_stiffness(positions: &[[f64; 3]], triangles: &[[usize; 3]]
     for (i, j, w) in corner_weights(positions, triangles) {
         k.add_upper(i, j, w);
     }
-    // every edge's summed weight, clamped, then the diagonal from the clamped weights
-    let edges = k.upper_off_diagonal();
-    let mean = edges.iter().map(|&(_, _, p)| k.val[p].abs()).sum::<f64>() / edges.len().max(1) as f64;
-    let floor = 1e-3 * mean;
-    for (i, j, p) in edges {
-        let w = k.val[p].max(floor);
-        k.val[p] = w;
-        let q = k.position(j, i);
-        k.val[q] = w;
-    }
-    k.diagonal_from_off_diagonal();
-    k.finish()
+    k.finish_clamped()
 }
 
 /// Every triangle's side `ij` with half the cotangent of the angle opposite it: `(i, j, ½ cot)`;
@@ -66,11 +55,12 @@ fn corner_weights<'a>(
     })
 }
 
-/// A symmetric matrix on the vertex adjacency of a triangle list (every edge both ways, every
-/// diagonal entry), assembled in place: the pattern is built once by counting and each
+/// A symmetric matrix on the vertex adjacency of a list of triangles (or tetrahedra: any
+/// cells whose corners are pairwise joined by edges; every edge both ways, every diagonal
+/// entry), assembled in place: the pattern is built once by counting and each
 /// weight lands at its entry by a binary search in a column of a few entries (no triplet
 /// list to sort: a tenth of the memory traffic).
-struct EdgeMatrix {
+pub(super) struct EdgeMatrix {
     col_ptr: Vec<usize>,
     row_idx: Vec<usize>,
     diag: Vec<usize>,
@@ -78,13 +68,13 @@ struct EdgeMatrix {
 }
 
 impl EdgeMatrix {
-    fn new(n: usize, triangles: &[[usize; 3]]) -> EdgeMatrix {
-        // each corner lists its two neighbours in the triangle, plus every diagonal entry
+    pub(super) fn new<const N: usize>(n: usize, cells: &[[usize; N]]) -> EdgeMatrix {
+        // each corner lists the other corners of its cell, plus every diagonal entry
         let mut count = vec![1usize; n + 1];
         count[0] = 0;
-        for tri in triangles {
-            for &v in tri {
-                count[v + 1] += 2;
+        for cell in cells {
+            for &v in cell {
+                count[v + 1] += N - 1;
             }
         }
         for j in 0..n {
@@ -96,12 +86,13 @@ impl EdgeMatrix {
             rows[fill[j]] = j;
             fill[j] += 1;
         }
-        for tri in triangles {
-            for c in 0..3 {
-                let v = tri[c];
-                rows[fill[v]] = tri[(c + 1) % 3];
-                rows[fill[v] + 1] = tri[(c + 2) % 3];
-                fill[v] += 2;
+        for cell in cells {
+            for c in 0..N {
+                let v = cell[c];
+                for d in 1..N {
+                    rows[fill[v] + d - 1] = cell[(c + d) % N];
+                }
+                fill[v] += N - 1;
             }
         }
         let (col_ptr, row_idx) = crate::linalg::compress_columns(&count, &mut rows);
@@ -114,11 +105,11 @@ impl EdgeMatrix {
     /// Position of entry `(i, j)` (in the pattern by construction).
     fn position(&self, i: usize, j: usize) -> usize {
         let (a, b) = (self.col_ptr[j], self.col_ptr[j + 1]);
-        a + self.row_idx[a..b].binary_search(&i).expect("an edge of the triangles")
+        a + self.row_idx[a..b].binary_search(&i).expect("an edge of the cells")
     }
 
     /// `−w` at `(i, j)` and `(j, i)`, `+w` at both diagonal entries.
-    fn add_edge(&mut self, i: usize, j: usize, w: f64) {
+    pub(super) fn add_edge(&mut self, i: usize, j: usize, w: f64) {
         let (p, q) = (self.position(i, j), self.position(j, i));
         self.val[p] -= w;
         self.val[q] -= w;
@@ -126,8 +117,8 @@ impl EdgeMatrix {
         self.val[self.diag[j]] += w;
     }
 
-    /// `+w` at the upper entry of edge `ij` only (summing an edge's weight over its triangles).
-    fn add_upper(&mut self, i: usize, j: usize, w: f64) {
+    /// `+w` at the upper entry of edge `ij` only (summing an edge's weight over its cells).
+    pub(super) fn add_upper(&mut self, i: usize, j: usize, w: f64) {
         let p = self.position(i.min(j), i.max(j));
         self.val[p] += w;
     }
@@ -161,7 +152,25 @@ impl EdgeMatrix {
         }
     }
 
-    fn finish(self) -> Sparse {
+    /// The stiffness of the summed edge weights (from [`EdgeMatrix::add_upper`]) clamped from
+    /// below at `10⁻³ ×` their mean absolute value over the edges: off-diagonal entries `−w`,
+    /// the diagonal `Σ w` (see [`positive_cotan_stiffness`]).
+    pub(super) fn finish_clamped(mut self) -> Sparse {
+        // every edge's summed weight, clamped, then the diagonal from the clamped weights
+        let edges = self.upper_off_diagonal();
+        let mean = edges.iter().map(|&(_, _, p)| self.val[p].abs()).sum::<f64>() / edges.len().max(1) as f64;
+        let floor = 1e-3 * mean;
+        for (i, j, p) in edges {
+            let w = self.val[p].max(floor);
+            self.val[p] = w;
+            let q = self.position(j, i);
+            self.val[q] = w;
+        }
+        self.diagonal_from_off_diagonal();
+        self.finish()
+    }
+
+    pub(super) fn finish(self) -> Sparse {
         let n = self.diag.len();
         let symbolic = faer::sparse::SymbolicSparseColMat::new_checked(n, n, self.col_ptr, None, self.row_idx);
         Sparse::new(symbolic, self.val)

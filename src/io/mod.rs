@@ -8,6 +8,8 @@ pub mod export;
 pub mod grid;
 #[cfg(feature = "io-vtk")]
 pub mod mesh;
+#[cfg(feature = "io-nifti")]
+pub mod nifti;
 mod npy_header;
 pub mod npy_input;
 pub mod npz;

@@ -173,6 +173,24 @@ pub fn fill_missing_with(k: &crate::operators::Sparse, values: &mut [f64]) -> Re
 
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn curl_of_a_rotation_and_a_shear_with_signed_spacing() {
+        // rotation about z (u = −y, v = x, w = 0) has curl (0, 0, 2); the shear u = z has
+        // curl (0, 1, 0); a negative dy is honoured (positions run downwards in y)
+        let g = Grid3d::with_geometry([4, 5, 3], [0.5, -0.25, 2.0], [1.0, 2.0, 3.0]).unwrap();
+        let n = 4 * 5 * 3;
+        let at = |v: usize| g.world(v);
+        let u: Vec<f64> = (0..n).map(|v| -at(v)[1] + at(v)[2]).collect();
+        let w_: Vec<f64> = (0..n).map(|v| at(v)[0]).collect();
+        let zero = vec![0.0; n];
+        let c = curl(&g, [&u, &w_, &zero]);
+        for ((x, y), z) in c[0].iter().zip(&c[1]).zip(&c[2]) {
+            assert!(x.abs() < 1e-12 && (y - 1.0).abs() < 1e-12 && (z - 2.0).abs() < 1e-12);
+        }
+        let m = magnitude3([&c[0], &c[1], &c[2]]);
+        assert!((m[7] - 5f64.sqrt()).abs() < 1e-12);
+    }
+
     use super::*;
 
     #[test]

@@ -103,8 +103,10 @@ pub struct GridInput {
     pub filled: Option<Vec<bool>>,
     /// The file the grid came from (the first velocity file with `--u/--v`).
     pub path: PathBuf,
-    /// A VTK image's arrays, for outputs that carry them through.
+    /// A VTK image's arrays (or a NIfTI file's affine), for outputs that carry them through.
     pub carried: Option<Carried>,
+    /// What reading found worth saying (an oblique NIfTI affine).
+    pub notes: Vec<String>,
 }
 
 /// A volume field ready to smooth.
@@ -120,8 +122,10 @@ pub struct VolumeInput {
     pub filled: Option<Vec<bool>>,
     /// The file the volume came from.
     pub path: PathBuf,
-    /// A VTK image's arrays, for outputs that carry them through.
+    /// A VTK image's arrays (or a NIfTI file's affine), for outputs that carry them through.
     pub carried: Option<Carried>,
+    /// What reading found worth saying (an oblique NIfTI affine).
+    pub notes: Vec<String>,
 }
 
 /// A field on a triangle mesh, ready to smooth.
@@ -262,7 +266,7 @@ pub fn read_mesh_field(path: &Path, opts: &GridOptions) -> Result<MeshInput> {
     // the field is the array of that name unless it came from a values file or a coordinate
     let source =
         (opts.values.is_none() && data.arrays.iter().any(|a| a.name == description)).then(|| description.clone());
-    let carried = Some(Carried { point: data.arrays, cells: data.cells, cell: data.cell_arrays, source });
+    let carried = Some(Carried { point: data.arrays, cells: data.cells, cell: data.cell_arrays, source, affine: None });
     Ok(MeshInput { mesh, values, description, notes, filled, path: path.to_path_buf(), carried })
 }
 
@@ -282,7 +286,8 @@ pub fn is_grid_file(path: &Path, kind: DomainKind) -> Result<bool> {
         DomainKind::Series | DomainKind::Mesh => false,
         DomainKind::Grid => true,
         DomainKind::Auto => match extension(path).as_str() {
-            "vti" | "vtk" | "npy" | "npz" | "png" | "tif" | "tiff" => true,
+            "vti" | "vtk" | "npy" | "npz" | "png" | "tif" | "tiff" | "nii" => true,
+            _ if crate::io::export::is_nifti(path) => true,
             _ => {
                 let bytes = std::fs::read(path).map_err(|source| Error::Io { path: path.into(), source })?;
                 crate::io::content::expect_text(path, &bytes, "CSV text")?;
@@ -520,6 +525,8 @@ struct Raw {
     active: Option<String>,
     /// A VTK image's arrays as read.
     carried: Option<Carried>,
+    /// What reading found worth saying (an oblique affine).
+    notes: Vec<String>,
 }
 
 fn read_raw(path: &Path, array: Option<&str>) -> Result<Raw> {
@@ -529,8 +536,12 @@ fn read_raw(path: &Path, array: Option<&str>) -> Result<Raw> {
         skipped: Vec::new(),
         active: None,
         carried: None,
+        notes: Vec::new(),
     };
     crate::io::content::check_extension(path)?;
+    if crate::io::export::is_nifti(path) {
+        return read_nifti_raw(path);
+    }
     match extension(path).as_str() {
         "vti" | "vtk" => {
             let (geometry, arrays, cell, skipped, active) = match read_any_image(path)? {
@@ -545,8 +556,8 @@ fn read_raw(path: &Path, array: Option<&str>) -> Result<Raw> {
                 }
             };
             let listed = arrays.iter().map(|a| (a.name.clone(), a.components, a.values.clone())).collect();
-            let carried = Carried { point: arrays, cells: None, cell, source: None };
-            Ok(Raw { geometry, arrays: listed, skipped, active, carried: Some(carried) })
+            let carried = Carried { point: arrays, cells: None, cell, source: None, affine: None };
+            Ok(Raw { geometry, arrays: listed, skipped, active, carried: Some(carried), notes: Vec::new() })
         }
         "npy" | "npz" => match read_numpy(path, array, Wanted::Grid)? {
             NumpyField::Grid(f) => Ok(from_field(f)),
@@ -556,6 +567,7 @@ fn read_raw(path: &Path, array: Option<&str>) -> Result<Raw> {
                 skipped: Vec::new(),
                 active: None,
                 carried: None,
+                notes: Vec::new(),
             }),
             NumpyField::Series { name, .. } => {
                 Err(Error::input(format!("array `{name}` is 1-D: a series, not a grid")).in_file(path))
@@ -564,6 +576,52 @@ fn read_raw(path: &Path, array: Option<&str>) -> Result<Raw> {
         "png" | "tif" | "tiff" => read_raster(path).map(from_field),
         _ => read_grid_csv(path).map(from_field),
     }
+}
+
+/// A NIfTI volume: |pixdim| as spacing, the affine's translation as origin, the affine
+/// itself carried to NIfTI outputs; one axis of extent 1 makes a 2D grid over the others.
+#[cfg(feature = "io-nifti")]
+fn read_nifti_raw(path: &Path) -> Result<Raw> {
+    let v = crate::io::nifti::read_nifti(path)?;
+    let mut notes = Vec::new();
+    if v.oblique {
+        notes.push(format!(
+            "the {} affine is oblique: the volume is smoothed on its voxel grid (spacing |pixdim|, origin the \
+             affine's translation); NIfTI outputs carry the affine, VTK outputs are axis-aligned",
+            v.affine_source
+        ));
+    }
+    let origin = v.origin();
+    let name = "values".to_string();
+    let flat: Vec<usize> = (0..3).filter(|&a| v.dims[a] > 1).collect();
+    let geometry = match flat.as_slice() {
+        [_, _, _] => Geometry::Volume(Grid3d::with_geometry(v.dims, v.spacing, origin).map_err(|e| e.in_file(path))?),
+        &[a, b] => Geometry::Flat(
+            Grid2d::with_geometry(v.dims[a], v.dims[b], [v.spacing[a], v.spacing[b]], [origin[a], origin[b]])
+                .map_err(|e| e.in_file(path))?,
+        ),
+        _ => {
+            return Err(Error::input(format!(
+                "the volume is {} × {} × {}: a grid needs at least two axes of 2 or more voxels",
+                v.dims[0], v.dims[1], v.dims[2]
+            ))
+            .in_file(path))
+        }
+    };
+    let carried = Carried { affine: Some(v.affine), source: Some(name.clone()), ..Carried::default() };
+    Ok(Raw {
+        geometry,
+        arrays: vec![(name, 1, v.values)],
+        skipped: Vec::new(),
+        active: None,
+        carried: Some(carried),
+        notes,
+    })
+}
+
+#[cfg(not(feature = "io-nifti"))]
+fn read_nifti_raw(path: &Path) -> Result<Raw> {
+    Err(Error::input("reading NIfTI files needs the io-nifti feature").in_file(path))
 }
 
 /// The geometry with `--spacing` applied: the file's origin kept, except for a raster, whose
@@ -644,6 +702,7 @@ fn pick<'a>(path: &Path, raw: &'a Raw, name: Option<&str>, vector: bool) -> Resu
 /// for contradictory options.
 pub fn read_grid(path: &Path, opts: &GridOptions) -> Result<FieldInput> {
     let mut carried = None;
+    let mut notes = Vec::new();
     let spacing = opts.spacing.as_deref();
     let (geometry, mut values, description, source) = match (&opts.uv, opts.derive) {
         (Some(_), None) => return Err(Error::Usage("--u and --v need --derive vorticity|magnitude".into())),
@@ -699,6 +758,7 @@ pub fn read_grid(path: &Path, opts: &GridOptions) -> Result<FieldInput> {
             let description = format!("{} of {}", d.name(), a.0);
             // the file's arrays move into the output's carried arrays, not copied
             carried = raw.carried;
+            notes = raw.notes;
             (geometry, values, description, path.to_path_buf())
         }
         (None, None) => {
@@ -719,6 +779,7 @@ pub fn read_grid(path: &Path, opts: &GridOptions) -> Result<FieldInput> {
             let geometry = with_spacing(path, &raw.geometry, spacing)?;
             let (name, values) = (a.0.clone(), a.2.clone());
             carried = raw.carried.map(|c| Carried { source: Some(name.clone()), ..c });
+            notes = raw.notes;
             (geometry, values, name, path.to_path_buf())
         }
     };
@@ -750,10 +811,10 @@ pub fn read_grid(path: &Path, opts: &GridOptions) -> Result<FieldInput> {
     }
     Ok(match geometry {
         Geometry::Flat(grid) => {
-            FieldInput::Grid(GridInput { grid, values, description, filled, path: source, carried })
+            FieldInput::Grid(GridInput { grid, values, description, filled, path: source, carried, notes })
         }
         Geometry::Volume(grid) => {
-            FieldInput::Volume(VolumeInput { grid, values, description, filled, path: source, carried })
+            FieldInput::Volume(VolumeInput { grid, values, description, filled, path: source, carried, notes })
         }
     })
 }
@@ -873,7 +934,7 @@ impl FieldInput {
                 path: g.path,
                 description: g.description,
                 filled: g.filled,
-                notes: Vec::new(),
+                notes: g.notes,
                 axis: None,
                 carried: g.carried,
             },
@@ -883,7 +944,7 @@ impl FieldInput {
                 path: v.path,
                 description: v.description,
                 filled: v.filled,
-                notes: Vec::new(),
+                notes: v.notes,
                 axis: None,
                 carried: v.carried,
             },

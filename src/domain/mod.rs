@@ -24,8 +24,8 @@ pub use grid::{Grid2d, MAX_SPACING, MIN_SPACING};
 pub use mesh::{shapes, triangle_area, TriMesh};
 pub use order::{sos_greater, sos_less, sos_sort, sos_untied, value_range};
 pub use series::Series;
-pub use volume::{Grid3d, NEIGHBOUR_OFFSETS};
 pub use tet_mesh::TetMesh;
+pub use volume::{Grid3d, NEIGHBOUR_OFFSETS};
 
 /// How persistence pairs are formed on a domain (SPEC.md, "Persistence").
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -24,8 +24,15 @@ pub const SERIES_OUTPUTS: &[&str] = &["csv"];
 pub const GRID_OUTPUTS: &[&str] = &["vti", "vtk", "npz", "npy", "csv"];
 /// Extensions of a mesh's output.
 pub const MESH_OUTPUTS: &[&str] = &["vtu", "vtp", "vtk", "ply"];
-/// Extensions of a volume's output (`.npy` holds the smoothed array only, shape (nz, ny, nx)).
-pub const VOLUME_OUTPUTS: &[&str] = &["vti", "vtk", "npz", "npy"];
+/// Extensions of a volume's output (`.npy` and NIfTI hold the smoothed array only; `.npy` of
+/// shape (nz, ny, nx)).
+pub const VOLUME_OUTPUTS: &[&str] = &["vti", "vtk", "npz", "npy", "nii", "nii.gz"];
+
+/// Whether a name is a NIfTI file's: `.nii` or `.nii.gz` (any case).
+pub fn is_nifti(path: &Path) -> bool {
+    let name = path.file_name().map(|n| n.to_string_lossy().to_ascii_lowercase()).unwrap_or_default();
+    name.ends_with(".nii") || name.ends_with(".nii.gz")
+}
 
 fn extension(path: &Path) -> String {
     path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase()
@@ -35,6 +42,9 @@ fn extension(path: &Path) -> String {
 /// (`-`, a FIFO or a device such as `/dev/stdout`) without one, the domain's streamable
 /// format: CSV for a series, NPY for a grid (a mesh has none: its name must say).
 fn format_of(path: &Path, domain: &AnyDomain) -> String {
+    if is_nifti(path) {
+        return if extension(path) == "gz" { "nii.gz".into() } else { "nii".into() };
+    }
     let e = extension(path);
     if !e.is_empty() || !super::staging::is_stream(path) {
         return e;
@@ -128,6 +138,8 @@ pub struct Carried {
     /// The point array the field is (not a derivation of it): the output gives the smoothed
     /// field that name, in place of the input's array.
     pub source: Option<String>,
+    /// A NIfTI input's voxel-to-world affine (rows of a 3 × 4 matrix), for NIfTI outputs.
+    pub affine: Option<[[f64; 4]; 3]>,
 }
 
 /// The names the tool's own arrays take in a VTK output.
@@ -304,9 +316,21 @@ pub fn stage_results(
                 }
             }
             "npz" => stage_npz_shaped(path, &[g.nz(), g.ny(), g.nx()], &arrays),
+            #[cfg(feature = "io-nifti")]
+            "nii" | "nii.gz" => {
+                let affine = r.carried.and_then(|c| c.affine).unwrap_or_else(|| volume_affine(g));
+                super::nifti::stage_nifti(path, g.dims(), g.spacing().map(f64::abs), &affine, r.smoothed)
+            }
             _ => stage_npy_shaped(path, &[g.nz(), g.ny(), g.nx()], r.smoothed),
         },
     }
+}
+
+/// The affine of a volume grid as VTK places its points: origin + (i·dx, j·dy, k·dz), signs
+/// kept.
+pub fn volume_affine(g: &Grid3d) -> [[f64; 4]; 3] {
+    let (s, o) = (g.spacing(), g.origin());
+    [[s[0], 0.0, 0.0, o[0]], [0.0, s[1], 0.0, o[1]], [0.0, 0.0, s[2], o[2]]]
 }
 
 /// The input's cell arrays, unchanged.
@@ -345,6 +369,14 @@ pub fn check_written(staged: &Staged, domain: &AnyDomain, r: &Results) -> Result
     let smoothed_only = match (domain, format_of(target, domain).as_str()) {
         (AnyDomain::Grid(_), "npy") => Some(super::grid::read_npy(tmp).map_err(reread)?.values),
         (AnyDomain::Grid(_), "csv") => Some(super::grid::read_grid_csv(tmp).map_err(reread)?.values),
+        #[cfg(feature = "io-nifti")]
+        (AnyDomain::Volume(g), "nii" | "nii.gz") => {
+            let v = super::nifti::read_nifti(tmp).map_err(reread)?;
+            if v.dims != g.dims() {
+                return Err(fail(&format!("dimensions {:?}", v.dims), None));
+            }
+            Some(v.values)
+        }
         (AnyDomain::Volume(g), "npy") => {
             let bytes = std::fs::read(tmp).map_err(|source| reread(Error::Io { path: tmp.to_path_buf(), source }))?;
             let (shape, values) = super::npz::decode_npy_nd(&bytes).map_err(reread)?;

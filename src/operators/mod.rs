@@ -23,8 +23,8 @@ mod harmonic;
 mod polyharmonic;
 mod series;
 mod sparse;
-mod volume;
 mod tet;
+mod volume;
 
 pub use cotan::{
     cotan_stiffness, grid_mass, grid_stiffness, lumped_mass, negative_cotan_edges, positive_cotan_stiffness,
@@ -35,5 +35,5 @@ pub use harmonic::{dirichlet_solve, dirichlet_solve_with, Dirichlet};
 pub use polyharmonic::{polyharmonic, Energy};
 pub use series::{series_mass, series_stiffness};
 pub use sparse::{plus_diagonal, quadratic_form, quadratic_form_without_diagonal, scaled_plus_diagonal, Sparse};
-pub use volume::{volume_mass, volume_stiffness};
 pub use tet::{positive_tet_stiffness, tet_gradient_factor, tet_gradient_operator, tet_lumped_mass, tet_stiffness};
+pub use volume::{volume_mass, volume_stiffness};

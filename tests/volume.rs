@@ -1,0 +1,203 @@
+//! Volumes: the pipeline on random 3D fields with ties (every kept set chosen by persistence
+//! ends certified), and the command-line tool on the bundled MRI volume and on NumPy and
+//! NIfTI volumes, checked with an extremum counter written here from SPEC.md's 14-neighbour
+//! rule, independently of the crate.
+
+mod common;
+
+use common::{dataset, scratch, succeeds, text, toposmooth, uniform};
+use std::path::Path;
+use toposmooth::domain::Grid3d;
+use toposmooth::pipeline::{smooth, SmoothSettings};
+use toposmooth::topology::{Role, Selection};
+
+/// SPEC's 14 neighbours of (i, j, k): the axes, the (+,+) face diagonals, the body diagonal.
+const OFFSETS: [[i64; 3]; 14] = [
+    [1, 0, 0],
+    [-1, 0, 0],
+    [0, 1, 0],
+    [0, -1, 0],
+    [0, 0, 1],
+    [0, 0, -1],
+    [1, 1, 0],
+    [-1, -1, 0],
+    [0, 1, 1],
+    [0, -1, -1],
+    [1, 0, 1],
+    [-1, 0, -1],
+    [1, 1, 1],
+    [-1, -1, -1],
+];
+
+/// Strict minima, strict maxima and non-regular (flat) vertices of a volume field.
+fn volume_extrema(n: [usize; 3], f: &[f64]) -> (Vec<usize>, Vec<usize>, Vec<usize>) {
+    let (mut mins, mut maxs, mut flat) = (vec![], vec![], vec![]);
+    for k in 0..n[2] as i64 {
+        for j in 0..n[1] as i64 {
+            for i in 0..n[0] as i64 {
+                let v = (i + n[0] as i64 * (j + n[1] as i64 * k)) as usize;
+                let (mut lower, mut higher, mut equal) = (0, 0, 0);
+                for d in OFFSETS {
+                    let (a, b, c) = (i + d[0], j + d[1], k + d[2]);
+                    if a < 0 || b < 0 || c < 0 || a >= n[0] as i64 || b >= n[1] as i64 || c >= n[2] as i64 {
+                        continue;
+                    }
+                    let w = (a + n[0] as i64 * (b + n[1] as i64 * c)) as usize;
+                    match f[w].partial_cmp(&f[v]).unwrap() {
+                        std::cmp::Ordering::Less => lower += 1,
+                        std::cmp::Ordering::Greater => higher += 1,
+                        std::cmp::Ordering::Equal => equal += 1,
+                    }
+                }
+                if lower == 0 && equal == 0 {
+                    mins.push(v);
+                } else if higher == 0 && equal == 0 {
+                    maxs.push(v);
+                } else if lower == 0 || higher == 0 {
+                    flat.push(v);
+                }
+            }
+        }
+    }
+    (mins, maxs, flat)
+}
+
+#[test]
+fn random_volumes_with_ties_end_certified_for_every_persistence_selection() {
+    let n = [6, 5, 4];
+    let count = n.iter().product();
+    for seed in 0..12u64 {
+        // few-valued noise (many ties) on a gentle ramp, or pure few-valued noise
+        let noise = uniform(seed, count);
+        let h: Vec<f64> = (0..count)
+            .map(|v| {
+                let level = (noise[v] * 5.0).floor();
+                if seed % 2 == 0 {
+                    level
+                } else {
+                    level + 0.5 * (v % 6) as f64
+                }
+            })
+            .collect();
+        let g = Grid3d::with_geometry(n, [1.0, 0.5, 2.0], [0.0; 3]).unwrap();
+        for selection in
+            [Selection::Relative(0.05), Selection::Relative(0.3), Selection::Count { minima: 2, maxima: 2 }]
+        {
+            let settings = SmoothSettings { selection: selection.clone(), ..Default::default() };
+            let out = smooth(&g, &h, &settings).unwrap_or_else(|e| panic!("seed {seed}, {selection:?}: {e}"));
+            let (mins, maxs, flat) = volume_extrema(n, &out.output);
+            assert!(flat.is_empty(), "seed {seed}: flat vertices {flat:?}");
+            let kept = |r: Role| (0..count).filter(|&v| out.roles[v] == r).collect::<Vec<_>>();
+            assert_eq!(mins, kept(Role::Min), "seed {seed}, {selection:?}");
+            assert_eq!(maxs, kept(Role::Max), "seed {seed}, {selection:?}");
+            for &v in mins.iter().chain(&maxs) {
+                assert_eq!(out.output[v].to_bits(), h[v].to_bits());
+            }
+        }
+    }
+}
+
+/// The .vti or .npz output's arrays, read back by the crate's verify reader.
+fn stored(p: &Path) -> toposmooth::io::export::Stored {
+    toposmooth::io::export::read_results(p).unwrap()
+}
+
+#[test]
+fn the_mri_volume_from_nifti_is_smoothed_certified_and_verified() {
+    let dir = scratch("volume-mri");
+    let out = dir.join("t1.vti");
+    let nii = dataset("mri_anatomical_33x41x25.nii");
+    let o = succeeds(&["smooth", &nii, "--persistence", "10%", "-o", out.to_str().unwrap()]);
+    assert!(text(&o).contains("certified:"), "{}", text(&o));
+    let s = stored(&out);
+    let (mins, maxs, flat) = volume_extrema([33, 41, 25], &s.smoothed);
+    assert!(flat.is_empty());
+    assert_eq!(mins, (0..s.roles.len()).filter(|&v| s.roles[v] == Role::Min).collect::<Vec<_>>());
+    assert_eq!(maxs, (0..s.roles.len()).filter(|&v| s.roles[v] == Role::Max).collect::<Vec<_>>());
+    assert!(!mins.is_empty() && !maxs.is_empty());
+    // the NIfTI file's voxels are the VTK copy's `t1` array, in the same (x fastest) order
+    let vti = toposmooth::io::vtk::read_dataset(Path::new(&dataset("mri_anatomical_33x41x25.vti"))).unwrap();
+    let t1 = vti.point_data.iter().find(|a| a.name == "t1").unwrap();
+    assert_eq!(s.input, t1.values);
+    // verify re-checks it, against the VTK copy of the input too
+    let o = succeeds(&["verify", out.to_str().unwrap(), "--input", &dataset("mri_anatomical_33x41x25.vti")]);
+    assert!(text(&o).contains("input matches"), "{}", text(&o));
+    // the spacing |pixdim| = 2 mm and the affine's translation as origin
+    let AnyVolume(g) = volume_of(&s);
+    assert_eq!(g.spacing(), [2.0; 3]);
+    assert_eq!(g.origin(), [32.0, -40.0, -16.0]);
+}
+
+struct AnyVolume(Grid3d);
+
+fn volume_of(s: &toposmooth::io::export::Stored) -> AnyVolume {
+    match &s.domain {
+        toposmooth::domain::AnyDomain::Volume(g) => AnyVolume(g.clone()),
+        d => panic!("not a volume: {}", d.describe()),
+    }
+}
+
+#[test]
+fn numpy_volumes_in_and_out_and_the_volume_errors() {
+    let dir = scratch("volume-npy");
+    let (nx, ny, nz) = (10, 8, 6);
+    let noise = uniform(7, nx * ny * nz);
+    let h: Vec<f64> = (0..nx * ny * nz)
+        .map(|v| {
+            let (i, j, k) = ((v % nx) as f64, ((v / nx) % ny) as f64, (v / (nx * ny)) as f64);
+            (i / 2.0).sin() * (j / 2.5).cos() + 0.3 * (k / 2.0).cos() + 0.1 * noise[v]
+        })
+        .collect();
+    let input = dir.join("v.npy");
+    toposmooth::io::npz::stage_npy_shaped(&input, &[nz, ny, nx], &h).unwrap().commit().unwrap();
+    let inp = input.to_str().unwrap();
+    let npz = dir.join("v.npz");
+    succeeds(&["smooth", inp, "--spacing", "0.5,0.5,1", "-o", npz.to_str().unwrap()]);
+    let s = stored(&npz);
+    assert_eq!(s.input, h);
+    let (mins, maxs, flat) = volume_extrema([nx, ny, nz], &s.smoothed);
+    assert!(flat.is_empty());
+    assert_eq!(mins.len() + maxs.len(), s.roles.iter().filter(|r| matches!(r, Role::Min | Role::Max)).count());
+    succeeds(&["verify", npz.to_str().unwrap(), "--input", inp]);
+    // .npy and .nii.gz views of the smoothed field
+    let npy = dir.join("s.npy");
+    succeeds(&["smooth", inp, "--spacing", "0.5,0.5,1", "-o", npy.to_str().unwrap()]);
+    let (shape, values) = toposmooth::io::npz::decode_npy_nd(&std::fs::read(&npy).unwrap()).unwrap();
+    assert_eq!((shape, values), (vec![nz, ny, nx], s.smoothed.clone()));
+    let nii = dir.join("s.nii.gz");
+    succeeds(&["smooth", inp, "--spacing", "0.5,0.5,1", "-o", nii.to_str().unwrap()]);
+    let v = toposmooth::io::nifti::read_nifti(&nii).unwrap();
+    assert_eq!((v.dims, v.spacing, v.values), ([nx, ny, nz], [0.5, 0.5, 1.0], s.smoothed.clone()));
+
+    // errors before any work: exit 2 naming the flag
+    let out = dir.join("x.vti");
+    let out = out.to_str().unwrap();
+    for (args, needle) in [
+        (vec!["--representative", "separatrix"], "--representative separatrix"),
+        (vec!["--spacing", "1,1"], "three numbers"),
+        (vec!["--plot", "p.png"], "--plot"),
+    ] {
+        let mut all = vec!["smooth", inp, "-o", out];
+        all.extend(args);
+        let o = toposmooth(&all);
+        let code = o.status.code();
+        assert!(code == Some(2) || code == Some(3), "{all:?}: {}", text(&o));
+        assert!(text(&o).contains(needle), "{all:?}: {}", text(&o));
+        assert!(!Path::new(out).exists());
+    }
+    // a 2D output format of a volume is a usage error
+    let o = toposmooth(&["smooth", inp, "-o", dir.join("x.csv").to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2), "{}", text(&o));
+}
+
+#[test]
+fn a_volume_with_one_flat_axis_is_a_2d_grid() {
+    let dir = scratch("volume-flat");
+    let (nx, nz) = (9, 7);
+    let h: Vec<f64> = (0..nx * nz).map(|v| ((v % nx) as f64 / 2.0).sin() + ((v / nx) as f64 / 3.0).cos()).collect();
+    let input = dir.join("xz.npy");
+    toposmooth::io::npz::stage_npy_shaped(&input, &[nz, 1, nx], &h).unwrap().commit().unwrap();
+    let out = dir.join("xz.npz");
+    let o = succeeds(&["smooth", input.to_str().unwrap(), "-o", out.to_str().unwrap()]);
+    assert!(text(&o).contains("9 × 7 grid"), "{}", text(&o));
+}

@@ -24,7 +24,6 @@
 //! ```
 
 use super::{Domain, PairingRule};
-use crate::domain::vec3::{cross, dot, sub};
 use crate::error::Result;
 
 mod shapes;
@@ -36,11 +35,7 @@ mod validate;
 /// tetrahedron `[0, 1, 2, 3]` (`(b − a) × (c − a)` points away from the opposite corner).
 const OUTWARD: [[usize; 3]; 4] = [[1, 2, 3], [0, 3, 2], [0, 1, 3], [0, 2, 1]];
 
-/// `6 ×` the signed volume of the tetrahedron `(a, b, c, d)`: positive when `d` lies on the
-/// side of the triangle `(a, b, c)` that its normal `(b − a) × (c − a)` points to.
-pub(crate) fn signed_volume6(a: [f64; 3], b: [f64; 3], c: [f64; 3], d: [f64; 3]) -> f64 {
-    dot(cross(sub(b, a), sub(c, a)), sub(d, a))
-}
+pub(crate) use crate::domain::vec3::signed_volume6;
 
 /// A validated tetrahedral mesh with its vertex adjacency and boundary surface.
 #[derive(Clone, Debug)]

@@ -30,3 +30,9 @@ pub fn unit(a: [f64; 3]) -> [f64; 3] {
         a
     }
 }
+
+/// `6 ×` the signed volume of the tetrahedron `(a, b, c, d)`: positive when `d` lies on the
+/// side of the triangle `(a, b, c)` that its normal `(b − a) × (c − a)` points to.
+pub(crate) fn signed_volume6(a: [f64; 3], b: [f64; 3], c: [f64; 3], d: [f64; 3]) -> f64 {
+    dot(cross(sub(b, a), sub(c, a)), sub(d, a))
+}

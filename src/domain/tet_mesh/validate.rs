@@ -3,7 +3,7 @@
 //! the edges (one fan each) and the vertices (one ball each). Messages name the first
 //! offending elements; each error carries the first as its [`Location`].
 
-use super::signed_volume6;
+use crate::domain::vec3::signed_volume6;
 use crate::domain::vec3::{norm, sub};
 use crate::error::{Error, Location, Result};
 

@@ -115,18 +115,20 @@ pub fn magnitude3([u, v, w]: [&[f64]; 3]) -> Vec<f64> {
 
 /// The first few missing samples as `(row r, column c)` text.
 pub fn describe_missing(grid: &Grid2d, values: &[f64], limit: usize) -> Option<String> {
+    describe_missing_with(values, limit, |i| {
+        let (r, c) = grid.row_col(i);
+        format!("(row {r}, column {c})")
+    })
+}
+
+/// The count of missing (NaN) samples and the first `limit` of them, each named by `name`;
+/// `None` when there are none.
+pub fn describe_missing_with(values: &[f64], limit: usize, name: impl Fn(usize) -> String) -> Option<String> {
     let missing: Vec<usize> = values.iter().enumerate().filter(|(_, v)| v.is_nan()).map(|(i, _)| i).collect();
     if missing.is_empty() {
         return None;
     }
-    let first: Vec<String> = missing
-        .iter()
-        .take(limit)
-        .map(|&i| {
-            let (r, c) = grid.row_col(i);
-            format!("(row {r}, column {c})")
-        })
-        .collect();
+    let first: Vec<String> = missing.iter().take(limit).map(|&i| name(i)).collect();
     Some(format!(
         "{} missing (NaN) samples, first {}{}",
         missing.len(),

@@ -821,24 +821,10 @@ pub fn read_grid(path: &Path, opts: &GridOptions) -> Result<FieldInput> {
 
 /// The first few missing samples of a volume as `(i, j, k)` text.
 fn describe_missing_in_volume(grid: &Grid3d, values: &[f64], limit: usize) -> Option<String> {
-    let missing: Vec<usize> = values.iter().enumerate().filter(|(_, v)| v.is_nan()).map(|(i, _)| i).collect();
-    if missing.is_empty() {
-        return None;
-    }
-    let first: Vec<String> = missing
-        .iter()
-        .take(limit)
-        .map(|&v| {
-            let [i, j, k] = grid.ijk(v);
-            format!("(i {i}, j {j}, k {k})")
-        })
-        .collect();
-    Some(format!(
-        "{} missing (NaN) samples, the first at {}{}",
-        missing.len(),
-        first.join(", "),
-        if missing.len() > limit { ", …" } else { "" }
-    ))
+    crate::derive::describe_missing_with(values, limit, |v| {
+        let [i, j, k] = grid.ijk(v);
+        format!("(i {i}, j {j}, k {k})")
+    })
 }
 
 /// A 2D grid's derived scalar.

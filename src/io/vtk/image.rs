@@ -41,17 +41,7 @@ pub(super) fn image_of(ds: Dataset) -> Result<ImageData> {
     let mut cell_arrays = ds.cell_data;
     let skipped = &ds.skipped;
     if arrays.is_empty() {
-        return Err(if !cell_arrays.is_empty() {
-            let names: Vec<&str> = cell_arrays.iter().map(|a| a.name.as_str()).collect();
-            Error::input(format!(
-                "the file has cell data only ({}); point data is needed (ParaView: Cell Data to Point Data)",
-                list_names(&names)
-            ))
-        } else if !skipped.is_empty() {
-            Error::input(format!("the file's point arrays are not numeric: {}", skipped.join(", ")))
-        } else {
-            Error::input("the file has no point data arrays")
-        });
+        return Err(no_point_data(&cell_arrays, skipped));
     }
     // index axis a lies along physical axis axes[a].0 with sign axes[a].1
     let coord = |a: usize, t: i64| g.origin[axes[a].0] + axes[a].1 * t as f64 * g.spacing[a];
@@ -111,17 +101,7 @@ pub(super) fn any_image_of(ds: Dataset) -> Result<AnyImage> {
     let mut arrays = ds.point_data;
     let mut cell_arrays = ds.cell_data;
     if arrays.is_empty() {
-        return Err(if !cell_arrays.is_empty() {
-            let names: Vec<&str> = cell_arrays.iter().map(|a| a.name.as_str()).collect();
-            Error::input(format!(
-                "the file has cell data only ({}); point data is needed (ParaView: Cell Data to Point Data)",
-                list_names(&names)
-            ))
-        } else if !ds.skipped.is_empty() {
-            Error::input(format!("the file's point arrays are not numeric: {}", ds.skipped.join(", ")))
-        } else {
-            Error::input("the file has no point data arrays")
-        });
+        return Err(no_point_data(&cell_arrays, &ds.skipped));
     }
     let ext = g.extent;
     // physical axis p is index axis `index_of[p]`
@@ -166,6 +146,22 @@ pub(super) fn any_image_of(ds: Dataset) -> Result<AnyImage> {
         skipped: ds.skipped,
         active_scalars: ds.active_scalars,
     }))
+}
+
+/// Why an image without point arrays cannot be smoothed: cell data only, non-numeric arrays,
+/// or nothing.
+fn no_point_data(cell_arrays: &[PointArray], skipped: &[String]) -> Error {
+    if !cell_arrays.is_empty() {
+        let names: Vec<&str> = cell_arrays.iter().map(|a| a.name.as_str()).collect();
+        Error::input(format!(
+            "the file has cell data only ({}); point data is needed (ParaView: Cell Data to Point Data)",
+            list_names(&names)
+        ))
+    } else if !skipped.is_empty() {
+        Error::input(format!("the file's point arrays are not numeric: {}", skipped.join(", ")))
+    } else {
+        Error::input("the file has no point data arrays")
+    }
 }
 
 /// The array with its index axes reordered: output axis p is input axis `index_of[p]`.

@@ -121,6 +121,15 @@ pub(super) fn smooth_shared(args: &SmoothArgs, shared: Option<&mut Option<Shared
     }
     check_output(&args.output, &field.domain)?;
     check_output_array(args.output_array.as_deref())?;
+    if matches!(field.domain, AnyDomain::Volume(_))
+        && args.settings.representative == Some(crate::pipeline::RepresentativeChoice::Separatrix)
+    {
+        return Err(Error::Usage(format!(
+            "{}: --representative separatrix is for series, grids and triangle meshes: on volumes use flooded or \
+             harmonic (docs/volumes.md)",
+            field.path.display()
+        )));
+    }
     if args.plot.is_some() && matches!(field.domain, AnyDomain::Volume(_)) {
         return Err(Error::setting("plot", "is not drawn for volumes yet (write a .vti and open it in ParaView)"));
     }

@@ -201,3 +201,44 @@ fn a_volume_with_one_flat_axis_is_a_2d_grid() {
     let o = succeeds(&["smooth", input.to_str().unwrap(), "-o", out.to_str().unwrap()]);
     assert!(text(&o).contains("9 × 7 grid"), "{}", text(&o));
 }
+
+#[test]
+fn the_active_set_iteration_smooths_a_noisy_volume_to_the_interior_point_optimum() {
+    use toposmooth::solve::{Method, QpSettings};
+    let n = [18, 15, 12];
+    let count: usize = n.iter().product();
+    let noise = uniform(7, count);
+    // two bumps and a dip with 5 % noise
+    let h: Vec<f64> = (0..count)
+        .map(|v| {
+            let (x, y, z) = ((v % n[0]) as f64, ((v / n[0]) % n[1]) as f64, (v / (n[0] * n[1])) as f64);
+            let bump =
+                |cx: f64, cy: f64, cz: f64| (-((x - cx).powi(2) + (y - cy).powi(2) + (z - cz).powi(2)) / 12.0).exp();
+            bump(4.0, 4.0, 3.0) + bump(13.0, 10.0, 8.0) - bump(9.0, 11.0, 3.0) + 0.1 * (noise[v] - 0.5)
+        })
+        .collect();
+    let g = Grid3d::with_geometry(n, [1.0; 3], [0.0; 3]).unwrap();
+    let run = |method| {
+        let settings = SmoothSettings {
+            selection: Selection::Count { minima: 2, maxima: 3 },
+            qp: QpSettings { method, ..Default::default() },
+            ..Default::default()
+        };
+        smooth(&g, &h, &settings).unwrap()
+    };
+    let (active, direct) = (run(Method::ActiveSet), run(Method::Structured));
+    assert_eq!(active.report.solver, Method::ActiveSet, "{:?}", active.report.solver_fallback);
+    assert!(active.report.solver_inner_iterations > 0);
+    let (mins, maxs, flat) = volume_extrema(n, &active.output);
+    assert!(flat.is_empty());
+    assert_eq!((mins.len(), maxs.len()), (2, 3));
+    assert_eq!(mins, (0..count).filter(|&v| active.roles[v] == Role::Min).collect::<Vec<_>>());
+    assert_eq!(maxs, (0..count).filter(|&v| active.roles[v] == Role::Max).collect::<Vec<_>>());
+    assert!(active.report.certificate.passed);
+    let gap = active.report.fit.gap_over_data.unwrap();
+    assert!(gap <= 1e-6, "gap {gap:e} × the data term");
+    // the same optimum as the interior-point method's, to the gap's distance bound
+    let rms =
+        (active.output.iter().zip(&direct.output).map(|(a, b)| (a - b).powi(2)).sum::<f64>() / count as f64).sqrt();
+    assert!(rms < 1e-3 * 2.0, "RMS difference {rms:e}");
+}

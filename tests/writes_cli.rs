@@ -244,6 +244,22 @@ fn outputs_that_cannot_be_written_are_refused_before_any_work() {
     assert_eq!(o.status.code(), Some(2), "{}", text(&o));
     let o = toposmooth(&["bench", "--sizes", "100000x100000"]);
     assert_eq!(o.status.code(), Some(2), "{}", text(&o));
+    let o = toposmooth(&["bench", "--sizes", "4x4x4x4"]);
+    assert_eq!(o.status.code(), Some(2), "{}", text(&o));
+    assert!(text(&o).contains("NXxNYxNZ (volume)"), "{}", text(&o));
+}
+
+#[test]
+fn bench_runs_a_volume_through_the_active_set_iteration() {
+    let o = toposmooth(&["bench", "--sizes", "12x10x8", "--solver", "active-set"]);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+    let row = String::from_utf8_lossy(&o.stdout).lines().find(|l| l.starts_with("| 12x10x8 |")).unwrap().to_string();
+    let cells: Vec<&str> = row.split('|').map(str::trim).collect();
+    // 13 kept (7 minima, 6 maxima); outer iterations with their conjugate-gradient count; the gap
+    assert_eq!(cells[3], "13", "{row}");
+    assert!(cells[5].contains(" CG)"), "{row}");
+    let gap: f64 = cells[6].parse().unwrap();
+    assert!(gap <= 1e-6, "{row}");
 }
 
 #[test]

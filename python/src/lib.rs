@@ -249,6 +249,7 @@ fn qp_settings(py: Python<'_>, d: &Bound<'_, PyDict>) -> PyResult<QpSettings> {
             ("structured", Method::Structured),
             ("clarabel", Method::Clarabel),
             ("clarabel-auxiliary", Method::ClarabelAuxiliary),
+            ("active-set", Method::ActiveSet),
         ],
         Method::Structured,
     )?;

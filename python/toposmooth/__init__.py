@@ -458,7 +458,7 @@ def smooth(
         the CLI's ``--fill-missing``; otherwise NaN is an :class:`InputError`.
     max_iter : int
         Largest number of solver iterations.
-    solver : {"structured", "clarabel", "clarabel-auxiliary"}
+    solver : {"structured", "clarabel", "clarabel-auxiliary", "active-set"}
     formulation : {"auto", "assembled", "factored"}
     threads : int, optional
         At most this many threads for the call (default 2). Results are bit-identical for

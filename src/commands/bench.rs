@@ -4,7 +4,7 @@
 //! (VmHWM) is its own.
 
 use crate::constraints::EdgeSet;
-use crate::domain::{Grid2d, Series};
+use crate::domain::{Grid2d, Grid3d, Series};
 use crate::error::{Error, Result};
 use crate::operators::Energy;
 use crate::pipeline::{smooth, RepresentativeChoice, SmoothSettings, Smoothable, Smoothed};
@@ -93,6 +93,41 @@ pub fn noisy_bumps(nx: usize, ny: usize, seed: u64) -> Vec<f64> {
         .collect()
 }
 
+/// The volume version of [`noisy_bumps`]: twelve Gaussian bumps and pits in the unit cube, a
+/// gentle tilt, and uniform noise of 5 % of the range (index `i + nx·(j + ny·k)`).
+pub fn noisy_bumps3(nx: usize, ny: usize, nz: usize, seed: u64) -> Vec<f64> {
+    let mut next = uniform(seed);
+    // (x, y, z, sign·height, width) in unit coordinates
+    let bumps = [
+        (0.2, 0.3, 0.3, 1.0, 0.12),
+        (0.7, 0.25, 0.6, 0.8, 0.14),
+        (0.45, 0.7, 0.2, 0.9, 0.13),
+        (0.85, 0.75, 0.75, 0.6, 0.11),
+        (0.15, 0.8, 0.7, 0.7, 0.1),
+        (0.5, 0.35, 0.8, 0.75, 0.11),
+        (0.35, 0.5, 0.5, -0.8, 0.12),
+        (0.65, 0.55, 0.35, -0.9, 0.13),
+        (0.9, 0.4, 0.15, -0.6, 0.1),
+        (0.25, 0.1, 0.85, -0.7, 0.11),
+        (0.75, 0.9, 0.3, -0.6, 0.11),
+        (0.55, 0.1, 0.45, -0.5, 0.1),
+    ];
+    let unit = |i: usize, n: usize| if n > 1 { i as f64 / (n - 1) as f64 } else { 0.5 };
+    (0..nx * ny * nz)
+        .map(|v| {
+            let (x, y, z) = (unit(v % nx, nx), unit((v / nx) % ny, ny), unit(v / (nx * ny), nz));
+            let smooth: f64 = bumps
+                .iter()
+                .map(|&(cx, cy, cz, a, w)| {
+                    a * (-((x - cx).powi(2) + (y - cy).powi(2) + (z - cz).powi(2)) / (w * w)).exp()
+                })
+                .sum::<f64>()
+                + 0.1 * x;
+            smooth + 0.1 * (next() - 0.5)
+        })
+        .collect()
+}
+
 fn peak_rss_mib() -> f64 {
     std::fs::read_to_string("/proc/self/status")
         .ok()
@@ -110,6 +145,8 @@ pub enum BenchCase {
     Series(usize),
     /// Noisy bumps on a grid (columns, rows).
     Grid(usize, usize),
+    /// Noisy bumps in a volume (nx, ny, nz).
+    Volume(usize, usize, usize),
     /// A mesh file, midpoint-subdivided this many times: geodesic distance from vertex 0,
     /// then smoothing with every maximum kept (the paper's figure 13).
     Mesh(String, usize),
@@ -140,10 +177,18 @@ impl BenchCase {
             };
             return Ok(BenchCase::Mesh(file.to_string(), levels));
         }
-        let bad = || Error::Usage(format!("bench size `{s}` is not N (series), NXxNY (grid) or a mesh file[@levels]"));
-        let case = match s.split_once(['x', 'X', '×']) {
-            Some((a, b)) => BenchCase::Grid(a.trim().parse().map_err(|_| bad())?, b.trim().parse().map_err(|_| bad())?),
-            None => BenchCase::Series(s.trim().parse().map_err(|_| bad())?),
+        let bad = || {
+            Error::Usage(format!(
+                "bench size `{s}` is not N (series), NXxNY (grid), NXxNYxNZ (volume) or a mesh file[@levels]"
+            ))
+        };
+        let parts: Vec<usize> =
+            s.split(['x', 'X', '×']).map(|p| p.trim().parse().map_err(|_| bad())).collect::<Result<_>>()?;
+        let case = match parts[..] {
+            [n] => BenchCase::Series(n),
+            [a, b] => BenchCase::Grid(a, b),
+            [a, b, c] => BenchCase::Volume(a, b, c),
+            _ => return Err(bad()),
         };
         match case {
             BenchCase::Series(n) if n > MAX_BENCH_VERTICES => Err(Error::Usage(format!(
@@ -152,6 +197,16 @@ impl BenchCase {
             BenchCase::Grid(a, b) if a.checked_mul(b).is_none_or(|n| n > MAX_BENCH_VERTICES) => Err(Error::Usage(
                 format!("bench grid {a} × {b}: at most {MAX_BENCH_VERTICES} vertices (a run of that size takes hours)"),
             )),
+            BenchCase::Volume(a, b, c)
+                if a.checked_mul(b).and_then(|ab| ab.checked_mul(c)).is_none_or(|n| n > MAX_BENCH_VERTICES) =>
+            {
+                Err(Error::Usage(format!(
+                    "bench volume {a} × {b} × {c}: at most {MAX_BENCH_VERTICES} vertices (a run of that size takes hours)"
+                )))
+            }
+            BenchCase::Volume(a, b, c) if a < 2 || b < 2 || c < 2 => {
+                Err(Error::Usage(format!("bench volumes need at least 2 × 2 × 2 vertices, got {a} × {b} × {c}")))
+            }
             BenchCase::Series(n) if n < 2 => {
                 Err(Error::Usage(format!("bench series need at least 2 samples, got {n}")))
             }
@@ -166,6 +221,7 @@ impl BenchCase {
         match self {
             BenchCase::Series(n) => n.to_string(),
             BenchCase::Grid(a, b) => format!("{a}x{b}"),
+            BenchCase::Volume(a, b, c) => format!("{a}x{b}x{c}"),
             BenchCase::Mesh(f, 0) => f.clone(),
             BenchCase::Mesh(f, l) => format!("{f}@{l}"),
         }
@@ -238,6 +294,17 @@ fn run_single(case: BenchCase, args: &BenchArgs) -> Result<String> {
                 (vec![(smooth(&grid, &h, &settings)?, f64::NAN)], nx * ny)
             }
         }
+        BenchCase::Volume(nx, ny, nz) => {
+            settings.selection = Selection::Count { minima: 7, maxima: 6 };
+            let grid = Grid3d::new(*nx, *ny, *nz)?;
+            let h = noisy_bumps3(*nx, *ny, *nz, args.seed);
+            let n = nx * ny * nz;
+            if many {
+                (through_smoother(grid, &h, &settings, args.fields)?, n)
+            } else {
+                (vec![(smooth(&grid, &h, &settings)?, f64::NAN)], n)
+            }
+        }
         BenchCase::Mesh(file, levels) => {
             let path = std::path::Path::new(file);
             let (mut mesh, _) = super::input::read_trimesh(path)?;
@@ -277,12 +344,14 @@ fn run_single(case: BenchCase, args: &BenchArgs) -> Result<String> {
             "kept": rep.kept.len(),
             "constraints": rep.constraints,
             "iterations": rep.solver_iterations,
+            "inner_iterations": rep.solver_inner_iterations,
             "solver": rep.solver,
             "fallback": rep.solver_fallback,
             "representative": rep.representative,
             "status": format!("{:?}", rep.solver_status),
             "certified": rep.certificate.passed,
             "gap_over_data": rep.fit.gap_over_data,
+            "active_fraction": rep.activity.active_fraction,
             "formulation": rep.fit.formulation,
             "seconds": rep.seconds,
             "total": if many { *seconds } else { total },
@@ -316,6 +385,7 @@ pub fn bench(args: &BenchArgs) -> Result<String> {
                     Method::Clarabel => "clarabel",
                     Method::ClarabelAuxiliary => "clarabel-auxiliary",
                     Method::Structured => "structured",
+                    Method::ActiveSet => "active-set",
                 },
             ])
             .args(args.representative.iter().flat_map(|r| {
@@ -348,7 +418,10 @@ pub fn bench(args: &BenchArgs) -> Result<String> {
             v["input_extrema"],
             v["kept"],
             v["constraints"],
-            v["iterations"],
+            match v["inner_iterations"].as_u64() {
+                Some(cg) if cg > 0 => format!("{} ({cg} CG)", v["iterations"]),
+                _ => v["iterations"].to_string(),
+            },
             f(&v["gap_over_data"]),
             v["extra"]["read"].as_f64().unwrap_or(0.0),
             v["extra"]["geodesic"].as_f64().unwrap_or(0.0),

@@ -166,7 +166,8 @@ enum Command {
     },
     /// Benchmark on random-walk series, noisy grids and meshes: seconds per stage and peak memory.
     Bench {
-        /// Series lengths `N`, grid sizes `NXxNY` (grids keep 7 minima and 6 maxima) and mesh files
+        /// Series lengths `N`, grid sizes `NXxNY` and volume sizes `NXxNYxNZ` (both keep 7 minima and
+        /// 6 maxima) and mesh files
         /// `MESH[@levels]` (midpoint-subdivided; geodesic from vertex 0, every maximum kept).
         #[arg(long, value_delimiter = ',', default_value = "1000,10000,100000,1000000")]
         sizes: Vec<String>,
@@ -446,8 +447,10 @@ struct SmoothCli {
     /// Largest number of solver iterations (at least 1).
     #[arg(long, default_value_t = 200, value_parser = clap::value_parser!(u32).range(1..))]
     max_iter: u32,
-    /// QP solver: the structured interior-point method (Clarabel takes over if it fails), or
-    /// Clarabel alone.
+    /// QP solver: the structured interior-point method (Clarabel takes over if it fails),
+    /// Clarabel alone, or (experimental, volumes) the active-set iteration with conjugate
+    /// gradients, which factorises nothing and hands over to the structured solver when it does
+    /// not converge.
     #[arg(long, value_enum, default_value_t = Method::Structured)]
     solver: Method,
     /// How the energy enters the solver: assembled (normal equations in double precision),

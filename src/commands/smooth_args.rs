@@ -41,7 +41,7 @@ pub struct SmoothArgs {
 /// The certificate, deviation and solver lines of `smooth`'s summary.
 pub fn fit_and_solver_lines(r: &Report) -> String {
     format!(
-        "{}; RMS deviation {}, max deviation {}\n{}\nsolver {:?} {:?} in {} iterations{}, {} constraints, margin {:.3e}; margin met exactly by moving {} vertices (at most {:.1e}); strictness repair changed {} vertices\n",
+        "{}; RMS deviation {}, max deviation {}\n{}\nsolver {:?} {:?} in {} iterations{}{}, {} constraints, margin {:.3e}; margin met exactly by moving {} vertices (at most {:.1e}); strictness repair changed {} vertices\n",
         r.certificate.summary(),
         sig6(r.rms_deviation),
         sig6(r.max_deviation),
@@ -49,7 +49,8 @@ pub fn fit_and_solver_lines(r: &Report) -> String {
         r.solver,
         r.solver_status,
         r.solver_iterations,
-        r.solver_fallback.as_ref().map(|w| format!(" (structured solver gave up: {w})")).unwrap_or_default(),
+        if r.solver_inner_iterations > 0 { format!(" ({} conjugate-gradient)", r.solver_inner_iterations) } else { String::new() },
+        r.solver_fallback.as_ref().map(|w| format!(" (first solver gave up: {w})")).unwrap_or_default(),
         r.constraints,
         r.settings.margin[0],
         r.margin_repair.changed_vertices,

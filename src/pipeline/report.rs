@@ -110,11 +110,14 @@ pub struct Report {
     pub max_deviation: f64,
     /// Solver outcome.
     pub solver_status: SolveStatus,
-    /// Interior-point iterations.
+    /// Interior-point iterations (the active-set iteration: outer iterations).
     pub solver_iterations: u32,
+    /// Conjugate-gradient iterations of the active-set iteration (0 for the others).
+    pub solver_inner_iterations: usize,
     /// The solver that produced the point.
     pub solver: Method,
-    /// Why the structured solver handed over to Clarabel, if it did.
+    /// Why the first solver handed over (to Clarabel, or from the active-set iteration to
+    /// the structured solver), if it did.
     pub solver_fallback: Option<String>,
     /// What the repair of strictness changed (after the margin was met, nothing).
     pub repair: RepairSummary,

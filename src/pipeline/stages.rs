@@ -351,6 +351,7 @@ impl Run<'_> {
             max_deviation,
             solver_status: self.sol.status,
             solver_iterations: self.sol.iterations,
+            solver_inner_iterations: self.sol.inner_iterations,
             solver: self.sol.method,
             solver_fallback: self.sol.fallback.clone(),
             repair,

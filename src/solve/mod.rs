@@ -4,6 +4,7 @@
 //!
 //! This layer knows matrices, vectors and index pairs only: no domain, no mesh.
 
+mod active_set;
 mod bounded;
 mod clarabel;
 mod condition;

@@ -44,6 +44,7 @@ pub fn solve_monotone_qp_with(
             y: None,
             status: SolveStatus::Trivial,
             iterations: 0,
+            inner_iterations: 0,
             method: settings.method,
             formulation: Formulation::Assembled,
             condition: None,
@@ -84,32 +85,62 @@ pub fn solve_monotone_qp_with(
     let hint: Option<Vec<f64>> = qp.hint.map(|h| free.iter().map(|&i| h[i]).collect());
     let mut fallback = None;
     let clarabel = |reduced: &ReducedQp| super::clarabel::solve(reduced, settings);
-    let (out, method) = match settings.method {
-        Method::Structured => match super::ipm::solve(&reduced, hint.as_deref(), settings, analyses, prepared.take()) {
-            Ok(out) => (out, Method::Structured),
-            // the assembled normal matrix lost its definiteness (an energy without a data
-            // term, ill-conditioned on its own): the factored form in double-double next
-            Err(_)
-                if formulation == Formulation::Assembled
-                    && settings.formulation == Formulation::Auto
-                    && qp.factor.is_some() =>
-            {
-                to_factored(&mut reduced, qp.factor.expect("checked"));
-                formulation = Formulation::Factored;
-                match super::ipm::solve(&reduced, hint.as_deref(), settings, analyses, None) {
-                    Ok(out) => (out, Method::Structured),
-                    Err(why) => {
-                        fallback = Some(why.to_string());
-                        (clarabel(&reduced)?, Method::Clarabel)
-                    }
+    let mut inner_iterations = 0;
+    let attempt = match settings.method {
+        Method::ActiveSet if formulation == Formulation::Assembled && reduced.gap_bound => {
+            match super::active_set::solve(&reduced, hint.as_deref(), settings) {
+                Ok(a) if a.outcome.status == SolveStatus::Solved => {
+                    inner_iterations = a.cg_iterations;
+                    Some(a.outcome)
+                }
+                Ok(a) => {
+                    fallback = Some(format!(
+                        "the active-set iteration ended {:?} after {} outer and {} conjugate-gradient iterations",
+                        a.outcome.status, a.outcome.iterations, a.cg_iterations
+                    ));
+                    None
+                }
+                Err(why) => {
+                    fallback = Some(why.to_string());
+                    None
                 }
             }
-            Err(why) => {
-                fallback = Some(why.to_string());
-                (clarabel(&reduced)?, Method::Clarabel)
+        }
+        Method::ActiveSet => {
+            fallback = Some("the active-set iteration needs the assembled energy with a data term everywhere".into());
+            None
+        }
+        _ => None,
+    };
+    let (out, method) = match (attempt, settings.method) {
+        (Some(out), _) => (out, Method::ActiveSet),
+        (None, Method::Structured | Method::ActiveSet) => {
+            match super::ipm::solve(&reduced, hint.as_deref(), settings, analyses, prepared.take()) {
+                Ok(out) => (out, Method::Structured),
+                // the assembled normal matrix lost its definiteness (an energy without a data
+                // term, ill-conditioned on its own): the factored form in double-double next
+                Err(_)
+                    if formulation == Formulation::Assembled
+                        && settings.formulation == Formulation::Auto
+                        && qp.factor.is_some() =>
+                {
+                    to_factored(&mut reduced, qp.factor.expect("checked"));
+                    formulation = Formulation::Factored;
+                    match super::ipm::solve(&reduced, hint.as_deref(), settings, analyses, None) {
+                        Ok(out) => (out, Method::Structured),
+                        Err(why) => {
+                            fallback = Some(why.to_string());
+                            (clarabel(&reduced)?, Method::Clarabel)
+                        }
+                    }
+                }
+                Err(why) => {
+                    fallback = Some(why.to_string());
+                    (clarabel(&reduced)?, Method::Clarabel)
+                }
             }
-        },
-        Method::Clarabel | Method::ClarabelAuxiliary => (clarabel(&reduced)?, settings.method),
+        }
+        (None, Method::Clarabel | Method::ClarabelAuxiliary) => (clarabel(&reduced)?, settings.method),
     };
     for (k, &i) in free.iter().enumerate() {
         x[i] = out.x[k];
@@ -117,7 +148,18 @@ pub fn solve_monotone_qp_with(
     // multipliers and auxiliary variables back in the problem's units
     let z = out.z.iter().map(|v| v.max(0.0) * reduced.scale).collect();
     let y = out.y.map(|y| y.iter().map(|v| v * reduced.scale.sqrt()).collect());
-    Ok(QpSolution { x, z, y, status: out.status, iterations: out.iterations, method, formulation, condition, fallback })
+    Ok(QpSolution {
+        x,
+        z,
+        y,
+        status: out.status,
+        iterations: out.iterations,
+        inner_iterations,
+        method,
+        formulation,
+        condition,
+        fallback,
+    })
 }
 
 /// The structured solver's analysis of the normal matrix of a QP with energy `p` and fixed
@@ -244,5 +286,67 @@ mod tests {
                 assert_eq!((sol.x[0], sol.x[3]), (0.0, 3.0));
             }
         }
+    }
+
+    #[test]
+    fn the_active_set_iteration_reaches_the_interior_point_optimum() {
+        // P = K² / 2 + I (a biharmonic-like energy: not an M-matrix) on a 14 × 11 grid, noisy
+        // data and every edge constrained to rise with x + y, two corners fixed
+        let (nx, ny) = (14, 11);
+        let n = nx * ny;
+        let (k, edges) = grid_qp(nx, ny);
+        let kd = k.to_dense();
+        let mut t = Vec::new();
+        for i in 0..n {
+            for j in 0..n {
+                let mut v: f64 = (0..n).map(|m| kd[(i, m)] * kd[(m, j)]).sum::<f64>() / 2.0;
+                if i == j {
+                    v += 1.0;
+                }
+                if v != 0.0 {
+                    t.push(Triplet::new(i, j, v));
+                }
+            }
+        }
+        let p = Sparse::try_new_from_triplets(n, n, &t).unwrap();
+        let ramp = |i: usize| ((i % nx) + (i / nx)) as f64 / (nx + ny - 2) as f64;
+        let h: Vec<f64> = (0..n).map(|i| ramp(i) + 0.3 * ((i * 7919) % 13) as f64 / 13.0 - 0.15).collect();
+        let q: Vec<f64> = h.iter().map(|v| -v).collect();
+        let d = vec![1.0; n];
+        let mut fixed = vec![None; n];
+        fixed[0] = Some(-0.2);
+        fixed[n - 1] = Some(1.2);
+        let hint: Vec<f64> = (0..n).map(|i| -0.2 + 1.4 * ramp(i)).collect();
+        let qp = MonotoneQp {
+            p: &p,
+            q: &q,
+            fixed: &fixed,
+            edges: &edges,
+            margin: 1e-6,
+            hint: Some(&hint),
+            bounds: &[],
+            data: Some(&d),
+            factor: None,
+            condition: None,
+        };
+        let objective = |x: &[f64]| {
+            let px = &p * faer::Mat::from_fn(n, 1, |i, _| x[i]);
+            (0..n).map(|i| 0.5 * x[i] * px[(i, 0)] + q[i] * x[i]).sum::<f64>()
+        };
+        let ipm = solve_monotone_qp(&qp, &QpSettings::default()).unwrap();
+        let active = solve_monotone_qp(&qp, &QpSettings { method: Method::ActiveSet, ..Default::default() }).unwrap();
+        assert_eq!(active.method, Method::ActiveSet, "{:?}", active.fallback);
+        assert_eq!(active.status, SolveStatus::Solved);
+        assert!(active.inner_iterations > 0);
+        // the constraints bind somewhere (the data falls along the ramp), and hold to a margin
+        let binding = edges.iter().filter(|&&(i, j)| ipm.x[j] - ipm.x[i] < 2e-6).count();
+        assert!(binding > 5, "{binding} binding edges");
+        let worst = edges.iter().map(|&(i, j)| active.x[j] - active.x[i]).fold(f64::INFINITY, f64::min);
+        assert!(worst > 0.5e-6, "{worst:e}");
+        let (ja, ji) = (objective(&active.x), objective(&ipm.x));
+        let data: f64 = (0..n).map(|i| 0.5 * (active.x[i] - h[i]).powi(2)).sum();
+        assert!((ja - ji).abs() <= 1e-6 * data, "objectives {ja} and {ji}, data term {data}");
+        let diff = active.x.iter().zip(&ipm.x).fold(0.0f64, |a, (x, y)| a.max((x - y).abs()));
+        assert!(diff < 1e-3, "{diff:e}");
     }
 }

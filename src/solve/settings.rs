@@ -15,6 +15,12 @@ pub enum Method {
     /// variables (f, t) with t = F f as equality constraints; needs the energy's factor F).
     #[cfg_attr(feature = "serde", serde(rename = "clarabel-auxiliary"))]
     ClarabelAuxiliary,
+    /// The active-set iteration with conjugate gradients: nothing factorised (volumes); needs
+    /// a data term at every free entry. The structured solver takes over if it cannot run or
+    /// does not converge (experimental: converges on the 32³ bench volume, cycles from 48³ on;
+    /// docs/volumes.md, "Speed").
+    #[cfg_attr(feature = "serde", serde(rename = "active-set"))]
+    ActiveSet,
 }
 
 /// How the objective enters the solver.

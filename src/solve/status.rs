@@ -32,8 +32,10 @@ pub struct QpSolution {
     pub y: Option<Vec<f64>>,
     /// Solver outcome.
     pub status: SolveStatus,
-    /// Interior-point iterations.
+    /// Interior-point iterations (active-set iteration: outer iterations).
     pub iterations: u32,
+    /// Conjugate-gradient iterations over all solves of the active-set iteration (0 otherwise).
+    pub inner_iterations: usize,
     /// The solver that produced the point.
     pub method: Method,
     /// The formulation used ([`Formulation::Assembled`] or [`Formulation::Factored`]).

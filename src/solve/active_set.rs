@@ -390,54 +390,46 @@ struct Forest {
 }
 
 impl Forest {
-    /// The tree row on the path from `i` to `j` (one tree) that runs the way `i → j` does,
-    /// `x` rising along it, with the smallest multiplier: swapping it for the row `i → j`
-    /// keeps the tree's equalities consistent with every row on the cycle.
-    fn rising_row_on_path(&self, rows: &[Row], z: &[f64], mut i: usize, mut j: usize) -> Option<usize> {
-        let mut best: Option<usize> = None;
-        let mut consider = |k: usize| {
-            if best.is_none_or(|b| z[k] < z[b]) {
-                best = Some(k);
-            }
-        };
+    /// Calls `visit(row, rises)` for each tree row on the path from `i` to `j` (one tree),
+    /// `rises` when `x` rises along it in the direction `i → j`.
+    fn walk_path(&self, rows: &[Row], mut i: usize, mut j: usize, mut visit: impl FnMut(usize, bool)) {
+        // Pair(a, b) is x_a − x_b ≤ −ε: x rises from a to b. Walking up from i, a row rises
+        // along i → j when i's side is its a; walking up from j, when j's side is its b.
         let other = |k: usize, v: usize| match rows[k] {
             Row::Pair(a, b, _) => (if a == v { b } else { a }, a == v),
             Row::Bound(..) => unreachable!("tree rows are pairs"),
         };
-        // Pair(a, b) is x_a − x_b ≤ −ε: x rises from a to b. Walking up from i, a row rises
-        // along i → j when i's side is its a; walking up from j, when j's side is its b.
-        while self.depth[i] > self.depth[j] {
-            let k = self.parent_row[i];
-            let (p, from_a) = other(k, i);
-            if from_a {
-                consider(k);
-            }
-            i = p;
-        }
-        while self.depth[j] > self.depth[i] {
-            let k = self.parent_row[j];
-            let (p, from_a) = other(k, j);
-            if !from_a {
-                consider(k);
-            }
-            j = p;
-        }
         while i != j {
-            let (ki, kj) = (self.parent_row[i], self.parent_row[j]);
-            if ki == usize::MAX || kj == usize::MAX {
-                return None;
+            if self.depth[i] >= self.depth[j] {
+                let k = self.parent_row[i];
+                if k == usize::MAX {
+                    return;
+                }
+                let (p, from_a) = other(k, i);
+                visit(k, from_a);
+                i = p;
+            } else {
+                let k = self.parent_row[j];
+                if k == usize::MAX {
+                    return;
+                }
+                let (p, from_a) = other(k, j);
+                visit(k, !from_a);
+                j = p;
             }
-            let (pi, a_i) = other(ki, i);
-            if a_i {
-                consider(ki);
-            }
-            let (pj, a_j) = other(kj, j);
-            if !a_j {
-                consider(kj);
-            }
-            i = pi;
-            j = pj;
         }
+    }
+
+    /// The tree row on the path from `i` to `j` that runs the way `i → j` does, `x` rising
+    /// along it, with the smallest multiplier: swapping it for the row `i → j` keeps the
+    /// tree's equalities consistent with every row on the cycle.
+    fn rising_row_on_path(&self, rows: &[Row], z: &[f64], i: usize, j: usize) -> Option<usize> {
+        let mut best: Option<usize> = None;
+        self.walk_path(rows, i, j, |k, rises| {
+            if rises && best.is_none_or(|b| z[k] < z[b]) {
+                best = Some(k);
+            }
+        });
         best
     }
 }

@@ -203,7 +203,7 @@ fn a_volume_with_one_flat_axis_is_a_2d_grid() {
 }
 
 #[test]
-fn the_active_set_iteration_smooths_a_noisy_volume_to_the_interior_point_optimum() {
+fn the_active_set_iteration_and_clarabel_smooth_a_noisy_volume_to_the_interior_point_optimum() {
     use toposmooth::solve::{Method, QpSettings};
     let n = [18, 15, 12];
     let count: usize = n.iter().product();
@@ -226,7 +226,17 @@ fn the_active_set_iteration_smooths_a_noisy_volume_to_the_interior_point_optimum
         };
         smooth(&g, &h, &settings).unwrap()
     };
-    let (active, direct) = (run(Method::ActiveSet), run(Method::Structured));
+    let (active, direct, clarabel) = (run(Method::ActiveSet), run(Method::Structured), run(Method::Clarabel));
+    // Clarabel on the same QP (the fit issue's comparison): certified, at the same optimum
+    assert_eq!(clarabel.report.solver, Method::Clarabel);
+    assert!(clarabel.report.certificate.passed && direct.report.certificate.passed);
+    for out in [&direct, &clarabel] {
+        let gap = out.report.fit.gap_over_data.unwrap();
+        assert!(gap <= 1e-6, "{:?}: gap {gap:e} × the data term", out.report.solver);
+    }
+    let rms_cd =
+        (clarabel.output.iter().zip(&direct.output).map(|(a, b)| (a - b).powi(2)).sum::<f64>() / count as f64).sqrt();
+    assert!(rms_cd < 2e-3, "Clarabel and the structured solver differ by RMS {rms_cd:e}");
     assert_eq!(active.report.solver, Method::ActiveSet, "{:?}", active.report.solver_fallback);
     assert!(active.report.solver_inner_iterations > 0);
     let (mins, maxs, flat) = volume_extrema(n, &active.output);

@@ -285,3 +285,35 @@ fn the_synthetic_abc_flow_is_smoothed_certified_and_closer_to_its_true_vorticity
     let o = succeeds(&["verify", out.to_str().unwrap()]);
     assert!(text(&o).contains("certified"), "{}", text(&o));
 }
+
+/// An ASCII VTK XML image with extent `extent` and one Float64 point array `f`.
+fn ascii_vti(path: &Path, extent: &str, spacing: &str, values: &[f64]) {
+    let list: Vec<String> = values.iter().map(|v| v.to_string()).collect();
+    let text = format!(
+        "<?xml version=\"1.0\"?>\n<VTKFile type=\"ImageData\" version=\"1.0\" byte_order=\"LittleEndian\">\n<ImageData WholeExtent=\"{extent}\" Origin=\"0 0 0\" Spacing=\"{spacing}\">\n<Piece Extent=\"{extent}\"><PointData Scalars=\"f\">\n<DataArray type=\"Float64\" Name=\"f\" format=\"ascii\">{}</DataArray>\n</PointData></Piece></ImageData></VTKFile>\n",
+        list.join(" ")
+    );
+    std::fs::write(path, text).unwrap();
+}
+
+#[test]
+fn images_in_the_xz_and_yz_planes_are_2d_grids_over_their_two_axes() {
+    let dir = scratch("volume-planes");
+    let (na, nb) = (9, 7);
+    let h: Vec<f64> = (0..na * nb).map(|v| ((v % na) as f64 / 2.0).sin() + ((v / na) as f64 / 3.0).cos()).collect();
+    for (plane, extent) in [("x-z", "0 8 0 0 0 6"), ("y-z", "0 0 0 8 0 6")] {
+        let input = dir.join(format!("{plane}.vti"));
+        ascii_vti(&input, extent, "1 0.25 0.5", &h);
+        let out = dir.join(format!("{plane}.npz"));
+        let o = succeeds(&["smooth", input.to_str().unwrap(), "-o", out.to_str().unwrap()]);
+        assert!(text(&o).contains("9 × 7 grid"), "{}", text(&o));
+        assert!(text(&o).contains(&format!("lies in the {plane} plane")), "{}", text(&o));
+        // the spacing of the file's two axes (x or y, then z)
+        let spacing = if plane == "x-z" { "spacing 1, 0.5" } else { "spacing 0.25, 0.5" };
+        assert!(text(&o).contains(spacing), "{}", text(&o));
+        let s = stored(&out);
+        assert_eq!(s.input, h, "the points are already in the grid's order");
+        let o = succeeds(&["verify", out.to_str().unwrap()]);
+        assert!(text(&o).contains("certified"), "{}", text(&o));
+    }
+}

@@ -544,20 +544,20 @@ fn read_raw(path: &Path, array: Option<&str>) -> Result<Raw> {
     }
     match extension(path).as_str() {
         "vti" | "vtk" => {
-            let (geometry, arrays, cell, skipped, active) = match read_any_image(path)? {
+            let (geometry, arrays, cell, skipped, active, notes) = match read_any_image(path)? {
                 AnyImage::Flat(img) => {
                     let grid =
                         Grid2d::with_geometry(img.nx, img.ny, img.spacing, img.origin).map_err(|e| e.in_file(path))?;
-                    (Geometry::Flat(grid), img.arrays, img.cell_arrays, img.skipped, img.active_scalars)
+                    (Geometry::Flat(grid), img.arrays, img.cell_arrays, img.skipped, img.active_scalars, img.notes)
                 }
                 AnyImage::Volume(v) => {
                     let grid = Grid3d::with_geometry(v.dims, v.spacing, v.origin).map_err(|e| e.in_file(path))?;
-                    (Geometry::Volume(grid), v.arrays, v.cell_arrays, v.skipped, v.active_scalars)
+                    (Geometry::Volume(grid), v.arrays, v.cell_arrays, v.skipped, v.active_scalars, v.notes)
                 }
             };
             let listed = arrays.iter().map(|a| (a.name.clone(), a.components, a.values.clone())).collect();
             let carried = Carried { point: arrays, cells: None, cell, source: None, affine: None };
-            Ok(Raw { geometry, arrays: listed, skipped, active, carried: Some(carried), notes: Vec::new() })
+            Ok(Raw { geometry, arrays: listed, skipped, active, carried: Some(carried), notes })
         }
         "npy" | "npz" => match read_numpy(path, array, Wanted::Grid)? {
             NumpyField::Grid(f) => Ok(from_field(f)),

@@ -83,8 +83,47 @@ pub(super) fn image_of(ds: Dataset) -> Result<ImageData> {
     })
 }
 
-/// The image a data set holds: a volume when every axis has at least 2 points, else as
-/// [`image_of`].
+/// An image in the x-z or y-z plane (one point along x or y): a 2D grid over its other two
+/// axes, whose points are already in the grid's order (the flat axis has stride 1 · …).
+/// The grid's x and y are the file's two axes; outputs are written in the x-y plane (a note
+/// says so).
+fn plane_of(ds: Dataset) -> Result<ImageData> {
+    let g = ds.image.clone().ok_or_else(|| Error::input("the data set is not image data"))?;
+    let dims = g.dims();
+    let axes = axes_of(&g.direction)?;
+    if axes.iter().enumerate().any(|(a, &(p, sign))| a != p || sign < 0.0) {
+        return Err(Error::input(format!(
+            "the Direction `{}` of an image with one point along {}: only the identity direction is supported for images outside the x-y plane",
+            text(&g.direction),
+            if dims[0] == 1 { "x" } else { "y" }
+        )));
+    }
+    if ds.point_data.is_empty() {
+        return Err(no_point_data(&ds.cell_data, &ds.skipped));
+    }
+    let (u, v) = if dims[0] == 1 { (1, 2) } else { (0, 2) };
+    let names = ["x", "y", "z"];
+    let ext = g.extent;
+    let start = |a: usize| g.origin[a] + ext[2 * a] as f64 * g.spacing[a];
+    Ok(ImageData {
+        nx: dims[u],
+        ny: dims[v],
+        spacing: [g.spacing[u], g.spacing[v]],
+        origin: [start(u), start(v)],
+        arrays: ds.point_data,
+        // cells of a flat image: none along the flat axis, the same order
+        cell_arrays: ds.cell_data,
+        notes: vec![format!(
+            "the image lies in the {}-{} plane: smoothed as a 2D grid with the file's {} and {} as its x and y (outputs lie in the x-y plane)",
+            names[u], names[v], names[u], names[v]
+        )],
+        skipped: ds.skipped,
+        active_scalars: ds.active_scalars,
+    })
+}
+
+/// The image a data set holds: a volume when every axis has at least 2 points, a 2D grid
+/// when one axis has one point ([`image_of`] in the x-y plane, else [`plane_of`]).
 ///
 /// # Errors
 /// As [`image_of`], without its limit on z.
@@ -93,6 +132,9 @@ pub(super) fn any_image_of(ds: Dataset) -> Result<AnyImage> {
         return image_of(ds).map(AnyImage::Flat);
     };
     let dims = g.dims();
+    if dims[2] > 1 && (dims[0] == 1) != (dims[1] == 1) && dims.iter().filter(|&&d| d >= 2).count() == 2 {
+        return plane_of(ds).map(AnyImage::Flat);
+    }
     if dims.iter().any(|&d| d < 2) {
         return image_of(ds).map(AnyImage::Flat);
     }

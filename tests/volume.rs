@@ -316,4 +316,11 @@ fn images_in_the_xz_and_yz_planes_are_2d_grids_over_their_two_axes() {
         let o = succeeds(&["verify", out.to_str().unwrap()]);
         assert!(text(&o).contains("certified"), "{}", text(&o));
     }
+    // VTK's own writer (tests/fixtures: extent 0 6 0 0 0 4, spacing 0.5 1 0.25, ParaView's
+    // default appended raw zlib encoding)
+    let vtk = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/vtk/img_xz.appended-raw-zlib-u64.vti");
+    let out = dir.join("vtk-xz.npz");
+    let o = succeeds(&["smooth", vtk.to_str().unwrap(), "--array", "f", "-o", out.to_str().unwrap()]);
+    assert!(text(&o).contains("7 × 5 grid") && text(&o).contains("spacing 0.5, 0.25"), "{}", text(&o));
+    assert!(text(&o).contains("certified:"), "{}", text(&o));
 }

@@ -84,11 +84,10 @@ pub(super) fn image_of(ds: Dataset) -> Result<ImageData> {
 }
 
 /// An image in the x-z or y-z plane (one point along x or y): a 2D grid over its other two
-/// axes, whose points are already in the grid's order (the flat axis has stride 1 · …).
-/// The grid's x and y are the file's two axes; outputs are written in the x-y plane (a note
-/// says so).
-fn plane_of(ds: Dataset) -> Result<ImageData> {
-    let g = ds.image.clone().ok_or_else(|| Error::input("the data set is not image data"))?;
+/// axes, whose points are already in the grid's order (x fastest, the flat axis contributes
+/// nothing to the index). The grid's x and y are the file's two axes; outputs are written in
+/// the x-y plane (a note says so).
+fn plane_of(ds: Dataset, g: &super::data::ImageGeometry) -> Result<ImageData> {
     let dims = g.dims();
     let axes = axes_of(&g.direction)?;
     if axes.iter().enumerate().any(|(a, &(p, sign))| a != p || sign < 0.0) {
@@ -132,8 +131,9 @@ pub(super) fn any_image_of(ds: Dataset) -> Result<AnyImage> {
         return image_of(ds).map(AnyImage::Flat);
     };
     let dims = g.dims();
-    if dims[2] > 1 && (dims[0] == 1) != (dims[1] == 1) && dims.iter().filter(|&&d| d >= 2).count() == 2 {
-        return plane_of(ds).map(AnyImage::Flat);
+    if dims[2] > 1 && (dims[0] == 1) != (dims[1] == 1) {
+        let g = g.clone();
+        return plane_of(ds, &g).map(AnyImage::Flat);
     }
     if dims.iter().any(|&d| d < 2) {
         return image_of(ds).map(AnyImage::Flat);

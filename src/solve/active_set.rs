@@ -16,6 +16,7 @@
 //! margin by a few ε, which the caller's margin repair restores, and the certificate and the
 //! gap of the output as written decide.
 
+use super::flow::Network;
 use super::problem::ReducedQp;
 use super::settings::QpSettings;
 use super::status::{Outcome, SolveStatus};
@@ -434,9 +435,33 @@ impl Forest {
     }
 }
 
+/// The gradient with each unanchored cluster's sum spread back over it in proportion to the
+/// data diagonal (the conjugate gradients leave a residual of their tolerance): what the
+/// multipliers of a cluster's rows must balance.
+fn balanced_gradient(cl: &Clusters, g: &[f64], d: &[f64]) -> Vec<f64> {
+    let nc = cl.anchor.len();
+    let (mut gsum, mut dsum) = (vec![0.0; nc], vec![0.0; nc]);
+    for (v, &c) in cl.label.iter().enumerate() {
+        gsum[c as usize] += g[v];
+        dsum[c as usize] += d[v];
+    }
+    cl.label
+        .iter()
+        .enumerate()
+        .map(|(v, &c)| {
+            let c = c as usize;
+            if cl.anchor[c].is_none() && dsum[c] > 0.0 {
+                g[v] - gsum[c] * d[v] / dsum[c]
+            } else {
+                g[v]
+            }
+        })
+        .collect()
+}
+
 /// The multipliers of the working set's rows by stationarity on each tree (zero elsewhere).
-fn tree_multipliers(rows: &[Row], in_set: &[bool], cl: &Clusters, g: &[f64], d: &[f64], z: &mut [f64]) -> Forest {
-    let n = g.len();
+fn tree_multipliers(rows: &[Row], in_set: &[bool], cl: &Clusters, balanced: &[f64], z: &mut [f64]) -> Forest {
+    let n = balanced.len();
     z.iter_mut().for_each(|v| *v = 0.0);
     // adjacency of the set's pair rows, the anchor row of each anchored cluster
     let mut deg = vec![0usize; n + 1];
@@ -463,24 +488,8 @@ fn tree_multipliers(rows: &[Row], in_set: &[bool], cl: &Clusters, g: &[f64], d: 
             at[j] += 1;
         }
     }
-    // per cluster: the gradient's sum and the data diagonal's, for the unknowns' share
     let nc = cl.anchor.len();
-    let (mut gsum, mut dsum) = (vec![0.0; nc], vec![0.0; nc]);
-    for v in 0..n {
-        let c = cl.label[v] as usize;
-        gsum[c] += g[v];
-        dsum[c] += d[v];
-    }
-    let mut acc: Vec<f64> = (0..n)
-        .map(|v| {
-            let c = cl.label[v] as usize;
-            if cl.anchor[c].is_none() && dsum[c] > 0.0 {
-                g[v] - gsum[c] * d[v] / dsum[c]
-            } else {
-                g[v]
-            }
-        })
-        .collect();
+    let mut acc = balanced.to_vec();
     // breadth-first from each cluster's root (the anchor row's variable when anchored)
     let mut seen = vec![false; n];
     let mut order = Vec::with_capacity(n);
@@ -544,6 +553,127 @@ fn tree_multipliers(rows: &[Row], in_set: &[bool], cl: &Clusters, g: &[f64], d: 
     Forest { parent_row, depth }
 }
 
+/// A row is tight (an arc of the multipliers' network) within this of its bound.
+const TIGHT: f64 = 1e-10;
+
+/// Multipliers for the clusters marked in `marked` as a non-negative flow over all their
+/// tight rows, tree rows or not: stationarity `g + Aᵀz = 0` asks each variable to send out
+/// `−g` (balanced) along rows `x_i ≤ x_j − ε` from `i` to `j`, an anchor row taking or giving
+/// the cluster's sum. Where no such flow exists the minimum cut's source side is a set the
+/// objective falls by raising (or its complement, by lowering) with every tight row
+/// respected: the tree rows across it leave the set, splitting the cluster once, for good.
+/// A tree row's negative multiplier alone says nothing of this when tight rows close cycles,
+/// and dropping it there only has the row rejoin (the cycling of 48³ volumes). Returns the
+/// rows dropped.
+#[allow(clippy::too_many_arguments)]
+fn flow_multipliers(
+    rows: &[Row],
+    in_set: &mut [bool],
+    cl: &Clusters,
+    balanced: &[f64],
+    x: &[f64],
+    d: &[f64],
+    marked: &[bool],
+    significant: f64,
+    z: &mut [f64],
+) -> usize {
+    let n = x.len();
+    let nc = cl.anchor.len();
+    let mut node = vec![NONE; n];
+    let mut count = 2usize; // 0 the source, 1 the sink
+    let mut scale = 0.0f64;
+    for v in 0..n {
+        if marked[cl.label[v] as usize] {
+            node[v] = count as u32;
+            count += 1;
+            scale = scale.max(balanced[v].abs());
+        }
+    }
+    if count == 2 || scale == 0.0 {
+        return 0;
+    }
+    let eps = 1e-14 * scale;
+    let mut net = Network::new(count);
+    let (source, sink) = (0, 1);
+    // per cluster: the sum to send out, the supply arcs, the smallest data diagonal
+    let mut sum = vec![0.0; nc];
+    let mut dmin = vec![f64::INFINITY; nc];
+    let mut supply: Vec<(u32, usize, f64)> = Vec::new();
+    for v in 0..n {
+        if node[v] == NONE {
+            continue;
+        }
+        let c = cl.label[v] as usize;
+        let out = -balanced[v];
+        sum[c] += out;
+        dmin[c] = dmin[c].min(d[v]);
+        if out > 0.0 {
+            supply.push((c as u32, net.add_arc(source, node[v] as usize, out), out));
+        } else if out < 0.0 {
+            net.add_arc(node[v] as usize, sink, -out);
+        }
+    }
+    let mut arcs: Vec<(usize, usize)> = Vec::new();
+    for (k, row) in rows.iter().enumerate() {
+        match *row {
+            Row::Pair(i, j, _) => {
+                if node[i] == NONE || cl.label[i] != cl.label[j] || !(in_set[k] || row.slack(x).abs() <= TIGHT) {
+                    continue;
+                }
+                arcs.push((k, net.add_arc(node[i] as usize, node[j] as usize, f64::INFINITY)));
+            }
+            Row::Bound(v, a, _) if in_set[k] && node[v] != NONE => {
+                let c = cl.label[v] as usize;
+                let hub = net.add_node();
+                if a > 0.0 {
+                    // x_v ≤ b: the anchor takes what the cluster sends out
+                    arcs.push((k, net.add_arc(node[v] as usize, hub, f64::INFINITY)));
+                    supply_or_demand(&mut net, &mut supply, hub, sink, sum[c].max(0.0), None);
+                } else {
+                    arcs.push((k, net.add_arc(hub, node[v] as usize, f64::INFINITY)));
+                    supply_or_demand(&mut net, &mut supply, source, hub, (-sum[c]).max(0.0), Some(c as u32));
+                }
+            }
+            Row::Bound(..) => {}
+        }
+    }
+    net.max_flow(source, sink, eps);
+    let mut deficit = vec![0.0; nc];
+    for &(c, a, cap) in &supply {
+        deficit[c as usize] += cap - net.flow(a);
+    }
+    let cut: Vec<bool> = (0..nc).map(|c| marked[c] && deficit[c] * deficit[c] / dmin[c] > significant).collect();
+    let side = net.reachable(source, eps);
+    let mut dropped = 0;
+    for &(k, a) in &arcs {
+        z[k] = net.flow(a);
+        if let Row::Pair(i, j, _) = rows[k] {
+            if in_set[k] && cut[cl.label[i] as usize] && side[node[i] as usize] != side[node[j] as usize] {
+                in_set[k] = false;
+                z[k] = 0.0;
+                dropped += 1;
+            }
+        }
+    }
+    dropped
+}
+
+/// An arc `from → to` of capacity `cap`, recorded as supply of cluster `c` when it leaves the
+/// source.
+fn supply_or_demand(
+    net: &mut Network,
+    supply: &mut Vec<(u32, usize, f64)>,
+    from: usize,
+    to: usize,
+    cap: f64,
+    c: Option<u32>,
+) {
+    let a = net.add_arc(from, to, cap);
+    if let Some(c) = c {
+        supply.push((c, a, cap));
+    }
+}
+
 /// `Σ max(s, 0) z⁺ + ½ Σ ρ²/d` with `ρ = g + Aᵀz⁺` (all in the reduced units).
 fn gap_bound(rows: &[Row], x: &[f64], z: &[f64], g: &[f64], d: &[f64]) -> f64 {
     let mut rho = g.to_vec();
@@ -599,25 +729,37 @@ pub(super) fn solve(
         let data = obj.data_term(&x).max(f64::MIN_POSITIVE);
         cg_iterations += solve_clustered(&obj, &cl, &mut x, relative * data);
         obj.gradient(&x, &mut g);
-        let forest = tree_multipliers(&rows, &in_set, &cl, &g, &r.d, &mut z);
+        let balanced = balanced_gradient(&cl, &g, &r.d);
+        let forest = tree_multipliers(&rows, &in_set, &cl, &balanced, &mut z);
         let data = obj.data_term(&x).max(f64::MIN_POSITIVE);
         let target = settings.gap_tolerance * data;
-        // leave: negative multipliers whose clamping would matter
+        // leave: an anchor whose multiplier is negative (the whole cluster moves off its
+        // bound); a cluster with a negative tree multiplier gets its multipliers as a flow
+        // over all its tight rows, and splits along the cut where there is none
         let in_count = in_set.iter().filter(|&&s| s).count().max(1);
+        let significant = final_tolerance * data / in_count as f64;
         let mut changed = 0usize;
+        let mut marked = vec![false; cl.anchor.len()];
+        let mut unanchored = vec![false; cl.anchor.len()];
         for (k, row) in rows.iter().enumerate() {
             if in_set[k] && z[k] < 0.0 {
-                let dk = match *row {
-                    Row::Pair(i, j, _) => r.d[i].min(r.d[j]),
-                    Row::Bound(v, _, _) => r.d[v],
-                };
-                if z[k] * z[k] / dk > final_tolerance * data / in_count as f64 {
-                    in_set[k] = false;
-                    z[k] = 0.0;
-                    changed += 1;
+                match *row {
+                    Row::Pair(i, j, _) if z[k] * z[k] / r.d[i].min(r.d[j]) > significant => {
+                        marked[cl.label[i] as usize] = true;
+                    }
+                    Row::Bound(v, _, _) if z[k] * z[k] / r.d[v] > significant => {
+                        unanchored[cl.label[v] as usize] = true;
+                        in_set[k] = false;
+                        z[k] = 0.0;
+                        changed += 1;
+                    }
+                    _ => {}
                 }
             }
         }
+        marked.iter_mut().zip(&unanchored).for_each(|(m, &u)| *m &= !u);
+        let drops = flow_multipliers(&rows, &mut in_set, &cl, &balanced, &x, &r.d, &marked, significant, &mut z);
+        changed += drops;
         // join: violated rows, the most violated first, merging distinct clusters only
         let cl = Clusters::new(n, &rows, &in_set);
         let mut violated: Vec<(f64, usize)> = rows
@@ -688,7 +830,7 @@ pub(super) fn solve(
         let worst = violated.first().map_or(0.0, |v| v.0);
         if std::env::var_os("TOPOSMOOTH_TRACE_ACTIVE").is_some() {
             eprintln!(
-                "active set {outer}: {} rows in, {changed} changed ({swaps} swaps), {} violated (worst {worst:.1e}), gap/data {:.1e}, cg {cg_iterations}",
+                "active set {outer}: {} rows in, {changed} changed ({swaps} swaps, {drops} cut), {} violated (worst {worst:.1e}), gap/data {:.1e}, cg {cg_iterations}",
                 in_set.iter().filter(|&&s| s).count(),
                 violated.len(),
                 gap / data

@@ -9,6 +9,7 @@ mod bounded;
 mod clarabel;
 mod condition;
 mod factored;
+mod flow;
 mod ipm;
 mod newton;
 mod optimality;

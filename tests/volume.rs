@@ -97,6 +97,89 @@ fn random_volumes_with_ties_end_certified_for_every_persistence_selection() {
     }
 }
 
+/// Strict minima, strict maxima and non-regular vertices of a field on tetrahedra, the
+/// neighbours taken from the tetrahedra's edges here (SPEC.md: neighbours share an edge).
+fn tet_extrema(n: usize, tets: &[[usize; 4]], f: &[f64]) -> (Vec<usize>, Vec<usize>, Vec<usize>) {
+    let mut nbrs = vec![std::collections::BTreeSet::new(); n];
+    for t in tets {
+        for a in 0..4 {
+            for b in 0..4 {
+                if a != b {
+                    nbrs[t[a]].insert(t[b]);
+                }
+            }
+        }
+    }
+    let (mut mins, mut maxs, mut flat) = (vec![], vec![], vec![]);
+    for v in 0..n {
+        let lower = nbrs[v].iter().filter(|&&w| f[w] < f[v]).count();
+        let higher = nbrs[v].iter().filter(|&&w| f[w] > f[v]).count();
+        if lower + higher < nbrs[v].len() {
+            flat.push(v);
+        } else if lower == 0 {
+            mins.push(v);
+        } else if higher == 0 {
+            maxs.push(v);
+        }
+    }
+    (mins, maxs, flat)
+}
+
+#[test]
+fn random_fields_with_ties_on_tetrahedral_meshes_end_certified_for_every_persistence_selection() {
+    use toposmooth::domain::{Domain, TetMesh};
+    for seed in 0..8u64 {
+        // a jittered box, its vertices renumbered and its tetrahedra shuffled and re-cornered
+        let base = TetMesh::jittered_box(6, 5, 4, [1.0, 0.7, 1.3], 0.05, seed);
+        let n = base.n_vertices();
+        let r = uniform(100 + seed, n + base.tets().len());
+        let mut order: Vec<usize> = (0..n).collect();
+        order.sort_by(|&a, &b| r[a].total_cmp(&r[b]));
+        let mut position = vec![[0.0; 3]; n];
+        for (new, &old) in order.iter().enumerate() {
+            position[new] = base.positions()[old];
+        }
+        let mut renamed = vec![0; n];
+        for (new, &old) in order.iter().enumerate() {
+            renamed[old] = new;
+        }
+        let mut tets: Vec<[usize; 4]> = base.tets().iter().map(|t| t.map(|v| renamed[v])).collect();
+        for (t, tet) in tets.iter_mut().enumerate() {
+            tet.rotate_left(t % 4);
+        }
+        let mesh = TetMesh::new(position, tets.clone()).unwrap();
+        let noise = uniform(seed, n);
+        let h: Vec<f64> = (0..n)
+            .map(|v| {
+                let level = (noise[v] * 4.0).floor();
+                if seed % 2 == 0 {
+                    level
+                } else {
+                    level + 0.3 * mesh.point(v)[0].round()
+                }
+            })
+            .collect();
+        for selection in
+            [Selection::Relative(0.05), Selection::Relative(0.3), Selection::Count { minima: 2, maxima: 2 }]
+        {
+            let settings = SmoothSettings { selection: selection.clone(), ..Default::default() };
+            let out = smooth(&mesh, &h, &settings).unwrap_or_else(|e| panic!("seed {seed}, {selection:?}: {e}"));
+            assert!(out.report.certificate.passed);
+            let (mins, maxs, flat) = tet_extrema(n, &tets, &out.output);
+            assert!(flat.is_empty(), "seed {seed}: flat vertices {flat:?}");
+            let kept = |r: Role| (0..n).filter(|&v| out.roles[v] == r).collect::<Vec<_>>();
+            assert_eq!(mins, kept(Role::Min), "seed {seed}, {selection:?}");
+            assert_eq!(maxs, kept(Role::Max), "seed {seed}, {selection:?}");
+            assert!(!mins.is_empty() && !maxs.is_empty());
+            for &v in mins.iter().chain(&maxs) {
+                assert_eq!(out.output[v].to_bits(), h[v].to_bits());
+            }
+            let gap = out.report.fit.gap_over_data.unwrap();
+            assert!(gap <= 1e-6, "seed {seed}, {selection:?}: gap {gap:e}");
+        }
+    }
+}
+
 /// The .vti or .npz output's arrays, read back by the crate's verify reader.
 fn stored(p: &Path) -> toposmooth::io::export::Stored {
     toposmooth::io::export::read_results(p).unwrap()
@@ -251,6 +334,35 @@ fn the_active_set_iteration_and_clarabel_smooth_a_noisy_volume_to_the_interior_p
     let rms =
         (active.output.iter().zip(&direct.output).map(|(a, b)| (a - b).powi(2)).sum::<f64>() / count as f64).sqrt();
     assert!(rms < 1e-3 * 2.0, "RMS difference {rms:e}");
+}
+
+#[test]
+fn the_default_solver_is_the_active_set_iteration_on_volumes_of_20000_voxels_and_more() {
+    use toposmooth::solve::{Method, ACTIVE_SET_FROM};
+    let field = |n: [usize; 3]| -> Vec<f64> {
+        let count: usize = n.iter().product();
+        let noise = uniform(3, count);
+        (0..count)
+            .map(|v| {
+                let (x, y, z) = ((v % n[0]) as f64, ((v / n[0]) % n[1]) as f64, (v / (n[0] * n[1])) as f64);
+                (0.4 * x).sin() * (0.3 * y).cos() + 0.2 * (0.5 * z).sin() + 0.05 * (noise[v] - 0.5)
+            })
+            .collect()
+    };
+    for (n, expected) in [([18, 15, 12], Method::Structured), ([28, 28, 26], Method::ActiveSet)] {
+        let count: usize = n.iter().product();
+        assert_eq!(count >= ACTIVE_SET_FROM, expected == Method::ActiveSet);
+        let g = Grid3d::with_geometry(n, [1.0; 3], [0.0; 3]).unwrap();
+        let settings = SmoothSettings { selection: Selection::Count { minima: 3, maxima: 3 }, ..Default::default() };
+        assert_eq!(settings.qp.method, Method::Auto);
+        let out = smooth(&g, &field(n), &settings).unwrap();
+        assert_eq!(out.report.solver, expected, "{n:?}: {:?}", out.report.solver_fallback);
+        assert!(out.report.certificate.passed);
+        let (mins, maxs, flat) = volume_extrema(n, &out.output);
+        assert_eq!((mins.len(), maxs.len(), flat.len()), (3, 3, 0), "{n:?}");
+        let gap = out.report.fit.gap_over_data.unwrap();
+        assert!(gap <= 1e-6, "{n:?}: gap {gap:e} × the data term");
+    }
 }
 
 #[test]

@@ -246,12 +246,13 @@ fn qp_settings(py: Python<'_>, d: &Bound<'_, PyDict>) -> PyResult<QpSettings> {
         "solver",
         get(py, d, "solver")?,
         &[
+            ("auto", Method::Auto),
             ("structured", Method::Structured),
             ("clarabel", Method::Clarabel),
             ("clarabel-auxiliary", Method::ClarabelAuxiliary),
             ("active-set", Method::ActiveSet),
         ],
-        Method::Structured,
+        Method::Auto,
     )?;
     let formulation = choice(
         py,

@@ -325,7 +325,7 @@ _SETTING_DEFAULTS: Dict[str, Any] = dict(
     edges="minimal",
     representative=None,
     max_iter=200,
-    solver="structured",
+    solver="auto",
     formulation="auto",
     threads=None,
 )
@@ -405,7 +405,7 @@ def smooth(
     representative: Optional[str] = None,
     fill_missing: bool = False,
     max_iter: int = 200,
-    solver: str = "structured",
+    solver: str = "auto",
     formulation: str = "auto",
     threads: Optional[int] = None,
 ) -> SmoothResult:
@@ -458,7 +458,9 @@ def smooth(
         the CLI's ``--fill-missing``; otherwise NaN is an :class:`InputError`.
     max_iter : int
         Largest number of solver iterations.
-    solver : {"structured", "clarabel", "clarabel-auxiliary", "active-set"}
+    solver : {"auto", "structured", "clarabel", "clarabel-auxiliary", "active-set"}
+        ``auto``: the active-set iteration on volumes of 20,000 voxels or more, else the
+        structured interior-point method.
     formulation : {"auto", "assembled", "factored"}
     threads : int, optional
         At most this many threads for the call (default 2). Results are bit-identical for

@@ -384,6 +384,7 @@ pub fn bench(args: &BenchArgs) -> Result<String> {
                 match args.method {
                     Method::Clarabel => "clarabel",
                     Method::ClarabelAuxiliary => "clarabel-auxiliary",
+                    Method::Auto => "auto",
                     Method::Structured => "structured",
                     Method::ActiveSet => "active-set",
                 },

@@ -191,7 +191,7 @@ enum Command {
         #[arg(long, default_value_t = 1)]
         seed: u64,
         /// QP solver.
-        #[arg(long, value_enum, default_value_t = Method::Structured)]
+        #[arg(long, value_enum, default_value_t = Method::Auto)]
         solver: Method,
         /// Representative function on grids and meshes (default: automatic).
         #[arg(long, value_enum)]
@@ -447,11 +447,11 @@ struct SmoothCli {
     /// Largest number of solver iterations (at least 1).
     #[arg(long, default_value_t = 200, value_parser = clap::value_parser!(u32).range(1..))]
     max_iter: u32,
-    /// QP solver: the structured interior-point method (Clarabel takes over if it fails),
-    /// Clarabel alone, or (experimental, volumes) the active-set iteration with conjugate
-    /// gradients, which factorises nothing and hands over to the structured solver when it does
-    /// not converge.
-    #[arg(long, value_enum, default_value_t = Method::Structured)]
+    /// QP solver: auto (the active-set iteration on volumes of 20,000 vertices or more, else
+    /// structured), the structured interior-point method (Clarabel takes over if it fails),
+    /// Clarabel alone, or the active-set iteration with conjugate gradients, which factorises
+    /// nothing and hands over to the structured solver when it does not converge.
+    #[arg(long, value_enum, default_value_t = Method::Auto)]
     solver: Method,
     /// How the energy enters the solver: assembled (normal equations in double precision),
     /// factored (FᵀF, the paper's auxiliary variables: double-double normal equations in the

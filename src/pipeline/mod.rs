@@ -21,7 +21,7 @@ use crate::error::{Error, Result};
 use crate::linalg::Analyses;
 use crate::operators::Sparse;
 use crate::progress::Stage;
-use crate::solve::{solve_monotone_qp_with, Bound, Method, MonotoneQp};
+use crate::solve::{solve_monotone_qp_with, Bound, Method, MonotoneQp, ACTIVE_SET_FROM};
 use crate::topology::morse_smale::MorseSmale;
 use crate::topology::{count_sos_extrema, select, Role};
 use crate::verify::certify;
@@ -123,6 +123,16 @@ pub(crate) fn smooth_on<D: Smoothable + Sync>(
         return Err(Error::input(format!("sharp vertex {v} is out of range (the input has {n} vertices)"))
             .at(crate::error::Location::Vertex(v)));
     }
+    let chosen;
+    let settings = match settings.qp.method {
+        Method::Auto => {
+            let method = if domain.solid() && n >= ACTIVE_SET_FROM { Method::ActiveSet } else { Method::Structured };
+            chosen =
+                SmoothSettings { qp: crate::solve::QpSettings { method, ..settings.qp.clone() }, ..settings.clone() };
+            &chosen
+        }
+        _ => settings,
+    };
     let mut seconds = StageSeconds::default();
 
     let stage = Stage::begin("selection");

@@ -1,12 +1,13 @@
 //! What a domain supplies to the pipeline: its operators and its representative function
 //! (the series' linear one, the surfaces' separatrix, harmonic and flooded constructions).
 
-use crate::domain::{Domain, Grid2d, Grid3d, Series, TriMesh};
+use crate::domain::{Domain, Grid2d, Grid3d, Series, TetMesh, TriMesh};
 use crate::error::{Error, Result};
 use crate::linalg::Analyses;
 use crate::operators::{
     cotan_stiffness, dirichlet_solve, edge_factor, gradient_factor, grid_mass, grid_stiffness, lumped_mass,
-    positive_cotan_stiffness, series_mass, series_stiffness, volume_mass, volume_stiffness, Factor, Sparse,
+    positive_cotan_stiffness, positive_tet_stiffness, series_mass, series_stiffness, tet_gradient_factor,
+    tet_lumped_mass, tet_stiffness, volume_mass, volume_stiffness, Factor, Sparse,
 };
 use crate::representative::{flooded_representative, separatrix_representative, series_representative, Repairs};
 use crate::topology::morse_smale::MorseSmale;
@@ -96,6 +97,11 @@ pub trait Smoothable: Domain {
     /// holds (the stiffness is that Laplacian where it already holds).
     fn own_fill_stiffness(&self) -> Option<Sparse> {
         None
+    }
+    /// A volume (tetrahedra): direct factorisations of its energies fill in as a 3D nested
+    /// dissection does, which sets [`Method::Auto`](crate::solve::Method::Auto)'s choice.
+    fn solid(&self) -> bool {
+        false
     }
     /// `F₁` with `F₁ᵀF₁ = k` (the stiffness): one row per edge of positive weight, or `None`
     /// when a weight is negative and the domain has no other square root.
@@ -390,11 +396,50 @@ impl Smoothable for Grid2d {
 /// The volume grid: the 7-point stencil (its weights are ≥ 0, so it is also the fills'
 /// Laplacian and has an edge factor) and the flooded or harmonic representative.
 impl Smoothable for Grid3d {
+    fn solid(&self) -> bool {
+        true
+    }
     fn stiffness(&self) -> Sparse {
         volume_stiffness(self)
     }
     fn mass(&self) -> Vec<f64> {
         volume_mass(self)
+    }
+    fn representative(
+        &self,
+        h: &[f64],
+        kept: &KeptSet,
+        choice: Option<RepresentativeChoice>,
+        fill: &Sparse,
+        excluded: &[(RepresentativeKind, String)],
+        analyses: &mut Analyses,
+    ) -> Result<Representative> {
+        surface_representative(self, h, kept, choice, fill, excluded, analyses, Cells::Tetrahedra)
+    }
+}
+
+/// Tetrahedral meshes: P1 elements (stiffness from the dihedral cotangents, lumped mass),
+/// the clamped positive-weight stiffness for harmonic fills, and the flooded or harmonic
+/// representative, as on the volume grid.
+impl Smoothable for TetMesh {
+    fn solid(&self) -> bool {
+        true
+    }
+    fn stiffness(&self) -> Sparse {
+        tet_stiffness(self.positions(), self.tets())
+    }
+    fn mass(&self) -> Vec<f64> {
+        tet_lumped_mass(self.positions(), self.tets())
+    }
+    /// Obtuse dihedral angles give negative edge weights, which break the maximum principle
+    /// of harmonic fills: [`positive_tet_stiffness`] clamps them.
+    fn own_fill_stiffness(&self) -> Option<Sparse> {
+        Some(positive_tet_stiffness(self.positions(), self.tets()))
+    }
+    /// One row per edge when every weight is ≥ 0, else the volume-weighted tetrahedron
+    /// gradients (three rows per tetrahedron).
+    fn stiffness_factor(&self, k: &Sparse) -> Option<Factor> {
+        edge_factor(k).or_else(|| Some(tet_gradient_factor(self.positions(), self.tets())))
     }
     fn representative(
         &self,

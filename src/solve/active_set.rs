@@ -2,19 +2,23 @@
 //! where one Cholesky factorisation of the normal matrix costs more than the whole run may
 //! (NOTES.md 6; docs/volumes.md, "Speed").
 //!
-//! The working set `S` holds rows taken as equalities, always a forest: a pair row joins two
-//! variables into one cluster (one value), a bound row fixes its variable's cluster at the
-//! bound. With `S` fixed the QP is unconstrained over the cluster values, `min ½ yᵀCᵀPCy +
-//! …`, solved by conjugate gradients preconditioned by the clusters' diagonal (one product
-//! with P per iteration, nothing factorised). The multipliers of the rows in `S` follow from
-//! stationarity alone: on a tree each row's multiplier is the gradient summed over the subtree
-//! it cuts off. Rows whose multiplier is negative leave `S` (the cluster splits), violated
-//! rows join it (merging two clusters, never closing a cycle), and the iteration stops when
-//! neither happens and the gap bound of [`super::optimality`] — `Σ s⁺z + ½ Σ ρ²/d` with
-//! the data term's diagonal `d` — is below the tolerance. Inside a cluster the values step
-//! by the margin along the tree's rows; a row that closes a cycle in a cluster may miss its
-//! margin by a few ε, which the caller's margin repair restores, and the certificate and the
-//! gap of the output as written decide.
+//! The working set `S` holds rows taken as equalities: a pair row joins two variables into
+//! one cluster (one value), a bound row fixes its variable's cluster at the bound. With `S`
+//! fixed the QP is unconstrained over the cluster values, `min ½ yᵀCᵀPCy + …`, solved by
+//! conjugate gradients preconditioned by the clusters' diagonal (one product with P per
+//! iteration, nothing factorised). The rows of `S` in a cluster form a spanning tree, and the
+//! multipliers follow from stationarity: on the tree each row's is the gradient summed over
+//! the subtree it cuts off. Where that gives a negative one, the cluster's multipliers are
+//! taken instead as a maximum flow over all its tight rows (a cluster's tight rows form
+//! cycles, and a tree's multipliers are one of many): if the flow carries the whole
+//! imbalance the multipliers are non-negative and the cluster stays; if not, the cluster
+//! splits along the minimum cut, the one split the gradient pulls apart. Violated rows
+//! within [`JOIN_SHARE`] of the worst join `S` (merging two clusters, never closing a
+//! cycle), and the iteration stops when nothing joins or leaves and the gap bound of
+//! [`super::optimality`] — `Σ s⁺z + ½ Σ ρ²/d` with the data term's diagonal `d` — is below
+//! the tolerance. Inside a cluster the values step by the margin along the tree's rows; a row
+//! that closes a cycle in a cluster may miss its margin by a few ε, which the caller's margin
+//! repair restores, and the certificate and the gap of the output as written decide.
 
 use super::flow::Network;
 use super::problem::ReducedQp;

@@ -114,7 +114,7 @@ pub fn solve_monotone_qp_with(
     };
     let (out, method) = match (attempt, settings.method) {
         (Some(out), _) => (out, Method::ActiveSet),
-        (None, Method::Structured | Method::ActiveSet) => {
+        (None, Method::Auto | Method::Structured | Method::ActiveSet) => {
             match super::ipm::solve(&reduced, hint.as_deref(), settings, analyses, prepared.take()) {
                 Ok(out) => (out, Method::Structured),
                 // the assembled normal matrix lost its definiteness (an energy without a data

@@ -6,6 +6,10 @@
 #[cfg_attr(feature = "serde", serde(rename_all = "lowercase"))]
 #[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 pub enum Method {
+    /// The active-set iteration on volumes of at least [`ACTIVE_SET_FROM`] vertices, the
+    /// structured solver elsewhere (chosen by the pipeline; the solver alone treats it as
+    /// structured).
+    Auto,
     /// The structured interior-point solver (normal equations, faer Cholesky with the
     /// symbolic analysis done once); Clarabel takes over if it does not converge.
     Structured,
@@ -17,8 +21,7 @@ pub enum Method {
     ClarabelAuxiliary,
     /// The active-set iteration with conjugate gradients: nothing factorised (volumes); needs
     /// a data term at every free entry. The structured solver takes over if it cannot run or
-    /// does not converge (experimental: converges on the 32³ bench volume, cycles from 48³ on;
-    /// docs/volumes.md, "Speed").
+    /// does not converge (docs/volumes.md, "Speed").
     #[cfg_attr(feature = "serde", serde(rename = "active-set"))]
     ActiveSet,
 }
@@ -47,6 +50,10 @@ pub enum Formulation {
 /// that is `10⁻¹⁴` of the data term, ample; at 10¹¹ it reaches the bound's target (10⁻⁷ of it).
 pub const FACTORED_ABOVE: f64 = 1e9;
 
+/// Vertices from which [`Method::Auto`] takes the active-set iteration on a volume, whose
+/// direct factorisation fills in as a 3D nested dissection does (measured: docs/volumes.md).
+pub const ACTIVE_SET_FROM: usize = 20_000;
+
 /// Solver settings.
 #[derive(Clone, Debug, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize))]
@@ -59,7 +66,7 @@ pub struct QpSettings {
     /// term (without a data term: of the objective's range, by the mean complementarity).
     /// {3e-7: a third of the target, 10⁻⁶, for what the output's rounding and the repair add}
     pub gap_tolerance: f64,
-    /// Solver. {structured}
+    /// Solver. {auto}
     pub method: Method,
     /// Formulation. {auto}
     pub formulation: Formulation,
@@ -71,7 +78,7 @@ impl Default for QpSettings {
             max_iter: 200,
             tolerance: 1e-9,
             gap_tolerance: 3e-7,
-            method: Method::Structured,
+            method: Method::Auto,
             formulation: Formulation::Auto,
         }
     }

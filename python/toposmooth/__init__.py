@@ -459,7 +459,7 @@ def smooth(
     max_iter : int
         Largest number of solver iterations.
     solver : {"auto", "structured", "clarabel", "clarabel-auxiliary", "active-set"}
-        ``auto``: the active-set iteration on volumes of 20,000 voxels or more, else the
+        ``auto``: the active-set iteration on volumes of 1,000 voxels or more, else the
         structured interior-point method.
     formulation : {"auto", "assembled", "factored"}
     threads : int, optional

@@ -4,7 +4,7 @@
 
 use crate::apps::skinning::Skinning;
 use crate::apps::weights::WeightMethod;
-use crate::commands::input::{Derive, DomainKind, GridOptions};
+use crate::commands::input::{Derive, DomainKind, GridOptions, MaskRule};
 use crate::commands::{self, BenchArgs, ExtremaArgs, SmoothArgs, VerifyArgs};
 use crate::constraints::EdgeSet;
 use crate::domain::{MAX_SPACING, MIN_SPACING};
@@ -239,6 +239,15 @@ struct GridCli {
     /// `--array x|y|z` takes a coordinate).
     #[arg(long, value_name = "FILE")]
     values: Option<PathBuf>,
+    /// Volume: smooth only the voxels where this point array of the input is non-zero (the
+    /// domain is the tetrahedra whose corners are all inside; the rest is written unchanged,
+    /// role 0, and the output's `mask` array says which voxels the domain holds).
+    #[arg(long, value_name = "ARRAY", conflicts_with = "mask_below")]
+    mask: Option<String>,
+    /// Volume: smooth only the voxels whose value is at least V (below V, and NaN, is
+    /// outside), as --mask does.
+    #[arg(long, value_name = "V", allow_negative_numbers = true)]
+    mask_below: Option<f64>,
 }
 
 impl GridCli {
@@ -272,6 +281,12 @@ impl GridCli {
             uv: self.u.clone().zip(self.v.clone()),
             fill_missing: self.fill_missing,
             values: self.values.clone(),
+            mask: match (&self.mask, self.mask_below) {
+                (Some(name), _) => Some(MaskRule::Array(name.clone())),
+                (None, Some(v)) if v.is_finite() => Some(MaskRule::Below(v)),
+                (None, Some(v)) => return Err(Error::setting("mask-below", format!("must be finite, got {v}"))),
+                (None, None) => None,
+            },
         })
     }
 }
@@ -447,7 +462,7 @@ struct SmoothCli {
     /// Largest number of solver iterations (at least 1).
     #[arg(long, default_value_t = 200, value_parser = clap::value_parser!(u32).range(1..))]
     max_iter: u32,
-    /// QP solver: auto (the active-set iteration on volumes of 20,000 vertices or more, else
+    /// QP solver: auto (the active-set iteration on volumes of 1,000 vertices or more, else
     /// structured), the structured interior-point method (Clarabel takes over if it fails),
     /// Clarabel alone, or the active-set iteration with conjugate gradients, which factorises
     /// nothing and hands over to the structured solver when it does not converge.

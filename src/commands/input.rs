@@ -88,6 +88,18 @@ pub struct GridOptions {
     pub fill_missing: bool,
     /// Meshes: one value per vertex from a text file (one per line) instead of an array.
     pub values: Option<PathBuf>,
+    /// Volumes: smooth only the voxels inside this mask.
+    pub mask: Option<MaskRule>,
+}
+
+/// Which voxels a mask holds inside.
+#[derive(Clone, Debug, PartialEq)]
+pub enum MaskRule {
+    /// Those where this array of the input file is non-zero (`--mask ARRAY`).
+    Array(String),
+    /// Those whose value is at least this (`--mask-below V`: below it is outside; NaN is
+    /// outside).
+    Below(f64),
 }
 
 /// A grid field ready to smooth.
@@ -126,6 +138,8 @@ pub struct VolumeInput {
     pub carried: Option<Carried>,
     /// What reading found worth saying (an oblique NIfTI affine).
     pub notes: Vec<String>,
+    /// The voxels inside `--mask` / `--mask-below`, when given.
+    pub mask: Option<Vec<bool>>,
 }
 
 /// A field on a triangle mesh, ready to smooth.
@@ -783,9 +797,23 @@ pub fn read_grid(path: &Path, opts: &GridOptions) -> Result<FieldInput> {
             (geometry, values, name, path.to_path_buf())
         }
     };
+    let inside = match (&opts.mask, &geometry) {
+        (None, _) => None,
+        (Some(_), Geometry::Flat(_)) => {
+            return Err(Error::Usage(format!(
+                "{}: --mask and --mask-below restrict volumes; on a 2D grid they are not implemented yet",
+                source.display()
+            )))
+        }
+        (Some(rule), Geometry::Volume(_)) => Some(mask_of(&source, rule, &values, carried.as_ref())?),
+    };
+    // NaN outside the mask is background, not missing data
+    let probe: Option<Vec<f64>> =
+        inside.as_ref().map(|m| values.iter().zip(m).map(|(&v, &i)| if i { v } else { 0.0 }).collect());
+    let checked = probe.as_deref().unwrap_or(&values);
     let missing = match &geometry {
-        Geometry::Flat(grid) => describe_missing(grid, &values, 5),
-        Geometry::Volume(grid) => describe_missing_in_volume(grid, &values, 5),
+        Geometry::Flat(grid) => describe_missing(grid, checked, 5),
+        Geometry::Volume(grid) => describe_missing_in_volume(grid, checked, 5),
     };
     let mut filled = None;
     if let Some(what) = missing {
@@ -801,22 +829,82 @@ pub fn read_grid(path: &Path, opts: &GridOptions) -> Result<FieldInput> {
                 Error::input(format!("{whose}; pass --fill-missing to fill them harmonically")).in_file(&source)
             );
         }
-        let mask: Vec<bool> = values.iter().map(|v| v.is_nan()).collect();
+        let background: Vec<bool> = match &inside {
+            Some(m) => values.iter().zip(m).map(|(v, &i)| v.is_nan() && !i).collect(),
+            None => vec![false; values.len()],
+        };
+        let mask: Vec<bool> = values.iter().zip(&background).map(|(v, &b)| v.is_nan() && !b).collect();
         match &geometry {
             Geometry::Flat(grid) => fill_missing(grid, &mut values),
             Geometry::Volume(grid) => fill_missing_with(&crate::operators::volume_stiffness(grid), &mut values),
         }
         .map_err(|e| e.in_file(&source))?;
+        for (v, &b) in values.iter_mut().zip(&background) {
+            if b {
+                *v = f64::NAN;
+            }
+        }
         filled = Some(mask);
     }
     Ok(match geometry {
         Geometry::Flat(grid) => {
             FieldInput::Grid(GridInput { grid, values, description, filled, path: source, carried, notes })
         }
-        Geometry::Volume(grid) => {
-            FieldInput::Volume(VolumeInput { grid, values, description, filled, path: source, carried, notes })
-        }
+        Geometry::Volume(grid) => FieldInput::Volume(VolumeInput {
+            grid,
+            values,
+            description,
+            filled,
+            path: source,
+            carried,
+            notes,
+            mask: inside,
+        }),
     })
+}
+
+/// The voxels inside a mask: where the named array of the file (a carried VTK array, or
+/// another array of the `.npz`) is non-zero, or where the field is at least the threshold.
+fn mask_of(path: &Path, rule: &MaskRule, values: &[f64], carried: Option<&Carried>) -> Result<Vec<bool>> {
+    let inside = match rule {
+        MaskRule::Below(t) => values.iter().map(|v| *v >= *t).collect(),
+        MaskRule::Array(name) => {
+            let array: Vec<f64> = match carried.and_then(|c| c.point.iter().find(|a| &a.name == name)) {
+                Some(a) if a.components == 1 => a.values.clone(),
+                Some(a) => {
+                    return Err(Error::input(format!(
+                        "the mask array `{name}` has {} components; a mask is one value per voxel",
+                        a.components
+                    ))
+                    .in_file(path))
+                }
+                None if extension(path) == "npz" => match read_numpy(path, Some(name), Wanted::Grid)? {
+                    NumpyField::Volume { values, .. } => values,
+                    _ => return Err(Error::input(format!("the mask array `{name}` is not a volume")).in_file(path)),
+                },
+                None => {
+                    let found = carried
+                        .map(|c| c.point.iter().map(|a| format!("`{}`", a.name)).collect::<Vec<_>>().join(", "))
+                        .filter(|t| !t.is_empty())
+                        .unwrap_or_else(|| "no other arrays".into());
+                    return Err(Error::input(format!(
+                        "no point array `{name}` for --mask (the file holds {found}; --mask-below V masks by value)"
+                    ))
+                    .in_file(path));
+                }
+            };
+            if array.len() != values.len() {
+                return Err(Error::input(format!(
+                    "the mask array `{name}` has {} values, the volume {} voxels",
+                    array.len(),
+                    values.len()
+                ))
+                .in_file(path));
+            }
+            array.iter().map(|&m| m != 0.0 && !m.is_nan()).collect()
+        }
+    };
+    Ok(inside)
 }
 
 /// The first few missing samples of a volume as `(i, j, k)` text.
@@ -894,6 +982,8 @@ pub struct Field {
     pub axis: Option<SeriesAxis>,
     /// What the input carries besides the field, for VTK outputs.
     pub carried: Option<Carried>,
+    /// Volumes: the voxels inside `--mask` / `--mask-below`, when given.
+    pub mask: Option<Vec<bool>>,
 }
 
 impl FieldInput {
@@ -905,6 +995,7 @@ impl FieldInput {
         use crate::domain::{AnyDomain, Series};
         Ok(match self {
             FieldInput::Series(SeriesInput { data, filled }) => Field {
+                mask: None,
                 domain: AnyDomain::Series(Series::with_coordinates(data.x.clone()).map_err(|e| e.in_file(path))?),
                 values: data.values,
                 path: if path.as_os_str() == "-" { PathBuf::from("standard input") } else { path.to_path_buf() },
@@ -915,6 +1006,7 @@ impl FieldInput {
                 carried: None,
             },
             FieldInput::Grid(g) => Field {
+                mask: None,
                 domain: AnyDomain::Grid(g.grid),
                 values: g.values,
                 path: g.path,
@@ -925,6 +1017,7 @@ impl FieldInput {
                 carried: g.carried,
             },
             FieldInput::Volume(v) => Field {
+                mask: v.mask,
                 domain: AnyDomain::Volume(v.grid),
                 values: v.values,
                 path: v.path,
@@ -935,6 +1028,7 @@ impl FieldInput {
                 carried: v.carried,
             },
             FieldInput::Mesh(m) => Field {
+                mask: None,
                 domain: AnyDomain::Mesh(m.mesh),
                 values: m.values,
                 path: m.path,

@@ -115,7 +115,7 @@ pub(super) fn smooth_shared(args: &SmoothArgs, shared: Option<&mut Option<Shared
         crate::io::ttk::check_diagram_output(d)?;
     }
     let start = Instant::now();
-    let field = read_field(args.input.as_deref(), args.kind, &args.csv, &args.grid)?.into_field(&input_path)?;
+    let mut field = read_field(args.input.as_deref(), args.kind, &args.csv, &args.grid)?.into_field(&input_path)?;
     if let Some(c) = &args.complex {
         check_complex_output(c, &field.domain)?;
     }
@@ -141,9 +141,19 @@ pub(super) fn smooth_shared(args: &SmoothArgs, shared: Option<&mut Option<Shared
     let filled_samples: Vec<usize> =
         field.filled.as_ref().map(|m| (0..m.len()).filter(|&i| m[i]).collect()).unwrap_or_default();
     check_explicit_not_filled(&field, &args.settings.selection, &filled_samples)?;
-    let result = match shared {
-        None => smooth_any(&field.domain, &field.values, &args.settings),
-        Some(slot) => {
+    let masked = match (&field.mask, &field.domain) {
+        (Some(inside), AnyDomain::Volume(g)) => {
+            let m = crate::domain::MaskedVolume::new(g, inside).map_err(|e| e.in_file(&field.path))?;
+            super::progress::line(&m.describe());
+            field.notes.push(m.describe());
+            Some(m)
+        }
+        _ => None,
+    };
+    let result = match (shared, &masked) {
+        (_, Some(m)) => crate::pipeline::smooth_masked(m, &field.values, &args.settings),
+        (None, None) => smooth_any(&field.domain, &field.values, &args.settings),
+        (Some(slot), None) => {
             if !slot.as_ref().is_some_and(|s| same_domain(&s.domain, &field.domain)) {
                 let smoother = AnySmoother::new(field.domain.clone(), args.settings.clone())
                     .map_err(|e| e.in_file(&field.path))?;
@@ -173,6 +183,7 @@ pub(super) fn smooth_shared(args: &SmoothArgs, shared: Option<&mut Option<Shared
         filled: field.filled.as_deref(),
         carried: field.carried.as_ref(),
         output_array: args.output_array.as_deref(),
+        mask: masked.as_ref().map(|m| m.used()),
     };
     let x_axis = field.axis.as_ref().map(|a| (a.x_name.as_str(), a.x_text.as_slice()));
     let output = stage_results(&args.output, &field.domain, x_axis, &results)?;

@@ -100,11 +100,36 @@ fn verify_results(args: &VerifyArgs, out: Stored) -> Result<String> {
     if !out.roles.contains(&Role::Min) || !out.roles.contains(&Role::Max) {
         problems.push("the role array keeps no minimum or no maximum".into());
     }
-    let cert = certify_any(d, &out.smoothed, &out.roles, Some(&out.input));
+    let (cert, ucert, within) = match (&out.mask, d) {
+        // a masked volume: the domain is the mask's tetrahedra, the rest written unchanged
+        (Some(mask), AnyDomain::Volume(g)) => {
+            let m = crate::domain::MaskedVolume::new(g, mask).map_err(|e| e.in_file(&args.file))?;
+            let unchanged = |v: usize| {
+                out.roles[v] == Role::Other
+                    && out.smoothed[v].to_bits() == out.input[v].to_bits()
+                    && out.representative[v].to_bits() == out.input[v].to_bits()
+            };
+            if let Some(v) = (0..n).find(|&v| !m.used()[v] && !unchanged(v)) {
+                problems.push(format!(
+                    "{} lies outside the mask's domain but is not written unchanged with role 0",
+                    d.describe_vertex(v)
+                ));
+            }
+            let roles = m.restrict(&out.roles);
+            let cert =
+                crate::verify::certify(m.mesh(), &m.restrict(&out.smoothed), &roles, Some(&m.restrict(&out.input)));
+            let ucert = crate::verify::certify(m.mesh(), &m.restrict(&out.representative), &roles, None);
+            (cert, ucert, format!(" inside a mask of {} voxels", m.voxels().len()))
+        }
+        _ => (
+            certify_any(d, &out.smoothed, &out.roles, Some(&out.input)),
+            certify_any(d, &out.representative, &out.roles, None),
+            String::new(),
+        ),
+    };
     if !cert.passed {
         problems.push(format!("smoothed: {}", cert.summary()));
     }
-    let ucert = certify_any(d, &out.representative, &out.roles, None);
     if !ucert.passed {
         problems.push(format!("representative: {}", ucert.summary()));
     }
@@ -114,7 +139,7 @@ fn verify_results(args: &VerifyArgs, out: Stored) -> Result<String> {
     let kmin = out.roles.iter().filter(|&&r| r == Role::Min).count();
     let kmax = out.roles.iter().filter(|&&r| r == Role::Max).count();
     Ok(format!(
-        "{}: {} ({}, {kmin} minima and {kmax} maxima kept at their input values, representative consistent{})\n",
+        "{}: {} ({}{within}, {kmin} minima and {kmax} maxima kept at their input values, representative consistent{})\n",
         args.file.display(),
         cert.summary(),
         d.describe(),

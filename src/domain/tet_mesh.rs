@@ -68,7 +68,19 @@ impl TetMesh {
     /// position, a triangle on more than two tetrahedra, an edge whose tetrahedra form more
     /// than one fan, a vertex whose tetrahedra are not connected through shared triangles or
     /// do not form a ball (a half-ball at the boundary).
-    pub fn new(positions: Vec<[f64; 3]>, mut tets: Vec<[usize; 4]>) -> Result<TetMesh> {
+    pub fn new(positions: Vec<[f64; 3]>, tets: Vec<[usize; 4]>) -> Result<TetMesh> {
+        TetMesh::build(positions, tets, true)
+    }
+
+    /// A tetrahedral complex: validated as [`TetMesh::new`] does except that edges and
+    /// vertices may be non-manifold (tetrahedra meeting only at an edge or a vertex), as the
+    /// tetrahedra of a masked volume do. Neighbours, operators, persistence and the
+    /// certificate need no manifold; the boundary triangles are those on one tetrahedron.
+    pub(crate) fn complex(positions: Vec<[f64; 3]>, tets: Vec<[usize; 4]>) -> Result<TetMesh> {
+        TetMesh::build(positions, tets, false)
+    }
+
+    fn build(positions: Vec<[f64; 3]>, mut tets: Vec<[usize; 4]>, manifold: bool) -> Result<TetMesh> {
         let n = positions.len();
         let diameter = validate::check_elements(&positions, &tets)?;
         // orient first: the tables below only see vertex sets, the boundary faces need corners
@@ -85,7 +97,9 @@ impl TetMesh {
         }
         let faces = validate::face_table(n, &tets)?;
         let edges = validate::edge_table(n, &tets);
-        validate::check_fans(n, &tets, &faces, &edges)?;
+        if manifold {
+            validate::check_fans(n, &tets, &faces, &edges)?;
+        }
         let mut repairs = Vec::new();
         if let Some(&first) = inverted.first() {
             let (count, noun) = (inverted.len(), if inverted.len() == 1 { "tetrahedron" } else { "tetrahedra" });

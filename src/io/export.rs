@@ -143,7 +143,7 @@ pub struct Carried {
 }
 
 /// The names the tool's own arrays take in a VTK output.
-const OWN_ARRAYS: [&str; 5] = ["input", "smoothed", "representative", "role", "filled"];
+const OWN_ARRAYS: [&str; 6] = ["input", "smoothed", "representative", "role", "filled", "mask"];
 
 /// The point arrays of a VTK output: the smoothed field under the input array's name (or
 /// `output_array`) first, as the active scalars, then `smoothed`, `input`, `representative`,
@@ -222,6 +222,9 @@ pub struct Results<'a> {
     /// The name of the smoothed field in VTK outputs (`--output-array`), instead of the input
     /// array's.
     pub output_array: Option<&'a str>,
+    /// Volumes smoothed inside a mask: the voxels the domain holds (written as `mask`, 1
+    /// inside, so that `verify` rebuilds the domain).
+    pub mask: Option<&'a [bool]>,
 }
 
 /// Stages a smoothing result at `path` in the format its extension names: a series as
@@ -245,6 +248,10 @@ pub fn stage_results(
         vec![("input", r.input), ("smoothed", r.smoothed), ("representative", r.representative), ("role", &roles)];
     if let Some(f) = &filled {
         arrays.push(("filled", f));
+    }
+    let mask: Option<Vec<f64>> = r.mask.map(|m| m.iter().map(|&b| f64::from(u8::from(b))).collect());
+    if let Some(m) = &mask {
+        arrays.push(("mask", m));
     }
     match domain {
         AnyDomain::Series(s) => {
@@ -595,6 +602,8 @@ pub struct Stored {
     pub roles: Vec<Role>,
     /// Series: the samples the `filled` column marks, when it has one.
     pub filled: Option<Vec<bool>>,
+    /// Volumes smoothed inside a mask: the voxels of the domain (the `mask` array, non-zero).
+    pub mask: Option<Vec<bool>>,
 }
 
 /// Reads a result that [`stage_results`] wrote: `.vti`, `.npz`, a mesh (`.vtu`, `.vtp`,
@@ -663,6 +672,7 @@ pub fn read_results(path: &Path) -> Result<Stored> {
                 representative: out.u,
                 roles: out.roles,
                 filled: out.filled,
+                mask: None,
             })
         }
     }
@@ -708,6 +718,17 @@ fn stored(path: &Path, domain: AnyDomain, names: Vec<String>, mut arrays: Vec<(S
     };
     let (input, smoothed, representative, role) =
         (take("input")?, take("smoothed")?, take("representative")?, take("role")?);
+    let mask = match arrays.iter().position(|(n, _)| n == "mask") {
+        Some(i) if matches!(domain, AnyDomain::Volume(_)) => {
+            let m = arrays.swap_remove(i).1;
+            if m.len() != role.len() {
+                return Err(Error::input(format!("the `mask` array has {} values for {} voxels", m.len(), role.len()))
+                    .in_file(path));
+            }
+            Some(m.iter().map(|&x| x != 0.0 && !x.is_nan()).collect())
+        }
+        _ => None,
+    };
     let roles = role
         .iter()
         .enumerate()
@@ -718,7 +739,7 @@ fn stored(path: &Path, domain: AnyDomain, names: Vec<String>, mut arrays: Vec<(S
             })
         })
         .collect::<Result<Vec<Role>>>()?;
-    Ok(Stored { domain, input, smoothed, representative, roles, filled: None })
+    Ok(Stored { domain, input, smoothed, representative, roles, filled: None, mask })
 }
 
 #[cfg(test)]
@@ -783,6 +804,7 @@ mod tests {
             filled: None,
             carried: None,
             output_array: None,
+            mask: None,
         };
         for ext in ["vti", "npz"] {
             let path = dir.join(format!("r.{ext}"));

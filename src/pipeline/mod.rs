@@ -16,7 +16,7 @@ mod settings;
 mod smoothable;
 mod stages;
 
-use crate::domain::Domain;
+use crate::domain::{Domain, MaskedVolume};
 use crate::error::{Error, Result};
 use crate::linalg::Analyses;
 use crate::operators::Sparse;
@@ -86,6 +86,59 @@ pub fn smooth<D: Smoothable + Sync>(domain: &D, h: &[f64], settings: &SmoothSett
 /// As [`smooth`].
 pub fn smooth_any(domain: &crate::domain::AnyDomain, h: &[f64], settings: &SmoothSettings) -> Result<Smoothed> {
     crate::with_domain!(domain, d => smooth(d, h, settings))
+}
+
+/// The fit's target (Ĝ ≤ 10⁻⁶ × the data term) that an active-set output must meet as
+/// written, else the structured solver runs instead.
+const ACTIVE_SET_FIT: f64 = 1e-6;
+
+/// [`smooth`] on a volume restricted to a mask: the pipeline runs on the
+/// [`MaskedVolume`]'s tetrahedra and its outputs come back on the whole grid, the outside
+/// (and inside voxels on no inside tetrahedron) unchanged with role [`Role::Other`]. Explicit
+/// kept voxels and sharp vertices are grid indices, as are the report's kept extrema; the
+/// fit and the active fraction are the domain's.
+///
+/// # Errors
+/// As [`smooth`]; an explicit kept voxel or sharp vertex outside the domain is an input
+/// error naming it.
+pub fn smooth_masked(masked: &MaskedVolume, h: &[f64], settings: &SmoothSettings) -> Result<Smoothed> {
+    let n = masked.grid().n_vertices();
+    if h.len() != n {
+        return Err(Error::input(format!("the field has {} values, the volume {n} voxels", h.len())));
+    }
+    let mut vertex = vec![usize::MAX; n];
+    for (i, &v) in masked.voxels().iter().enumerate() {
+        vertex[v] = i;
+    }
+    let inner = |list: &[usize], what: &str| -> Result<Vec<usize>> {
+        list.iter()
+            .map(|&v| match vertex.get(v) {
+                Some(&i) if i != usize::MAX => Ok(i),
+                Some(_) => {
+                    let [a, b, c] = masked.grid().ijk(v);
+                    Err(Error::input(format!("{what} {v} (i {a}, j {b}, k {c}) lies outside the mask's domain"))
+                        .at(crate::error::Location::Vertex(v)))
+                }
+                None => Err(Error::input(format!("{what} {v} is out of range (the volume has {n} voxels)"))),
+            })
+            .collect()
+    };
+    let mut local = settings.clone();
+    if let crate::topology::Selection::Explicit { minima, maxima } = &settings.selection {
+        local.selection = crate::topology::Selection::Explicit {
+            minima: inner(minima, "kept minimum")?,
+            maxima: inner(maxima, "kept maximum")?,
+        };
+    }
+    local.energy.sharp = inner(&settings.energy.sharp, "sharp vertex")?;
+    let mut out = smooth(masked.mesh(), &masked.restrict(h), &local)?;
+    out.output = masked.extend(&out.output, h);
+    out.u = masked.extend(&out.u, h);
+    out.roles = masked.extend(&out.roles, &vec![Role::Other; n]);
+    for k in &mut out.report.kept {
+        k.index = masked.voxels()[k.index];
+    }
+    Ok(out)
 }
 
 /// [`smooth`] with the harmonic fills' analysis taken from `analyses` (made, for instance, by
@@ -225,6 +278,27 @@ pub(crate) fn smooth_on<D: Smoothable + Sync>(
         diameter: domain.diameter(),
     };
     let report = run.report(seconds, certificate);
+    // the active-set point is checked as written, after the margin repair: one further from
+    // the optimum than the fit's target is solved again by the interior-point method
+    if sol.method == Method::ActiveSet && report.fit.gap_over_data.is_some_and(|g| g > ACTIVE_SET_FIT) {
+        let why = format!(
+            "the active-set output, after the margin repair moved {} vertices by up to {:.1e}, was {:.1e} × the data term from the optimum",
+            report.margin_repair.changed_vertices,
+            report.margin_repair.max_change,
+            report.fit.gap_over_data.unwrap_or(f64::NAN)
+        );
+        let structured = SmoothSettings {
+            qp: crate::solve::QpSettings { method: Method::Structured, ..settings.qp.clone() },
+            ..settings.clone()
+        };
+        ops.own_fill = domain.own_fill_stiffness();
+        let mut again = smooth_on(domain, ops, h, &structured, analyses, keep_analyses)?;
+        again.report.solver_fallback = Some(match again.report.solver_fallback.take() {
+            Some(more) => format!("{why}; {more}"),
+            None => why,
+        });
+        return Ok(again);
+    }
     let Ordered { u, complex, .. } = ordered;
     Ok(Smoothed { output: f, u, roles: kept.roles, report, complex })
 }

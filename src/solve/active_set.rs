@@ -33,6 +33,16 @@ const MAX_CG: usize = 5000;
 /// A row joins the working set when violated by more than this (unit values; the margin
 /// repair closes smaller violations).
 const ADD_ABOVE: f64 = 1e-10;
+/// The iteration ends as stalled when the same working-set size, violated count and number
+/// of changes come back this many times within [`CYCLE_WINDOW`] outer iterations.
+const CYCLE_REPEATS: usize = 4;
+/// See [`CYCLE_REPEATS`].
+const CYCLE_WINDOW: usize = 20;
+/// The iteration ends as stalled, not solved, when rows stay violated by more than this
+/// many margins with nothing left to change. Smaller ones the margin repair closes, moving
+/// vertices by at most the violation, and the pipeline checks the gap of the output as
+/// written (the structured solver runs when it misses the fit's target).
+const STUCK_SHARE: f64 = 4.0;
 /// Violated rows join the working set when violated by at least this share of the worst
 /// violation: the others are mostly relieved by the same solve (joining every violated row
 /// merges clusters the next solve splits again: at 48³ 88 outer and 8,696 conjugate-gradient
@@ -732,6 +742,12 @@ pub(super) fn solve(
     let mut cg_iterations = 0;
     let mut status = SolveStatus::MaxIterations;
     let mut outer = 0;
+    let mut history: Vec<(usize, usize, usize)> = Vec::new();
+    let margin = rows.iter().map(|r| if let Row::Pair(_, _, b) = *r { -b } else { 0.0 }).fold(0.0, f64::max);
+    let stuck_above = (STUCK_SHARE * margin).max(ADD_ABOVE);
+    // rows that once joined two anchored clusters (an anchor left for them): not again, as
+    // the next cut tends to undo it
+    let mut tabu = vec![false; rows.len()];
     while outer < MAX_OUTER {
         outer += 1;
         let t0 = std::time::Instant::now();
@@ -798,12 +814,20 @@ pub(super) fn solve(
         // a cluster's tree changes by one swap per iteration at most
         let mut swapped = vec![false; nc];
         let mut swaps = 0usize;
-        for &(_, k) in &violated[..joining] {
+        let mut stuck = [0usize; 5];
+        // the rows within the share of the worst; the rest too when none of those could join
+        let mut joined_any = false;
+        for (rank, &(_, k)) in violated.iter().enumerate() {
+            if rank >= joining && (joined_any || changed > 0) {
+                break;
+            }
+            let before = changed;
             match rows[k] {
                 Row::Pair(i, j, _) if cl.label[i] == cl.label[j] => {
                     // a cycle in one cluster: the row replaces a tree row on its path
                     let c = cl.label[i] as usize;
                     if swapped[c] {
+                        stuck[0] += 1;
                         continue;
                     }
                     if let Some(out) = forest.rising_row_on_path(&rows, &z, i, j) {
@@ -812,15 +836,41 @@ pub(super) fn solve(
                         in_set[k] = true;
                         swaps += 1;
                         changed += 1;
+                    } else {
+                        stuck[1] += 1;
                     }
                 }
                 Row::Pair(i, j, _) => {
-                    let (a, b) = (find(&mut parent, cl.label[i]), find(&mut parent, cl.label[j]));
+                    let (ci, cj) = (cl.label[i], cl.label[j]);
+                    let (a, b) = (find(&mut parent, ci), find(&mut parent, cj));
                     if a != b && !(anchored[a as usize] && anchored[b as usize]) {
                         parent[a as usize] = b;
                         anchored[b as usize] |= anchored[a as usize];
                         in_set[k] = true;
                         changed += 1;
+                    } else if a != b
+                        && !tabu[k]
+                        && (a, b) == (ci, cj)
+                        && !swapped[ci as usize]
+                        && !swapped[cj as usize]
+                        && anchor_row[ci as usize] != usize::MAX
+                        && anchor_row[cj as usize] != usize::MAX
+                    {
+                        // two clusters on their bounds that the row pulls together: one
+                        // leaves its bound (the one holding it less), the row joins them
+                        let (ri, rj) = (anchor_row[ci as usize], anchor_row[cj as usize]);
+                        let out = if z[ri] <= z[rj] { ri } else { rj };
+                        in_set[out] = false;
+                        z[out] = 0.0;
+                        in_set[k] = true;
+                        tabu[k] = true;
+                        parent[a as usize] = b;
+                        swapped[ci as usize] = true;
+                        swapped[cj as usize] = true;
+                        swaps += 1;
+                        changed += 2;
+                    } else {
+                        stuck[if a == b { 2 } else { 3 }] += 1;
                     }
                 }
                 Row::Bound(v, _, _) => {
@@ -838,15 +888,18 @@ pub(super) fn solve(
                         in_set[k] = true;
                         swaps += 1;
                         changed += 1;
+                    } else {
+                        stuck[4] += 1;
                     }
                 }
             }
+            joined_any |= changed > before;
         }
         let gap = gap_bound(&rows, &x, &z, &g, &r.d);
         let t5 = std::time::Instant::now();
         if std::env::var_os("TOPOSMOOTH_TRACE_ACTIVE").is_some() {
             eprintln!(
-                "active set {outer}: {} rows in, {changed} changed ({swaps} swaps, {drops} cut), {} violated (worst {worst:.1e}), gap/data {:.1e}, cg {cg_iterations}; ms clusters {} cg {} multipliers {} flow {} join {}",
+                "active set {outer}: {} rows in, {changed} changed ({swaps} swaps, {drops} cut), {} violated (worst {worst:.1e}, stuck {stuck:?} above {stuck_above:.1e}), gap/data {:.1e}, cg {cg_iterations}; ms clusters {} cg {} multipliers {} flow {} join {}",
                 in_set.iter().filter(|&&s| s).count(),
                 violated.len(),
                 gap / data,
@@ -857,7 +910,19 @@ pub(super) fn solve(
                 (t5 - t4).as_millis()
             );
         }
+        // a working set that keeps coming back (a swap undone by the next cut) is a cycle
+        let state = (in_set.iter().filter(|&&s| s).count(), violated.len(), changed);
+        history.push(state);
+        if history.iter().rev().take(CYCLE_WINDOW).filter(|&&h| h == state).count() >= CYCLE_REPEATS {
+            status = SolveStatus::Stalled;
+            break;
+        }
         if changed == 0 {
+            // every violated row is stuck where nothing else changed: not a solution
+            if worst > stuck_above {
+                status = SolveStatus::Stalled;
+                break;
+            }
             if gap <= target {
                 status = SolveStatus::Solved;
                 break;

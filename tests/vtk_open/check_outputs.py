@@ -264,6 +264,34 @@ if run("smooth", vin, "--array", "density", "--persistence", "10%", "-o", nout):
         fail(nout, f"spacing {nimg.GetSpacing()}")
     else:
         print("ok volume .nii.gz: vtkNIFTIImageReader reads the smoothed field bit for bit")
+# the same volume with a uint8 mask array (VTK's own writer): smoothed inside the mask only,
+# the output read by vtkXMLImageDataReader with the outside unchanged and the domain's mask
+brain = ((i - 4.0) ** 2 + (j - 3.5) ** 2 + ((k - 3.0) * 1.2) ** 2 < 12.0).astype(np.uint8)
+m_arr = _to_vtk(brain.ravel(), deep=True, array_type=vtk.VTK_UNSIGNED_CHAR)
+m_arr.SetName("brain")
+vol.GetPointData().AddArray(m_arr)
+min_ = os.path.join(WORK, "volume_masked_in.vti")
+w = vtk.vtkXMLImageDataWriter()
+w.SetInputData(vol)
+w.SetFileName(min_)
+w.Write()
+mout = os.path.join(WORK, "volume_masked_out.vti")
+if run("smooth", min_, "--array", "density", "--mask", "brain", "--persistence", "10%", "-o", mout):
+    check_smoothed(min_, mout, "density")
+    res, _ = read(mout)
+    pd = res.GetPointData()
+    dom = vtk_to_numpy(pd.GetArray("mask"))
+    sm, inp = vtk_to_numpy(pd.GetArray("smoothed")), vtk_to_numpy(pd.GetArray("input"))
+    roles = vtk_to_numpy(pd.GetArray("role"))
+    inside = brain.ravel() != 0
+    if dom is None or not np.all(dom[~inside] == 0) or dom.sum() < 0.5 * inside.sum():
+        fail(mout, "the mask array is not the domain inside the brain mask")
+    elif not (np.array_equal(sm[dom == 0], inp[dom == 0]) and np.all(roles[dom == 0] == 0)):
+        fail(mout, "voxels outside the mask changed")
+    elif np.array_equal(sm[dom == 1], inp[dom == 1]):
+        fail(mout, "nothing inside the mask was smoothed")
+    else:
+        print(f"ok masked volume .vti: {int(dom.sum())} of {dom.size} voxels smoothed, the rest unchanged")
 # the bundled real MRI volume (written by VTK's XML writer with its defaults)
 t1 = os.path.join(DATASETS, "mri_anatomical_33x41x25.vti")
 t1_out = os.path.join(WORK, "t1_out.vti")

@@ -47,7 +47,9 @@ pub use domain::{AnyDomain, Domain, Grid2d, Series, TriMesh};
 pub use error::{ConstructionError, Error, ErrorKind, Location, NumericalError, Result};
 pub use linalg::Analyses;
 pub use operators::Energy;
-pub use pipeline::{smooth, smooth_any, smooth_masked, Report, RepresentativeChoice, SmoothSettings, Smoothed};
+pub use pipeline::{
+    smooth, smooth_any, smooth_masked, smooth_masked_grid, Report, RepresentativeChoice, SmoothSettings, Smoothed,
+};
 pub use smoother::{AnySmoother, Smoother};
 pub use solve::{Formulation, Method, QpSettings};
 pub use topology::{Role, Selection};

@@ -557,3 +557,79 @@ fn a_masked_volume_is_smoothed_inside_its_tetrahedra_and_verified_and_nan_backgr
     assert_eq!(o.status.code(), Some(3));
     assert!(text(&o).contains("no tetrahedron"), "{}", text(&o));
 }
+
+#[test]
+fn the_split_differs_from_ttk_s_mirror_split_on_a_known_case() {
+    // docs/volumes.md: TTK's implicit triangulation is SPEC's split mirrored in x. On a 2 × 2 × 2
+    // volume whose lower slice has its two low values on the (+,+) diagonal, SPEC's split joins
+    // them (one minimum) where the mirror split does not (two minima).
+    let n = [2, 2, 2];
+    let f = vec![0.0, 1.0, 1.1, 0.1, 2.0, 2.1, 2.2, 2.3];
+    let (mins, maxs, flat) = volume_extrema(n, &f);
+    assert_eq!((mins, maxs, flat), (vec![0], vec![7], vec![]));
+    let g = Grid3d::with_geometry(n, [1.0; 3], [0.0; 3]).unwrap();
+    assert_eq!(toposmooth::topology::count_sos_extrema(&g, &f), (1, 1));
+    // the mirror split on f is SPEC's split on f mirrored in x
+    let mirrored: Vec<f64> = (0..8).map(|v| f[v ^ 1]).collect();
+    let (mins, _, _) = volume_extrema(n, &mirrored);
+    // voxels 1 and 2 of the mirrored field are 0 and 3 of the file
+    assert_eq!(mins, vec![1, 2]);
+    assert_eq!(toposmooth::topology::count_sos_extrema(&g, &mirrored).0, 2);
+}
+
+#[test]
+fn a_masked_2d_grid_is_smoothed_on_its_triangles_without_pinch_points_and_verified() {
+    let dir = scratch("grid-mask");
+    // a noisy wave on a disk of NaN background
+    let (nx, ny) = (24, 20);
+    let noise = uniform(11, nx * ny);
+    let mut values = vec![f64::NAN; nx * ny];
+    for r in 0..ny {
+        for c in 0..nx {
+            let (x, y) = (c as f64 - 9.0, r as f64 - 9.5);
+            if x * x + y * y < 64.0 {
+                values[r * nx + c] = (x * 0.5).sin() * (y * 0.4).cos() + 0.2 * noise[r * nx + c];
+            }
+        }
+    }
+    let input = dir.join("disk.vti");
+    ascii_vti(&input, &format!("0 {} 0 {} 0 0", nx - 1, ny - 1), "1 1 1", &values);
+    let out = dir.join("disk_out.vti");
+    let o = succeeds(&["smooth", input.to_str().unwrap(), "--mask-below", "-10", "-o", out.to_str().unwrap()]);
+    assert!(text(&o).contains("mask: ") && text(&o).contains("certified"), "{}", text(&o));
+    let s = stored(&out);
+    let used = s.mask.clone().expect("a mask array");
+    assert_eq!(used, values.iter().map(|v| !v.is_nan()).collect::<Vec<_>>(), "a disk has no specks or pinches");
+    // SPEC's grid triangles with every corner used, written here
+    let mut tris = Vec::new();
+    for r in 0..ny - 1 {
+        for c in 0..nx - 1 {
+            let (a, b, d, e) = (r * nx + c, r * nx + c + 1, (r + 1) * nx + c, (r + 1) * nx + c + 1);
+            for t in [[a, b, e], [a, e, d]] {
+                if t.iter().all(|&v| used[v]) {
+                    tris.push(t);
+                }
+            }
+        }
+    }
+    // every pixel the mask array marks lies on a triangle of the domain
+    for v in (0..nx * ny).filter(|&v| used[v]) {
+        let fan: Vec<&[usize; 3]> = tris.iter().filter(|t| t.contains(&v)).collect();
+        assert!(!fan.is_empty(), "used pixel {v} on no triangle");
+    }
+    let voxels: Vec<usize> = (0..nx * ny).filter(|&v| used[v]).collect();
+    let mut local = vec![usize::MAX; nx * ny];
+    voxels.iter().enumerate().for_each(|(i, &v)| local[v] = i);
+    let ltris: Vec<[usize; 3]> = tris.iter().map(|t| t.map(|v| local[v])).collect();
+    let f: Vec<f64> = voxels.iter().map(|&v| s.smoothed[v]).collect();
+    let (mins, maxs, flat) = common::mesh_extrema(voxels.len(), &ltris, &f);
+    assert!(flat.is_empty());
+    let kept =
+        |r: Role| voxels.iter().enumerate().filter(|(_, &v)| s.roles[v] == r).map(|(i, _)| i).collect::<Vec<_>>();
+    assert_eq!((mins, maxs), (kept(Role::Min), kept(Role::Max)));
+    for v in (0..nx * ny).filter(|&v| !used[v]) {
+        assert_eq!((s.smoothed[v].to_bits(), s.roles[v]), (values[v].to_bits(), Role::Other), "pixel {v}");
+    }
+    let o = succeeds(&["verify", out.to_str().unwrap()]);
+    assert!(text(&o).contains("inside a mask of"), "{}", text(&o));
+}

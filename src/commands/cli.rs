@@ -239,13 +239,14 @@ struct GridCli {
     /// `--array x|y|z` takes a coordinate).
     #[arg(long, value_name = "FILE")]
     values: Option<PathBuf>,
-    /// Volume: smooth only the voxels where this point array of the input is non-zero (the
-    /// domain is the tetrahedra whose corners are all inside; the rest is written unchanged,
-    /// role 0, and the output's `mask` array says which voxels the domain holds).
+    /// Volume or grid: smooth only the voxels where this point array of the input is non-zero
+    /// (the domain is the tetrahedra, or triangles, whose corners are all inside; the rest is
+    /// written unchanged, role 0, and the output's `mask` array says which voxels the domain
+    /// holds).
     #[arg(long, value_name = "ARRAY", conflicts_with = "mask_below")]
     mask: Option<String>,
-    /// Volume: smooth only the voxels whose value is at least V (below V, and NaN, is
-    /// outside), as --mask does.
+    /// Volume or grid: smooth only the voxels whose value is at least V (below V, and NaN,
+    /// is outside), as --mask does.
     #[arg(long, value_name = "V", allow_negative_numbers = true)]
     mask_below: Option<f64>,
 }

@@ -119,6 +119,8 @@ pub struct GridInput {
     pub carried: Option<Carried>,
     /// What reading found worth saying (an oblique NIfTI affine).
     pub notes: Vec<String>,
+    /// The pixels inside `--mask` / `--mask-below`, when given.
+    pub mask: Option<Vec<bool>>,
 }
 
 /// A volume field ready to smooth.
@@ -797,15 +799,9 @@ pub fn read_grid(path: &Path, opts: &GridOptions) -> Result<FieldInput> {
             (geometry, values, name, path.to_path_buf())
         }
     };
-    let inside = match (&opts.mask, &geometry) {
-        (None, _) => None,
-        (Some(_), Geometry::Flat(_)) => {
-            return Err(Error::Usage(format!(
-                "{}: --mask and --mask-below restrict volumes; on a 2D grid they are not implemented yet",
-                source.display()
-            )))
-        }
-        (Some(rule), Geometry::Volume(_)) => Some(mask_of(&source, rule, &values, carried.as_ref())?),
+    let inside = match &opts.mask {
+        None => None,
+        Some(rule) => Some(mask_of(&source, rule, &values, carried.as_ref())?),
     };
     // NaN outside the mask is background, not missing data
     let probe: Option<Vec<f64>> =
@@ -847,9 +843,16 @@ pub fn read_grid(path: &Path, opts: &GridOptions) -> Result<FieldInput> {
         filled = Some(mask);
     }
     Ok(match geometry {
-        Geometry::Flat(grid) => {
-            FieldInput::Grid(GridInput { grid, values, description, filled, path: source, carried, notes })
-        }
+        Geometry::Flat(grid) => FieldInput::Grid(GridInput {
+            grid,
+            values,
+            description,
+            filled,
+            path: source,
+            carried,
+            notes,
+            mask: inside,
+        }),
         Geometry::Volume(grid) => FieldInput::Volume(VolumeInput {
             grid,
             values,
@@ -863,7 +866,7 @@ pub fn read_grid(path: &Path, opts: &GridOptions) -> Result<FieldInput> {
     })
 }
 
-/// The voxels inside a mask: where the named array of the file (a carried VTK array, or
+/// The voxels (pixels) inside a mask: where the named array of the file (a carried VTK array, or
 /// another array of the `.npz`) is non-zero, or where the field is at least the threshold.
 fn mask_of(path: &Path, rule: &MaskRule, values: &[f64], carried: Option<&Carried>) -> Result<Vec<bool>> {
     let inside = match rule {
@@ -1006,7 +1009,7 @@ impl FieldInput {
                 carried: None,
             },
             FieldInput::Grid(g) => Field {
-                mask: None,
+                mask: g.mask,
                 domain: AnyDomain::Grid(g.grid),
                 values: g.values,
                 path: g.path,

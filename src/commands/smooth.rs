@@ -141,17 +141,31 @@ pub(super) fn smooth_shared(args: &SmoothArgs, shared: Option<&mut Option<Shared
     let filled_samples: Vec<usize> =
         field.filled.as_ref().map(|m| (0..m.len()).filter(|&i| m[i]).collect()).unwrap_or_default();
     check_explicit_not_filled(&field, &args.settings.selection, &filled_samples)?;
+    // a mask's domain: the volume's tetrahedra or the grid's triangles inside it
+    enum Masked {
+        Volume(crate::domain::MaskedVolume),
+        Grid(crate::domain::MaskedGrid),
+    }
     let masked = match (&field.mask, &field.domain) {
         (Some(inside), AnyDomain::Volume(g)) => {
-            let m = crate::domain::MaskedVolume::new(g, inside).map_err(|e| e.in_file(&field.path))?;
-            super::progress::line(&m.describe());
-            field.notes.push(m.describe());
-            Some(m)
+            Some(Masked::Volume(crate::domain::MaskedVolume::new(g, inside).map_err(|e| e.in_file(&field.path))?))
+        }
+        (Some(inside), AnyDomain::Grid(g)) => {
+            Some(Masked::Grid(crate::domain::MaskedGrid::new(g, inside).map_err(|e| e.in_file(&field.path))?))
         }
         _ => None,
     };
+    if let Some(m) = &masked {
+        let line = match m {
+            Masked::Volume(m) => m.describe(),
+            Masked::Grid(m) => m.describe(),
+        };
+        super::progress::line(&line);
+        field.notes.push(line);
+    }
     let result = match (shared, &masked) {
-        (_, Some(m)) => crate::pipeline::smooth_masked(m, &field.values, &args.settings),
+        (_, Some(Masked::Volume(m))) => crate::pipeline::smooth_masked(m, &field.values, &args.settings),
+        (_, Some(Masked::Grid(m))) => crate::pipeline::smooth_masked_grid(m, &field.values, &args.settings),
         (None, None) => smooth_any(&field.domain, &field.values, &args.settings),
         (Some(slot), None) => {
             if !slot.as_ref().is_some_and(|s| same_domain(&s.domain, &field.domain)) {
@@ -183,7 +197,10 @@ pub(super) fn smooth_shared(args: &SmoothArgs, shared: Option<&mut Option<Shared
         filled: field.filled.as_deref(),
         carried: field.carried.as_ref(),
         output_array: args.output_array.as_deref(),
-        mask: masked.as_ref().map(|m| m.used()),
+        mask: masked.as_ref().map(|m| match m {
+            Masked::Volume(m) => m.used(),
+            Masked::Grid(m) => m.used(),
+        }),
     };
     let x_axis = field.axis.as_ref().map(|a| (a.x_name.as_str(), a.x_text.as_slice()));
     let output = stage_results(&args.output, &field.domain, x_axis, &results)?;

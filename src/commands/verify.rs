@@ -100,28 +100,49 @@ fn verify_results(args: &VerifyArgs, out: Stored) -> Result<String> {
     if !out.roles.contains(&Role::Min) || !out.roles.contains(&Role::Max) {
         problems.push("the role array keeps no minimum or no maximum".into());
     }
-    let (cert, ucert, within) = match (&out.mask, d) {
-        // a masked volume: the domain is the mask's tetrahedra, the rest written unchanged
+    let unchanged = |v: usize| {
+        out.roles[v] == Role::Other
+            && out.smoothed[v].to_bits() == out.input[v].to_bits()
+            && out.representative[v].to_bits() == out.input[v].to_bits()
+    };
+    // a masked volume or grid: the domain is the mask's tetrahedra or triangles, the rest
+    // written unchanged
+    let masked = match (&out.mask, d) {
         (Some(mask), AnyDomain::Volume(g)) => {
             let m = crate::domain::MaskedVolume::new(g, mask).map_err(|e| e.in_file(&args.file))?;
-            let unchanged = |v: usize| {
-                out.roles[v] == Role::Other
-                    && out.smoothed[v].to_bits() == out.input[v].to_bits()
-                    && out.representative[v].to_bits() == out.input[v].to_bits()
-            };
-            if let Some(v) = (0..n).find(|&v| !m.used()[v] && !unchanged(v)) {
+            let on = |f: &[f64]| m.restrict(f);
+            let roles = m.restrict(&out.roles);
+            Some((
+                m.used().to_vec(),
+                crate::verify::certify(m.mesh(), &on(&out.smoothed), &roles, Some(&on(&out.input))),
+                crate::verify::certify(m.mesh(), &on(&out.representative), &roles, None),
+                format!(" inside a mask of {} voxels", m.voxels().len()),
+            ))
+        }
+        (Some(mask), AnyDomain::Grid(g)) => {
+            let m = crate::domain::MaskedGrid::new(g, mask).map_err(|e| e.in_file(&args.file))?;
+            let on = |f: &[f64]| m.restrict(f);
+            let roles = m.restrict(&out.roles);
+            Some((
+                m.used().to_vec(),
+                crate::verify::certify(m.mesh(), &on(&out.smoothed), &roles, Some(&on(&out.input))),
+                crate::verify::certify(m.mesh(), &on(&out.representative), &roles, None),
+                format!(" inside a mask of {} pixels", m.voxels().len()),
+            ))
+        }
+        _ => None,
+    };
+    let (cert, ucert, within) = match masked {
+        Some((used, cert, ucert, within)) => {
+            if let Some(v) = (0..n).find(|&v| !used[v] && !unchanged(v)) {
                 problems.push(format!(
                     "{} lies outside the mask's domain but is not written unchanged with role 0",
                     d.describe_vertex(v)
                 ));
             }
-            let roles = m.restrict(&out.roles);
-            let cert =
-                crate::verify::certify(m.mesh(), &m.restrict(&out.smoothed), &roles, Some(&m.restrict(&out.input)));
-            let ucert = crate::verify::certify(m.mesh(), &m.restrict(&out.representative), &roles, None);
-            (cert, ucert, format!(" inside a mask of {} voxels", m.voxels().len()))
+            (cert, ucert, within)
         }
-        _ => (
+        None => (
             certify_any(d, &out.smoothed, &out.roles, Some(&out.input)),
             certify_any(d, &out.representative, &out.roles, None),
             String::new(),

@@ -20,7 +20,7 @@
 //! # Ok::<(), toposmooth::Error>(())
 //! ```
 
-use super::{Domain, Grid3d, TetMesh};
+use super::{Domain, Grid2d, Grid3d, TetMesh, TriMesh};
 use crate::error::{Error, Result};
 
 /// A volume grid restricted to the voxels a mask holds inside.
@@ -133,6 +133,161 @@ impl MaskedVolume {
     }
 }
 
+/// A 2D grid restricted to a mask: the triangles of the grid's split with every corner
+/// inside, after removing the inside pixels where triangles meet at a single vertex (the
+/// triangle mesh of the 2D route, with its Morse–Smale complex, needs a manifold: each
+/// vertex's triangles one fan). The removed pixels are left unchanged with the outside.
+#[derive(Clone, Debug)]
+pub struct MaskedGrid {
+    grid: Grid2d,
+    mesh: TriMesh,
+    voxel: Vec<usize>,
+    used: Vec<bool>,
+    inside: usize,
+    pinched: usize,
+}
+
+impl MaskedGrid {
+    /// The triangles of `grid` whose corners are all `inside` (one flag per pixel, row
+    /// after row), pinch points removed.
+    ///
+    /// # Errors
+    /// [`Error::Input`] when `inside` has the wrong length or no triangle lies inside.
+    pub fn new(grid: &Grid2d, inside: &[bool]) -> Result<MaskedGrid> {
+        let n = grid.n_vertices();
+        if inside.len() != n {
+            return Err(Error::input(format!("the mask has {} values, the grid {n} pixels", inside.len())));
+        }
+        let count = inside.iter().filter(|&&b| b).count();
+        let mut keep = inside.to_vec();
+        let mut pinched = 0;
+        let triangles = loop {
+            let tris: Vec<[usize; 3]> = grid.triangles().filter(|t| t.iter().all(|&v| keep[v])).collect();
+            let pinch = pinch_points(n, &tris);
+            if pinch.is_empty() {
+                break tris;
+            }
+            pinched += pinch.len();
+            for v in pinch {
+                keep[v] = false;
+            }
+        };
+        if triangles.is_empty() {
+            return Err(Error::input(format!(
+                "the mask holds {count} of {n} pixels inside but no triangle of the grid (a domain needs a square's \
+                 worth of inside pixels somewhere)"
+            )));
+        }
+        let mut used = vec![false; n];
+        triangles.iter().flatten().for_each(|&v| used[v] = true);
+        let voxel: Vec<usize> = (0..n).filter(|&v| used[v]).collect();
+        let mut vertex = vec![usize::MAX; n];
+        for (i, &v) in voxel.iter().enumerate() {
+            vertex[v] = i;
+        }
+        let positions = voxel.iter().map(|&v| grid.point(v)).collect();
+        let triangles = triangles.into_iter().map(|t| t.map(|v| vertex[v])).collect();
+        let mesh = TriMesh::new(positions, triangles)?;
+        Ok(MaskedGrid { grid: grid.clone(), mesh, voxel, used, inside: count, pinched })
+    }
+
+    /// The grid the mask lies on.
+    pub fn grid(&self) -> &Grid2d {
+        &self.grid
+    }
+
+    /// The domain: a triangle mesh over the used pixels, numbered in grid order.
+    pub fn mesh(&self) -> &TriMesh {
+        &self.mesh
+    }
+
+    /// The grid index of each domain vertex.
+    pub fn voxels(&self) -> &[usize] {
+        &self.voxel
+    }
+
+    /// Whether each pixel is a vertex of the domain.
+    pub fn used(&self) -> &[bool] {
+        &self.used
+    }
+
+    /// Inside pixels left out: on no inside triangle, or removed as pinch points.
+    pub fn left_out(&self) -> usize {
+        self.inside - self.voxel.len()
+    }
+
+    /// A grid field's values at the domain's vertices.
+    pub fn restrict<T: Copy>(&self, f: &[T]) -> Vec<T> {
+        self.voxel.iter().map(|&v| f[v]).collect()
+    }
+
+    /// The grid field that is `inner` on the domain and `outside` elsewhere.
+    pub fn extend<T: Copy>(&self, inner: &[T], outside: &[T]) -> Vec<T> {
+        let mut f = outside.to_vec();
+        for (&v, &x) in self.voxel.iter().zip(inner) {
+            f[v] = x;
+        }
+        f
+    }
+
+    /// One line: inside pixels, domain vertices and triangles, components, pixels left out.
+    pub fn describe(&self) -> String {
+        let n = self.grid.n_vertices();
+        format!(
+            "mask: {} of {n} pixels inside ({:.1} %); domain {} vertices, {} triangles, {} component{}{}",
+            self.inside,
+            100.0 * self.inside as f64 / n as f64,
+            self.voxel.len(),
+            self.mesh.faces().len(),
+            self.mesh.n_components(),
+            if self.mesh.n_components() == 1 { "" } else { "s" },
+            match self.left_out() {
+                0 => String::new(),
+                k => format!("; {k} inside pixels left unchanged ({} where triangles meet at a point)", self.pinched),
+            }
+        )
+    }
+}
+
+/// Vertices whose triangles do not form one fan: the edges opposite a vertex in its
+/// triangles (its link) must make one path or one cycle.
+fn pinch_points(n: usize, tris: &[[usize; 3]]) -> Vec<usize> {
+    let mut link: Vec<Vec<(usize, usize)>> = vec![Vec::new(); n];
+    for t in tris {
+        for k in 0..3 {
+            link[t[k]].push((t[(k + 1) % 3], t[(k + 2) % 3]));
+        }
+    }
+    let mut out = Vec::new();
+    for (v, edges) in link.iter().enumerate() {
+        if edges.is_empty() {
+            continue;
+        }
+        // degrees in the link and its connectivity (a handful of edges: quadratic is fine)
+        let mut nodes: Vec<usize> = edges.iter().flat_map(|&(a, b)| [a, b]).collect();
+        nodes.sort_unstable();
+        nodes.dedup();
+        let degree = |x: usize| edges.iter().filter(|&&(a, b)| a == x || b == x).count();
+        let mut reached = vec![nodes[0]];
+        let mut i = 0;
+        while i < reached.len() {
+            let x = reached[i];
+            for &(a, b) in edges {
+                for (p, q) in [(a, b), (b, a)] {
+                    if p == x && !reached.contains(&q) {
+                        reached.push(q);
+                    }
+                }
+            }
+            i += 1;
+        }
+        if reached.len() < nodes.len() || nodes.iter().any(|&x| degree(x) > 2) {
+            out.push(v);
+        }
+    }
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -169,19 +324,47 @@ mod tests {
     }
 
     #[test]
+    fn a_2d_mask_is_a_triangle_mesh_without_pinch_points() {
+        let g = Grid2d::new(6, 6).unwrap();
+        // two 3 × 3 blocks meeting only at the pixel (2, 2) across the (−,+) diagonal (blocks
+        // along the (+,+) one share the split's diagonal triangles), and a lone pixel
+        let mut inside = vec![false; 36];
+        for r in 0..3 {
+            for c in 0..3 {
+                inside[g.index(r, c + 2)] = true;
+                inside[g.index(r + 2, c)] = true;
+            }
+        }
+        inside[g.index(5, 5)] = true;
+        let m = MaskedGrid::new(&g, &inside).unwrap();
+        // the pinch pixel goes with one triangle of each block: seven remain in each
+        assert_eq!((m.mesh().faces().len(), m.mesh().n_vertices(), m.mesh().n_components()), (14, 16, 2));
+        assert_eq!(m.left_out(), 2);
+        assert!(!m.used()[g.index(2, 2)] && m.used()[g.index(1, 3)]);
+        assert!(m.describe().contains("1 where triangles meet at a point"), "{}", m.describe());
+        // the domain's own pixels rebuild the same domain
+        let again = MaskedGrid::new(&g, m.used()).unwrap();
+        assert_eq!((again.voxels(), again.left_out()), (m.voxels(), 0));
+        assert!(MaskedGrid::new(&g, &[false; 36]).is_err());
+    }
+
+    #[test]
     fn cubes_meeting_at_one_vertex_make_a_non_manifold_complex_with_one_component() {
         let g = Grid3d::new(3, 3, 3).unwrap();
         let mut inside = vec![false; 27];
         for k in 0..2 {
             for j in 0..2 {
                 for i in 0..2 {
-                    inside[g.index(i, j, k)] = true;
-                    inside[g.index(i + 1, j + 1, k + 1)] = true;
+                    // the cubes at (1, 0, 0) and (0, 1, 1) share only the voxel (1, 1, 1),
+                    // and no tetrahedron of the split has corners in both (its corners lie
+                    // in one cube, from its first corner to the opposite one)
+                    inside[g.index(i + 1, j, k)] = true;
+                    inside[g.index(i, j + 1, k + 1)] = true;
                 }
             }
         }
         let m = MaskedVolume::new(&g, &inside).unwrap();
-        assert_eq!(m.mesh().n_vertices(), 15);
+        assert_eq!((m.mesh().n_vertices(), m.mesh().tets().len()), (15, 12));
         assert_eq!(m.mesh().n_components(), 1);
         // the manifold mesh refuses the same tetrahedra
         assert!(TetMesh::new(m.mesh().positions().to_vec(), m.mesh().tets().to_vec()).is_err());

@@ -602,7 +602,8 @@ pub struct Stored {
     pub roles: Vec<Role>,
     /// Series: the samples the `filled` column marks, when it has one.
     pub filled: Option<Vec<bool>>,
-    /// Volumes smoothed inside a mask: the voxels of the domain (the `mask` array, non-zero).
+    /// Volumes and grids smoothed inside a mask: the voxels of the domain (the `mask` array,
+    /// non-zero).
     pub mask: Option<Vec<bool>>,
 }
 
@@ -719,7 +720,7 @@ fn stored(path: &Path, domain: AnyDomain, names: Vec<String>, mut arrays: Vec<(S
     let (input, smoothed, representative, role) =
         (take("input")?, take("smoothed")?, take("representative")?, take("role")?);
     let mask = match arrays.iter().position(|(n, _)| n == "mask") {
-        Some(i) if matches!(domain, AnyDomain::Volume(_)) => {
+        Some(i) if matches!(domain, AnyDomain::Volume(_) | AnyDomain::Grid(_)) => {
             let m = arrays.swap_remove(i).1;
             if m.len() != role.len() {
                 return Err(Error::input(format!("the `mask` array has {} values for {} voxels", m.len(), role.len()))

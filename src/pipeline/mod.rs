@@ -16,7 +16,7 @@ mod settings;
 mod smoothable;
 mod stages;
 
-use crate::domain::{Domain, MaskedVolume};
+use crate::domain::{Domain, MaskedGrid, MaskedVolume};
 use crate::error::{Error, Result};
 use crate::linalg::Analyses;
 use crate::operators::Sparse;
@@ -102,24 +102,52 @@ const ACTIVE_SET_FIT: f64 = 1e-6;
 /// As [`smooth`]; an explicit kept voxel or sharp vertex outside the domain is an input
 /// error naming it.
 pub fn smooth_masked(masked: &MaskedVolume, h: &[f64], settings: &SmoothSettings) -> Result<Smoothed> {
-    let n = masked.grid().n_vertices();
+    let g = masked.grid();
+    let name = |v: usize| {
+        let [i, j, k] = g.ijk(v);
+        format!("voxel {v} (i {i}, j {j}, k {k})")
+    };
+    smooth_inside(masked.mesh(), masked.voxels(), g.n_vertices(), &name, h, settings)
+}
+
+/// [`smooth_masked`] on a 2D grid: the pipeline runs on the [`MaskedGrid`]'s triangle mesh
+/// (its Morse–Smale complex and separatrix representative included).
+///
+/// # Errors
+/// As [`smooth_masked`].
+pub fn smooth_masked_grid(masked: &MaskedGrid, h: &[f64], settings: &SmoothSettings) -> Result<Smoothed> {
+    let g = masked.grid();
+    let name = |v: usize| {
+        let (r, c) = g.row_col(v);
+        format!("pixel {v} (row {r}, column {c})")
+    };
+    smooth_inside(masked.mesh(), masked.voxels(), g.n_vertices(), &name, h, settings)
+}
+
+/// The pipeline on `domain`, whose vertex `i` is the grid's `voxels[i]` (of `n`), with
+/// inputs and outputs on the whole grid.
+fn smooth_inside<D: Smoothable + Sync>(
+    domain: &D,
+    voxels: &[usize],
+    n: usize,
+    name: &dyn Fn(usize) -> String,
+    h: &[f64],
+    settings: &SmoothSettings,
+) -> Result<Smoothed> {
     if h.len() != n {
-        return Err(Error::input(format!("the field has {} values, the volume {n} voxels", h.len())));
+        return Err(Error::input(format!("the field has {} values, the grid {n}", h.len())));
     }
     let mut vertex = vec![usize::MAX; n];
-    for (i, &v) in masked.voxels().iter().enumerate() {
+    for (i, &v) in voxels.iter().enumerate() {
         vertex[v] = i;
     }
     let inner = |list: &[usize], what: &str| -> Result<Vec<usize>> {
         list.iter()
             .map(|&v| match vertex.get(v) {
                 Some(&i) if i != usize::MAX => Ok(i),
-                Some(_) => {
-                    let [a, b, c] = masked.grid().ijk(v);
-                    Err(Error::input(format!("{what} {v} (i {a}, j {b}, k {c}) lies outside the mask's domain"))
-                        .at(crate::error::Location::Vertex(v)))
-                }
-                None => Err(Error::input(format!("{what} {v} is out of range (the volume has {n} voxels)"))),
+                Some(_) => Err(Error::input(format!("{what} {} lies outside the mask's domain", name(v)))
+                    .at(crate::error::Location::Vertex(v))),
+                None => Err(Error::input(format!("{what} {v} is out of range (the grid has {n} points)"))),
             })
             .collect()
     };
@@ -131,13 +159,23 @@ pub fn smooth_masked(masked: &MaskedVolume, h: &[f64], settings: &SmoothSettings
         };
     }
     local.energy.sharp = inner(&settings.energy.sharp, "sharp vertex")?;
-    let mut out = smooth(masked.mesh(), &masked.restrict(h), &local)?;
-    out.output = masked.extend(&out.output, h);
-    out.u = masked.extend(&out.u, h);
-    out.roles = masked.extend(&out.roles, &vec![Role::Other; n]);
+    let restricted: Vec<f64> = voxels.iter().map(|&v| h[v]).collect();
+    let mut out = smooth(domain, &restricted, &local)?;
+    let extend = |inner: &[f64]| {
+        let mut f = h.to_vec();
+        voxels.iter().zip(inner).for_each(|(&v, &x)| f[v] = x);
+        f
+    };
+    out.output = extend(&out.output);
+    out.u = extend(&out.u);
+    let mut roles = vec![Role::Other; n];
+    voxels.iter().zip(&out.roles).for_each(|(&v, &r)| roles[v] = r);
+    out.roles = roles;
     for k in &mut out.report.kept {
-        k.index = masked.voxels()[k.index];
+        k.index = voxels[k.index];
     }
+    // the grid's complex is not the mesh's: a complex on mesh vertices would misname them
+    out.complex = None;
     Ok(out)
 }
 

@@ -28,61 +28,33 @@ use crate::error::{Error, Result};
 pub struct MaskedVolume {
     grid: Grid3d,
     mesh: TetMesh,
-    /// The grid index of each of the mesh's vertices, increasing.
+    on: Restriction,
+}
+
+/// Which grid points a masked domain holds and how its vertices map to them: what
+/// [`MaskedVolume`] and [`MaskedGrid`] share (both dereference to it).
+#[derive(Clone, Debug)]
+pub struct Restriction {
+    /// The grid index of each of the domain's vertices, increasing.
     voxel: Vec<usize>,
-    /// Whether each grid voxel is a vertex of the domain.
+    /// Whether each grid point is a vertex of the domain.
     used: Vec<bool>,
-    /// Inside voxels of the mask.
+    /// Inside points of the mask.
     inside: usize,
 }
 
-impl MaskedVolume {
-    /// The tetrahedra of `grid` whose corners are all `inside` (one flag per voxel, VTK
-    /// order).
-    ///
-    /// # Errors
-    /// [`Error::Input`] when `inside` has the wrong length or no tetrahedron lies inside.
-    pub fn new(grid: &Grid3d, inside: &[bool]) -> Result<MaskedVolume> {
-        let n = grid.n_vertices();
-        if inside.len() != n {
-            return Err(Error::input(format!("the mask has {} values, the volume {n} voxels", inside.len())));
-        }
-        let count = inside.iter().filter(|&&b| b).count();
+impl Restriction {
+    /// The points of `n` on some `cells` (grid indices), the cells renumbered onto them.
+    fn new<const K: usize>(n: usize, cells: Vec<[usize; K]>, inside: usize) -> (Restriction, Vec<[usize; K]>) {
         let mut used = vec![false; n];
-        let mut tets: Vec<[usize; 4]> = Vec::new();
-        for t in grid.tetrahedra() {
-            if t.iter().all(|&v| inside[v]) {
-                for &v in &t {
-                    used[v] = true;
-                }
-                tets.push(t);
-            }
-        }
-        if tets.is_empty() {
-            return Err(Error::input(format!(
-                "the mask holds {count} of {n} voxels inside but no tetrahedron of the grid (a domain needs a cube's \
-                 worth of inside voxels somewhere)"
-            )));
-        }
+        cells.iter().flatten().for_each(|&v| used[v] = true);
         let voxel: Vec<usize> = (0..n).filter(|&v| used[v]).collect();
         let mut vertex = vec![usize::MAX; n];
         for (i, &v) in voxel.iter().enumerate() {
             vertex[v] = i;
         }
-        let positions = voxel.iter().map(|&v| grid.position(v)).collect();
-        let tets = tets.into_iter().map(|t| t.map(|v| vertex[v])).collect();
-        let mesh = TetMesh::complex(positions, tets)?;
-        Ok(MaskedVolume { grid: grid.clone(), mesh, voxel, used, inside: count })
-    }
-
-    /// The grid the mask lies on.
-    pub fn grid(&self) -> &Grid3d {
-        &self.grid
-    }
-
-    /// The domain: a tetrahedral complex over the used voxels, numbered in grid order.
-    pub fn mesh(&self) -> &TetMesh {
-        &self.mesh
+        let cells = cells.into_iter().map(|c| c.map(|v| vertex[v])).collect();
+        (Restriction { voxel, used, inside }, cells)
     }
 
     /// The grid index of each domain vertex.
@@ -90,12 +62,12 @@ impl MaskedVolume {
         &self.voxel
     }
 
-    /// Whether each grid voxel is a vertex of the domain.
+    /// Whether each grid point is a vertex of the domain.
     pub fn used(&self) -> &[bool] {
         &self.used
     }
 
-    /// Inside voxels on no inside tetrahedron, left out of the domain.
+    /// Inside points left out of the domain (on no inside cell, or removed as pinch points).
     pub fn left_out(&self) -> usize {
         self.inside - self.voxel.len()
     }
@@ -113,15 +85,65 @@ impl MaskedVolume {
         }
         f
     }
+}
+
+impl std::ops::Deref for MaskedVolume {
+    type Target = Restriction;
+    fn deref(&self) -> &Restriction {
+        &self.on
+    }
+}
+
+impl std::ops::Deref for MaskedGrid {
+    type Target = Restriction;
+    fn deref(&self) -> &Restriction {
+        &self.on
+    }
+}
+
+impl MaskedVolume {
+    /// The tetrahedra of `grid` whose corners are all `inside` (one flag per voxel, VTK
+    /// order).
+    ///
+    /// # Errors
+    /// [`Error::Input`] when `inside` has the wrong length or no tetrahedron lies inside.
+    pub fn new(grid: &Grid3d, inside: &[bool]) -> Result<MaskedVolume> {
+        let n = grid.n_vertices();
+        if inside.len() != n {
+            return Err(Error::input(format!("the mask has {} values, the volume {n} voxels", inside.len())));
+        }
+        let count = inside.iter().filter(|&&b| b).count();
+        let tets: Vec<[usize; 4]> = grid.tetrahedra().filter(|t| t.iter().all(|&v| inside[v])).collect();
+        if tets.is_empty() {
+            return Err(Error::input(format!(
+                "the mask holds {count} of {n} voxels inside but no tetrahedron of the grid (a domain needs a cube's \
+                 worth of inside voxels somewhere)"
+            )));
+        }
+        let (on, tets) = Restriction::new(n, tets, count);
+        let positions = on.voxel.iter().map(|&v| grid.position(v)).collect();
+        let mesh = TetMesh::complex(positions, tets)?;
+        Ok(MaskedVolume { grid: grid.clone(), mesh, on })
+    }
+
+    /// The grid the mask lies on.
+    pub fn grid(&self) -> &Grid3d {
+        &self.grid
+    }
+
+    /// The domain: a tetrahedral complex over the used voxels, numbered in grid order.
+    pub fn mesh(&self) -> &TetMesh {
+        &self.mesh
+    }
 
     /// One line: inside voxels, domain vertices and tetrahedra, components, voxels left out.
     pub fn describe(&self) -> String {
         let n = self.grid.n_vertices();
         format!(
             "mask: {} of {n} voxels inside ({:.1} %); domain {} vertices, {} tetrahedra, {} component{}{}",
-            self.inside,
-            100.0 * self.inside as f64 / n as f64,
-            self.voxel.len(),
+            self.on.inside,
+            100.0 * self.on.inside as f64 / n as f64,
+            self.on.voxel.len(),
             self.mesh.tets().len(),
             self.mesh.n_components(),
             if self.mesh.n_components() == 1 { "" } else { "s" },
@@ -141,9 +163,7 @@ impl MaskedVolume {
 pub struct MaskedGrid {
     grid: Grid2d,
     mesh: TriMesh,
-    voxel: Vec<usize>,
-    used: Vec<bool>,
-    inside: usize,
+    on: Restriction,
     pinched: usize,
 }
 
@@ -178,17 +198,10 @@ impl MaskedGrid {
                  worth of inside pixels somewhere)"
             )));
         }
-        let mut used = vec![false; n];
-        triangles.iter().flatten().for_each(|&v| used[v] = true);
-        let voxel: Vec<usize> = (0..n).filter(|&v| used[v]).collect();
-        let mut vertex = vec![usize::MAX; n];
-        for (i, &v) in voxel.iter().enumerate() {
-            vertex[v] = i;
-        }
-        let positions = voxel.iter().map(|&v| grid.point(v)).collect();
-        let triangles = triangles.into_iter().map(|t| t.map(|v| vertex[v])).collect();
+        let (on, triangles) = Restriction::new(n, triangles, count);
+        let positions = on.voxel.iter().map(|&v| grid.point(v)).collect();
         let mesh = TriMesh::new(positions, triangles)?;
-        Ok(MaskedGrid { grid: grid.clone(), mesh, voxel, used, inside: count, pinched })
+        Ok(MaskedGrid { grid: grid.clone(), mesh, on, pinched })
     }
 
     /// The grid the mask lies on.
@@ -201,43 +214,14 @@ impl MaskedGrid {
         &self.mesh
     }
 
-    /// The grid index of each domain vertex.
-    pub fn voxels(&self) -> &[usize] {
-        &self.voxel
-    }
-
-    /// Whether each pixel is a vertex of the domain.
-    pub fn used(&self) -> &[bool] {
-        &self.used
-    }
-
-    /// Inside pixels left out: on no inside triangle, or removed as pinch points.
-    pub fn left_out(&self) -> usize {
-        self.inside - self.voxel.len()
-    }
-
-    /// A grid field's values at the domain's vertices.
-    pub fn restrict<T: Copy>(&self, f: &[T]) -> Vec<T> {
-        self.voxel.iter().map(|&v| f[v]).collect()
-    }
-
-    /// The grid field that is `inner` on the domain and `outside` elsewhere.
-    pub fn extend<T: Copy>(&self, inner: &[T], outside: &[T]) -> Vec<T> {
-        let mut f = outside.to_vec();
-        for (&v, &x) in self.voxel.iter().zip(inner) {
-            f[v] = x;
-        }
-        f
-    }
-
     /// One line: inside pixels, domain vertices and triangles, components, pixels left out.
     pub fn describe(&self) -> String {
         let n = self.grid.n_vertices();
         format!(
             "mask: {} of {n} pixels inside ({:.1} %); domain {} vertices, {} triangles, {} component{}{}",
-            self.inside,
-            100.0 * self.inside as f64 / n as f64,
-            self.voxel.len(),
+            self.on.inside,
+            100.0 * self.on.inside as f64 / n as f64,
+            self.on.voxel.len(),
             self.mesh.faces().len(),
             self.mesh.n_components(),
             if self.mesh.n_components() == 1 { "" } else { "s" },

@@ -22,7 +22,7 @@ mod volume;
 
 pub use any::AnyDomain;
 pub use grid::{Grid2d, MAX_SPACING, MIN_SPACING};
-pub use masked::{MaskedGrid, MaskedVolume};
+pub use masked::{MaskedGrid, MaskedVolume, Restriction};
 pub use mesh::{shapes, triangle_area, TriMesh};
 pub use order::{sos_greater, sos_less, sos_sort, sos_untied, value_range};
 pub use series::Series;

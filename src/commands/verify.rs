@@ -110,25 +110,11 @@ fn verify_results(args: &VerifyArgs, out: Stored) -> Result<String> {
     let masked = match (&out.mask, d) {
         (Some(mask), AnyDomain::Volume(g)) => {
             let m = crate::domain::MaskedVolume::new(g, mask).map_err(|e| e.in_file(&args.file))?;
-            let on = |f: &[f64]| m.restrict(f);
-            let roles = m.restrict(&out.roles);
-            Some((
-                m.used().to_vec(),
-                crate::verify::certify(m.mesh(), &on(&out.smoothed), &roles, Some(&on(&out.input))),
-                crate::verify::certify(m.mesh(), &on(&out.representative), &roles, None),
-                format!(" inside a mask of {} voxels", m.voxels().len()),
-            ))
+            Some(certify_masked(m.mesh(), &m, &out, "voxels"))
         }
         (Some(mask), AnyDomain::Grid(g)) => {
             let m = crate::domain::MaskedGrid::new(g, mask).map_err(|e| e.in_file(&args.file))?;
-            let on = |f: &[f64]| m.restrict(f);
-            let roles = m.restrict(&out.roles);
-            Some((
-                m.used().to_vec(),
-                crate::verify::certify(m.mesh(), &on(&out.smoothed), &roles, Some(&on(&out.input))),
-                crate::verify::certify(m.mesh(), &on(&out.representative), &roles, None),
-                format!(" inside a mask of {} pixels", m.voxels().len()),
-            ))
+            Some(certify_masked(m.mesh(), &m, &out, "pixels"))
         }
         _ => None,
     };
@@ -166,6 +152,23 @@ fn verify_results(args: &VerifyArgs, out: Stored) -> Result<String> {
         d.describe(),
         if args.input.is_some() { ", input matches" } else { "" }
     ))
+}
+
+/// The certificates of a masked result's smoothed and representative arrays on the mask's
+/// domain, the domain's grid points, and the summary's words for it.
+fn certify_masked<D: crate::domain::Domain>(
+    mesh: &D,
+    on: &crate::domain::Restriction,
+    out: &Stored,
+    points: &str,
+) -> (Vec<bool>, crate::Certificate, crate::Certificate, String) {
+    let roles = on.restrict(&out.roles);
+    (
+        on.used().to_vec(),
+        crate::verify::certify(mesh, &on.restrict(&out.smoothed), &roles, Some(&on.restrict(&out.input))),
+        crate::verify::certify(mesh, &on.restrict(&out.representative), &roles, None),
+        format!(" inside a mask of {} {points}", on.voxels().len()),
+    )
 }
 
 /// Compares the result's `input` with the original file read as the result's domain. A `.vti`

@@ -16,7 +16,7 @@ mod settings;
 mod smoothable;
 mod stages;
 
-use crate::domain::{Domain, MaskedGrid, MaskedVolume};
+use crate::domain::{Domain, MaskedGrid, MaskedVolume, Restriction};
 use crate::error::{Error, Result};
 use crate::linalg::Analyses;
 use crate::operators::Sparse;
@@ -107,7 +107,7 @@ pub fn smooth_masked(masked: &MaskedVolume, h: &[f64], settings: &SmoothSettings
         let [i, j, k] = g.ijk(v);
         format!("voxel {v} (i {i}, j {j}, k {k})")
     };
-    smooth_inside(masked.mesh(), masked.voxels(), g.n_vertices(), &name, h, settings)
+    smooth_inside(masked.mesh(), masked, &name, h, settings)
 }
 
 /// [`smooth_masked`] on a 2D grid: the pipeline runs on the [`MaskedGrid`]'s triangle mesh
@@ -121,19 +121,19 @@ pub fn smooth_masked_grid(masked: &MaskedGrid, h: &[f64], settings: &SmoothSetti
         let (r, c) = g.row_col(v);
         format!("pixel {v} (row {r}, column {c})")
     };
-    smooth_inside(masked.mesh(), masked.voxels(), g.n_vertices(), &name, h, settings)
+    smooth_inside(masked.mesh(), masked, &name, h, settings)
 }
 
-/// The pipeline on `domain`, whose vertex `i` is the grid's `voxels[i]` (of `n`), with
-/// inputs and outputs on the whole grid.
+/// The pipeline on `domain`, whose vertices are the grid points `on` holds, with inputs and
+/// outputs on the whole grid.
 fn smooth_inside<D: Smoothable + Sync>(
     domain: &D,
-    voxels: &[usize],
-    n: usize,
+    on: &Restriction,
     name: &dyn Fn(usize) -> String,
     h: &[f64],
     settings: &SmoothSettings,
 ) -> Result<Smoothed> {
+    let (n, voxels) = (on.used().len(), on.voxels());
     if h.len() != n {
         return Err(Error::input(format!("the field has {} values, the grid {n}", h.len())));
     }
@@ -159,18 +159,10 @@ fn smooth_inside<D: Smoothable + Sync>(
         };
     }
     local.energy.sharp = inner(&settings.energy.sharp, "sharp vertex")?;
-    let restricted: Vec<f64> = voxels.iter().map(|&v| h[v]).collect();
-    let mut out = smooth(domain, &restricted, &local)?;
-    let extend = |inner: &[f64]| {
-        let mut f = h.to_vec();
-        voxels.iter().zip(inner).for_each(|(&v, &x)| f[v] = x);
-        f
-    };
-    out.output = extend(&out.output);
-    out.u = extend(&out.u);
-    let mut roles = vec![Role::Other; n];
-    voxels.iter().zip(&out.roles).for_each(|(&v, &r)| roles[v] = r);
-    out.roles = roles;
+    let mut out = smooth(domain, &on.restrict(h), &local)?;
+    out.output = on.extend(&out.output, h);
+    out.u = on.extend(&out.u, h);
+    out.roles = on.extend(&out.roles, &vec![Role::Other; n]);
     for k in &mut out.report.kept {
         k.index = voxels[k.index];
     }

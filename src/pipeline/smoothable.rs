@@ -113,7 +113,8 @@ pub trait Smoothable: Domain {
     /// why: the pipeline excludes one whose order makes the constraints infeasible); `fill`
     /// is the harmonic fills' Laplacian ([`Smoothable::own_fill_stiffness`] or the stiffness), the
     /// factorisations' analyses are in `analyses`. By default the surface constructions
-    /// (separatrix, harmonic, flooded) on the domain's Morse–Smale complex; series override it.
+    /// (separatrix, harmonic, flooded) on the domain's Morse–Smale complex, on solid domains
+    /// the flooded and harmonic ones; series override it.
     fn representative(
         &self,
         h: &[f64],
@@ -126,7 +127,8 @@ pub trait Smoothable: Domain {
     where
         Self: Sized,
     {
-        surface_representative(self, h, kept, choice, fill, excluded, analyses, Cells::Triangles)
+        let cells = if self.solid() { Cells::Tetrahedra } else { Cells::Triangles };
+        surface_representative(self, h, kept, choice, fill, excluded, analyses, cells)
     }
 }
 
@@ -405,17 +407,6 @@ impl Smoothable for Grid3d {
     fn mass(&self) -> Vec<f64> {
         volume_mass(self)
     }
-    fn representative(
-        &self,
-        h: &[f64],
-        kept: &KeptSet,
-        choice: Option<RepresentativeChoice>,
-        fill: &Sparse,
-        excluded: &[(RepresentativeKind, String)],
-        analyses: &mut Analyses,
-    ) -> Result<Representative> {
-        surface_representative(self, h, kept, choice, fill, excluded, analyses, Cells::Tetrahedra)
-    }
 }
 
 /// Tetrahedral meshes: P1 elements (stiffness from the dihedral cotangents, lumped mass),
@@ -440,16 +431,5 @@ impl Smoothable for TetMesh {
     /// gradients (three rows per tetrahedron).
     fn stiffness_factor(&self, k: &Sparse) -> Option<Factor> {
         edge_factor(k).or_else(|| Some(tet_gradient_factor(self.positions(), self.tets())))
-    }
-    fn representative(
-        &self,
-        h: &[f64],
-        kept: &KeptSet,
-        choice: Option<RepresentativeChoice>,
-        fill: &Sparse,
-        excluded: &[(RepresentativeKind, String)],
-        analyses: &mut Analyses,
-    ) -> Result<Representative> {
-        surface_representative(self, h, kept, choice, fill, excluded, analyses, Cells::Tetrahedra)
     }
 }

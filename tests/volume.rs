@@ -553,6 +553,10 @@ fn a_masked_volume_is_smoothed_inside_its_tetrahedra_and_verified_and_nan_backgr
         "{}",
         text(&o)
     );
+    let fx = dataset("fx_eur_per_usd_daily_1999_2017.csv");
+    let o = toposmooth(&["smooth", &fx, "--mask-below", "1", "-o", dir.join("fx.csv").to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2), "{}", text(&o));
+    assert!(text(&o).contains("fx_eur_per_usd") && text(&o).contains("restrict grids and volumes"), "{}", text(&o));
     let o = toposmooth(&["smooth", &vti, "--mask-below", "1e9", "-o", out.to_str().unwrap()]);
     assert_eq!(o.status.code(), Some(3));
     assert!(text(&o).contains("no tetrahedron"), "{}", text(&o));

@@ -133,6 +133,13 @@ pub(super) fn smooth_shared(args: &SmoothArgs, shared: Option<&mut Option<Shared
     if args.plot.is_some() && matches!(field.domain, AnyDomain::Volume(_)) {
         return Err(Error::setting("plot", "is not drawn for volumes yet (write a .vti and open it in ParaView)"));
     }
+    if args.grid.mask.is_some() && !matches!(field.domain, AnyDomain::Grid(_) | AnyDomain::Volume(_)) {
+        return Err(Error::Usage(format!(
+            "{}: --mask and --mask-below restrict grids and volumes; this input is {}",
+            field.path.display(),
+            field.domain.describe()
+        )));
+    }
     if args.isolines > 0 && !matches!(field.domain, AnyDomain::Grid(_)) {
         return Err(Error::setting("isolines", "draws on a grid's figure only; this input is not a grid"));
     }

@@ -2,7 +2,7 @@
 //! same over a domain chosen at run time (for bindings that cannot be generic).
 
 pub use crate::domain::AnyDomain;
-use crate::domain::{Domain, Grid2d, Grid3d, Series, TriMesh};
+use crate::domain::{Domain, Grid2d, Grid3d, Series, TetMesh, TriMesh};
 use crate::error::Result;
 use crate::linalg::Analyses;
 #[cfg(doc)]
@@ -86,6 +86,8 @@ pub enum AnySmoother {
     Mesh(Smoother<TriMesh>),
     /// On a volume grid.
     Volume(Smoother<Grid3d>),
+    /// On a tetrahedral mesh.
+    Tets(Smoother<TetMesh>),
 }
 
 /// Runs `$body` with `$s` bound to the [`Smoother`] inside an [`AnySmoother`].
@@ -96,6 +98,7 @@ macro_rules! with_smoother {
             AnySmoother::Grid($s) => $body,
             AnySmoother::Mesh($s) => $body,
             AnySmoother::Volume($s) => $body,
+            AnySmoother::Tets($s) => $body,
         }
     };
 }
@@ -111,6 +114,7 @@ impl AnySmoother {
             AnyDomain::Grid(d) => AnySmoother::Grid(Smoother::new(d, settings)?),
             AnyDomain::Mesh(d) => AnySmoother::Mesh(Smoother::new(d, settings)?),
             AnyDomain::Volume(d) => AnySmoother::Volume(Smoother::new(d, settings)?),
+            AnyDomain::Tets(d) => AnySmoother::Tets(Smoother::new(d, settings)?),
         })
     }
 

@@ -131,7 +131,27 @@ fn vtk_xml_cases() -> Vec<Case> {
             "components",
         ),
         smooth("types.vtu", edit(&vtu, "Name=\"types\"", "Name=\"kinds\""), m, 3, "`types`"),
-        smooth("tets.vtu", fixture("tets.ascii.vtu"), m, 3, "tetrahedron"),
+        // tetrahedral meshes are read; their errors name the tetrahedron or the cell
+        with_args(
+            smooth(
+                "tet-corner.vtu",
+                edit(&fixture("tets.ascii.vtu"), "4 1 10 0 0 4", "4 1 10 4 0 4"),
+                "o.vtu",
+                3,
+                "tetrahedron 0 = [4, 1, 10, 4]",
+            ),
+            &["--array", "f"],
+        ),
+        with_args(
+            smooth(
+                "hex.vtu",
+                edit(&fixture("tets.ascii.vtu"), ">\n          10 10", ">\n          12 10"),
+                "o.vtu",
+                3,
+                "cell 0 is a hexahedron",
+            ),
+            &["--array", "f"],
+        ),
         smooth(
             "short-f.vtu",
             edit(&vtu, "Name=\"f\" format=\"ascii\"", "Name=\"f\" NumberOfComponents=\"2\" format=\"ascii\""),
@@ -245,7 +265,6 @@ fn legacy_cases() -> Vec<Case> {
             "first offset",
         ),
         smooth("corner.vtk", edit(&poly, "3 0 1 7", "3 0 1 70"), m, 3, "point 70"),
-        smooth("tets.vtk", fixture("tets.legacy-ugrid-binary-v51.vtk"), m, 3, "tetrahedron"),
     ]
 }
 

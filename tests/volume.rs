@@ -637,3 +637,96 @@ fn a_masked_2d_grid_is_smoothed_on_its_triangles_without_pinch_points_and_verifi
     let o = succeeds(&["verify", out.to_str().unwrap()]);
     assert!(text(&o).contains("inside a mask of"), "{}", text(&o));
 }
+
+/// A VTK fixture's path.
+fn vtk_fixture(name: &str) -> String {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/vtk").join(name).display().to_string()
+}
+
+/// The tetrahedra of a VTK dataset's cells (every cell must be one).
+fn tetra_of(ds: &toposmooth::io::vtk::Dataset) -> Vec<[usize; 4]> {
+    (0..ds.cells.len())
+        .map(|c| {
+            assert_eq!(ds.cells.types[c], 10, "cell {c} is no tetra");
+            let k = ds.cells.corners(c);
+            [k[0], k[1], k[2], k[3]]
+        })
+        .collect()
+}
+
+#[test]
+fn tetrahedral_vtk_meshes_are_smoothed_written_with_their_cells_and_verified() {
+    use toposmooth::io::vtk::{read_dataset, stage_vtu_cells, OutArray};
+    let dir = scratch("volume-tets");
+    for (input, name) in [("tets.ascii.vtu", "t.vtu"), ("tets.legacy-ugrid-binary-v51.vtk", "t.vtk")] {
+        let (src, out) = (vtk_fixture(input), dir.join(name));
+        let o = succeeds(&["smooth", &src, "--array", "f", "-o", out.to_str().unwrap()]);
+        assert!(text(&o).contains("tetrahedral mesh of 27 vertices, 40 tetrahedra"), "{}", text(&o));
+        let before = read_dataset(Path::new(&src)).unwrap();
+        let after = read_dataset(&out).unwrap();
+        // the input's cells and arrays go through as a VTK filter passes them
+        assert_eq!(
+            (after.cells.types.clone(), after.cells.connectivity.clone()),
+            (before.cells.types.clone(), before.cells.connectivity.clone()),
+            "{input}"
+        );
+        assert_eq!(after.points, before.points);
+        // … and the smoothed field takes the processed array's name, as a filter's output does
+        let s = stored(&out);
+        for a in &before.point_data {
+            let b = after.point_data.iter().find(|b| b.name == a.name).map(|b| &b.values);
+            let expected = if a.name == "f" { &s.smoothed } else { &a.values };
+            assert_eq!(b, Some(expected), "{input}: `{}`", a.name);
+        }
+        let tets = tetra_of(&after);
+        let (h, _, _) = tet_extrema(27, &tets, &before.point_data.iter().find(|a| a.name == "f").unwrap().values);
+        let (mins, maxs, flat) = tet_extrema(27, &tets, &s.smoothed);
+        assert!(flat.is_empty(), "{input}: {flat:?}");
+        assert_eq!(mins, (0..27).filter(|&v| s.roles[v] == Role::Min).collect::<Vec<_>>());
+        assert_eq!(maxs, (0..27).filter(|&v| s.roles[v] == Role::Max).collect::<Vec<_>>());
+        // the fixture's two minima: the shallower one is cancelled
+        assert_eq!((h.len(), mins.len(), maxs.len()), (2, 1, 1), "{input}");
+        let o = succeeds(&["verify", out.to_str().unwrap(), "--input", &src, "--array", "f"]);
+        assert!(text(&o).contains("certified") && text(&o).contains("input matches"), "{}", text(&o));
+    }
+    // a tampered output: one regular vertex dropped below everything is a new minimum
+    let out = dir.join("t.vtu");
+    let ds = read_dataset(&out).unwrap();
+    let s = stored(&out);
+    let v = (0..27).find(|&v| s.roles[v] == Role::Other).unwrap();
+    let mut smoothed = s.smoothed.clone();
+    smoothed[v] = s.smoothed.iter().copied().fold(f64::INFINITY, f64::min) - 1.0;
+    let codes: Vec<f64> = s.roles.iter().map(|r| f64::from(r.code())).collect();
+    let arrays = [
+        OutArray::float64("input", &s.input),
+        OutArray::float64("smoothed", &smoothed),
+        OutArray::float64("representative", &s.representative),
+        OutArray::float64("role", &codes),
+    ];
+    let bad = dir.join("tampered.vtu");
+    stage_vtu_cells(&bad, &ds.points, &ds.cells, (&arrays, &[]), None).unwrap().commit().unwrap();
+    let o = toposmooth(&["verify", bad.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(1), "{}", text(&o));
+    assert!(text(&o).contains("minim"), "{}", text(&o));
+    // a tetrahedral mesh has VTK outputs only; surface commands name what they need
+    let o = toposmooth(&[
+        "smooth",
+        &vtk_fixture("tets.ascii.vtu"),
+        "--array",
+        "f",
+        "-o",
+        dir.join("t.vtp").to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(2), "{}", text(&o));
+    assert!(text(&o).contains("the output of a tetrahedral mesh is written as .vtu, .vtk"), "{}", text(&o));
+    let o = toposmooth(&[
+        "geodesic",
+        &vtk_fixture("tets.ascii.vtu"),
+        "--source",
+        "0",
+        "-o",
+        dir.join("g.vtu").to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(3), "{}", text(&o));
+    assert!(text(&o).contains("tets.ascii.vtu") && text(&o).contains("needs a triangle surface"), "{}", text(&o));
+}

@@ -11,7 +11,7 @@ use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyType};
 use toposmooth::apps::weights::{WeightMethod, WeightSettings};
-use toposmooth::domain::{AnyDomain, Domain as _, Grid2d, Grid3d, Series, TriMesh};
+use toposmooth::domain::{AnyDomain, Domain as _, Grid2d, Grid3d, Series, TetMesh, TriMesh};
 use toposmooth::topology::{extrema_table, select, ExtremumKind, Role, Selection};
 use toposmooth::{
     AnySmoother, EdgeSet, Energy, Error, ErrorKind, Formulation, Method, QpSettings, RepresentativeChoice,
@@ -135,13 +135,46 @@ impl Domain {
         Ok(Domain { inner: AnyDomain::Mesh(mesh) })
     }
 
+    /// A tetrahedral mesh from `vertices` (n, 3) float64 and `tets` (m, 4) int64.
+    #[staticmethod]
+    fn tetrahedra(
+        py: Python<'_>,
+        vertices: PyReadonlyArray2<'_, f64>,
+        tets: PyReadonlyArray2<'_, i64>,
+    ) -> PyResult<Self> {
+        let (v, t) = (vertices.as_array(), tets.as_array());
+        if v.ncols() != 3 {
+            return Err(to_py(
+                py,
+                Error::input(format!("vertices of tetrahedra must have 3 columns, got {}", v.ncols())),
+            ));
+        }
+        if t.ncols() != 4 {
+            return Err(to_py(py, Error::input(format!("tetrahedra must have 4 columns, got {}", t.ncols()))));
+        }
+        let positions: Vec<[f64; 3]> = v.rows().into_iter().map(|r| [r[0], r[1], r[2]]).collect();
+        let n = positions.len() as i64;
+        let mut cells = Vec::with_capacity(t.nrows());
+        for (k, r) in t.rows().into_iter().enumerate() {
+            if let Some(&bad) = r.iter().find(|&&i| !(0..n).contains(&i)) {
+                return Err(to_py(
+                    py,
+                    Error::input(format!("tetrahedron {k} has vertex {bad}; the mesh has {n} vertices")),
+                ));
+            }
+            cells.push([r[0] as usize, r[1] as usize, r[2] as usize, r[3] as usize]);
+        }
+        let mesh = py.detach(|| TetMesh::new(positions, cells)).map_err(|e| to_py(py, e))?;
+        Ok(Domain { inner: AnyDomain::Tets(mesh) })
+    }
+
     /// Number of vertices (the length of a field on this domain).
     #[getter]
     fn n_vertices(&self) -> usize {
         self.inner.n_vertices()
     }
 
-    /// "series", "grid" or "mesh".
+    /// "series", "grid", "mesh", "volume" or "tetrahedra".
     #[getter]
     fn kind(&self) -> &'static str {
         match self.inner {
@@ -149,6 +182,7 @@ impl Domain {
             AnyDomain::Grid(_) => "grid",
             AnyDomain::Mesh(_) => "mesh",
             AnyDomain::Volume(_) => "volume",
+            AnyDomain::Tets(_) => "tetrahedra",
         }
     }
 
@@ -167,6 +201,9 @@ impl Domain {
                 g.spacing(),
                 g.origin()
             ),
+            AnyDomain::Tets(m) => {
+                format!("Domain.tetrahedra({} vertices, {} tetrahedra)", m.n_vertices(), m.tets().len())
+            }
         }
     }
 }
@@ -380,14 +417,7 @@ impl Smoother {
         let (inner, threads) = (&mut self.inner, self.threads);
         let out =
             py.detach(|| toposmooth::parallel::with_threads(threads, || inner.smooth(h))).map_err(|e| to_py(py, e))?;
-        let report = serde_json::to_string(&out.report).map_err(|e| to_py(py, Error::internal(e.to_string())))?;
-        let d = PyDict::new(py);
-        d.set_item("certified", out.report.certificate.passed)?;
-        d.set_item("roles", PyArray1::from_vec(py, role_codes(&out.roles)))?;
-        d.set_item("smoothed", PyArray1::from_vec(py, out.output))?;
-        d.set_item("representative", PyArray1::from_vec(py, out.u))?;
-        d.set_item("report", report)?;
-        Ok(d)
+        result_dict(py, out)
     }
 
     /// Number of vertices of the domain.
@@ -395,6 +425,60 @@ impl Smoother {
     fn n_vertices(&self) -> usize {
         self.inner.n_vertices()
     }
+}
+
+/// The result dict of a smoothing run (see [`Smoother::smooth`]).
+fn result_dict(py: Python<'_>, out: toposmooth::pipeline::Smoothed) -> PyResult<Bound<'_, PyDict>> {
+    let report = serde_json::to_string(&out.report).map_err(|e| to_py(py, Error::internal(e.to_string())))?;
+    let d = PyDict::new(py);
+    d.set_item("certified", out.report.certificate.passed)?;
+    d.set_item("roles", PyArray1::from_vec(py, role_codes(&out.roles)))?;
+    d.set_item("smoothed", PyArray1::from_vec(py, out.output))?;
+    d.set_item("representative", PyArray1::from_vec(py, out.u))?;
+    d.set_item("report", report)?;
+    Ok(d)
+}
+
+/// Smooths `h` on a grid or volume restricted to `mask` (true inside), as the CLI's `--mask`:
+/// the domain is the triangles (tetrahedra) with every corner inside; the outside comes back
+/// unchanged with role 0. The same dict as [`Smoother::smooth`].
+#[pyfunction]
+fn smooth_masked<'py>(
+    py: Python<'py>,
+    domain: &Domain,
+    settings: &Bound<'py, PyDict>,
+    h: PyReadonlyArray1<'py, f64>,
+    mask: PyReadonlyArray1<'py, bool>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let threads = threads(py, settings)?;
+    let settings = smooth_settings(py, settings)?;
+    // NaN outside the mask is background, as in the CLI: the pipeline checks the inside
+    let h = values(py, "values", &h)?;
+    if h.len() != domain.inner.n_vertices() {
+        let msg = format!("values has {} entries, the domain {} vertices", h.len(), domain.inner.n_vertices());
+        return Err(to_py(py, Error::input(msg)));
+    }
+    let inside = mask.as_slice().map_err(|_| usage(py, "mask must be a contiguous bool array".into()))?;
+    if inside.len() != h.len() {
+        return Err(to_py(py, Error::input(format!("mask has {} entries, the values {}", inside.len(), h.len()))));
+    }
+    let d = &domain.inner;
+    let out = py
+        .detach(|| {
+            toposmooth::parallel::with_threads(threads, || match d {
+                AnyDomain::Volume(g) => {
+                    let m = toposmooth::domain::MaskedVolume::new(g, inside)?;
+                    toposmooth::pipeline::smooth_masked(&m, h, &settings)
+                }
+                AnyDomain::Grid(g) => {
+                    let m = toposmooth::domain::MaskedGrid::new(g, inside)?;
+                    toposmooth::pipeline::smooth_masked_grid(&m, h, &settings)
+                }
+                _ => Err(Error::input("mask= is for grids and volumes (2-D and 3-D values)")),
+            })
+        })
+        .map_err(|e| to_py(py, e))?;
+    result_dict(py, out)
 }
 
 /// The extrema of `h` with their persistence: a dict of arrays `vertex`, `is_max`, `value`,
@@ -612,6 +696,10 @@ fn fill_missing<'py>(py: Python<'py>, domain: &Domain, h: PyReadonlyArray1<'py, 
                                 let k = toposmooth::operators::volume_stiffness(g);
                                 toposmooth::derive::fill_missing_with(&k, &mut v)?
                             }
+                            AnyDomain::Tets(m) => {
+                                let k = toposmooth::operators::positive_tet_stiffness(m.positions(), m.tets());
+                                toposmooth::derive::fill_missing_with(&k, &mut v)?
+                            }
                             AnyDomain::Series(_) => unreachable!("handled above"),
                         };
                     }
@@ -679,6 +767,7 @@ fn _toposmooth(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(geodesic, m)?)?;
     m.add_function(wrap_pyfunction!(weights, m)?)?;
     m.add_function(wrap_pyfunction!(fill_missing, m)?)?;
+    m.add_function(wrap_pyfunction!(smooth_masked, m)?)?;
     m.add_function(wrap_pyfunction!(resolve_handles, m)?)?;
     m.add_function(wrap_pyfunction!(run, m)?)?;
     m.add_function(wrap_pyfunction!(main, m)?)?;

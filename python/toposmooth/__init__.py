@@ -145,26 +145,37 @@ def _domain(
     h = _float64("values", values)
     if vertices is not None:
         if x is not None or spacing is not None or origin is not None:
-            raise UsageError("x=, spacing= and origin= are for series and grids, not meshes")
+            raise UsageError("x=, spacing= and origin= are for series, grids and volumes, not meshes")
         v = _float64("vertices", vertices, 2)
         f = np.ascontiguousarray(np.asarray(faces), dtype=np.int64)
-        if f.ndim != 2:
-            raise InputError(f"faces must be 2-D (m, 3), got shape {f.shape}")
+        if f.ndim != 2 or f.shape[1] not in (3, 4):
+            raise InputError(f"faces must be 2-D (m, 3) triangles or (m, 4) tetrahedra, got shape {f.shape}")
         if h.ndim != 1:
             raise InputError(f"values on a mesh must be 1-D (one per vertex), got shape {h.shape}")
+        if f.shape[1] == 4:
+            return _toposmooth.Domain.tetrahedra(v, f), h, h.shape
         return _toposmooth.Domain.mesh(v, f), h, h.shape
     if h.ndim == 1:
         if spacing is not None or origin is not None:
-            raise UsageError("spacing= and origin= are for grids (2-D values); a series takes x=")
+            raise UsageError("spacing= and origin= are for grids and volumes (2-D, 3-D values); a series takes x=")
         return _toposmooth.Domain.series(h.shape[0], _series_x(values, x)), h, h.shape
-    if h.ndim == 2:
-        if x is not None:
-            raise UsageError("x= is for series; a grid takes spacing=(dx, dy) and origin=(x0, y0)")
+    if x is not None:
+        raise UsageError("x= is for series; a grid or volume takes spacing= and origin=")
+    d = h.ndim
+    if d not in (2, 3):
+        raise InputError(
+            f"values must be 1-D (a series or a mesh field), 2-D (ny, nx) a grid or 3-D (nz, ny, nx) a volume, got shape {h.shape}"
+        )
+    for name, given in (("spacing", spacing), ("origin", origin)):
+        if given is not None and len(given) != d:
+            raise UsageError(f"{name}= has {len(given)} entries; {d}-D values take {d} (x first)")
+    step = [1.0] * d if spacing is None else [float(s) for s in spacing]
+    at = [0.0] * d if origin is None else [float(o) for o in origin]
+    if d == 2:
         ny, nx = h.shape
-        dx, dy = (1.0, 1.0) if spacing is None else (float(spacing[0]), float(spacing[1]))
-        x0, y0 = (0.0, 0.0) if origin is None else (float(origin[0]), float(origin[1]))
-        return _toposmooth.Domain.grid(nx, ny, [dx, dy], [x0, y0]), h.reshape(-1), h.shape
-    raise InputError(f"values must be 1-D (a series or a mesh field) or 2-D (a grid), got shape {h.shape}")
+        return _toposmooth.Domain.grid(nx, ny, step, at), h.reshape(-1), h.shape
+    nz, ny, nx = h.shape
+    return _toposmooth.Domain.volume(nx, ny, nz, step, at), h.reshape(-1), h.shape
 
 
 def _selection_kwargs(
@@ -262,7 +273,7 @@ class Smoother:
     Parameters
     ----------
     shape : tuple, optional
-        ``(n,)`` for a series, ``(ny, nx)`` for a grid; not for a mesh.
+        ``(n,)`` for a series, ``(ny, nx)`` for a grid, ``(nz, ny, nx)`` for a volume; not for a mesh.
     x, spacing, origin, vertices, faces
         As in :func:`smooth`.
     **settings
@@ -404,6 +415,7 @@ def smooth(
     edges: str = "minimal",
     representative: Optional[str] = None,
     fill_missing: bool = False,
+    mask: Any = None,
     max_iter: int = 200,
     solver: str = "auto",
     formulation: str = "auto",
@@ -415,19 +427,21 @@ def smooth(
     ----------
     values : array_like or pandas.Series
         Shape (n,): a series, or a field on a mesh's n vertices. Shape (ny, nx): a grid, row r
-        at y = y0 + r*dy. float64 is used without a copy when C-contiguous; float32 and
-        integers are converted.
+        at y = y0 + r*dy. Shape (nz, ny, nx): a volume, voxel [k, j, i] at
+        origin + (i*dx, j*dy, k*dz) (a NIfTI or VTK image's x fastest). float64 is used
+        without a copy when C-contiguous; float32 and integers are converted.
     x : array_like of shape (n,), optional
         Series coordinates, strictly increasing (default 0, 1, ...; a pandas Series' index:
         numbers, or dates as days since 1970-01-01).
-    spacing : (dx, dy), optional
-        Grid spacing (default (1, 1)); signs kept (dy < 0 for rows running downward).
-    origin : (x0, y0), optional
-        Coordinates of ``values[0, 0]`` (default (0, 0)).
+    spacing : (dx, dy) or (dx, dy, dz), optional
+        Grid or volume spacing (default 1); signs kept (dy < 0 for rows running downward).
+    origin : (x0, y0) or (x0, y0, z0), optional
+        Coordinates of ``values[0, 0]`` / ``values[0, 0, 0]`` (default 0).
     vertices : array_like of shape (n, 2) or (n, 3), optional
         Mesh vertex positions (with ``faces``).
-    faces : array_like of int, shape (m, 3), optional
-        Mesh triangles as vertex indices.
+    faces : array_like of int, shape (m, 3) or (m, 4), optional
+        Mesh triangles, or tetrahedra (a tetrahedral mesh; ``vertices`` (n, 3)), as vertex
+        indices.
     persistence : float or str, optional
         Keep the extrema of persistence >= this: a number in the field's units, or a
         percentage of the value range such as ``"5%"`` (the default rule, at 5 %).
@@ -456,6 +470,10 @@ def smooth(
     fill_missing : bool
         Fill NaN samples first (linearly on series, harmonically on grids and meshes), as
         the CLI's ``--fill-missing``; otherwise NaN is an :class:`InputError`.
+    mask : array_like of bool, optional
+        Grids and volumes: smooth only inside (True), as the CLI's ``--mask``: the domain is
+        the triangles (tetrahedra) with every corner inside, the outside comes back unchanged
+        with role 0, and NaN outside is background, not missing data.
     max_iter : int
         Largest number of solver iterations.
     solver : {"auto", "structured", "clarabel", "clarabel-auxiliary", "active-set"}
@@ -523,6 +541,19 @@ def smooth(
             threads=threads,
         )
     )
+    if mask is not None:
+        inside = np.asarray(mask)
+        if inside.shape != shape or len(shape) < 2:
+            raise InputError(f"mask has shape {inside.shape}; it must be the values' shape {shape} (a grid or volume)")
+        inside = np.ascontiguousarray(inside.reshape(-1) != 0)
+        filled = None
+        if fill_missing:
+            # only the inside is filled: NaN outside the mask is background
+            gaps = np.isnan(flat) & inside
+            if gaps.any():
+                raise UsageError("fill_missing= with mask=: give the mask without the NaN voxels, or fill first")
+        raw = _toposmooth.smooth_masked(domain, settings, flat, inside)
+        return SmoothResult(raw, shape, filled)
     flat, filled = _fill(domain, flat, fill_missing, settings)
     raw = _toposmooth.Smoother(domain, settings).smooth(flat)
     return SmoothResult(raw, shape, filled)

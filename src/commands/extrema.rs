@@ -81,6 +81,9 @@ fn place(field: &Field, i: usize) -> serde_json::Map<String, serde_json::Value> 
         AnyDomain::Mesh(mesh) => {
             m.insert("position".into(), json!(mesh.positions()[i]));
         }
+        AnyDomain::Tets(mesh) => {
+            m.insert("position".into(), json!(mesh.positions()[i]));
+        }
         AnyDomain::Volume(g) => {
             let ijk = g.ijk(i);
             m.insert("ijk".into(), json!(ijk));
@@ -115,8 +118,8 @@ fn label(field: &Field, i: usize) -> String {
             let (r, c) = g.row_col(i);
             format!("({r},{c})")
         }
-        AnyDomain::Mesh(m) => {
-            let p = m.positions()[i];
+        AnyDomain::Mesh(_) | AnyDomain::Tets(_) => {
+            let p = crate::with_domain!(&field.domain, d => d.point(i));
             format!("({},{},{})", sig6(p[0]), sig6(p[1]), sig6(p[2]))
         }
         AnyDomain::Volume(g) => {
@@ -134,7 +137,7 @@ fn list<D: Domain>(args: &ExtremaArgs, field: &Field, domain: &D) -> Result<Stri
     };
     let mesh = match &field.domain {
         AnyDomain::Mesh(m) => Some(format!("mesh of {}", m.describe())),
-        AnyDomain::Volume(_) => Some(field.domain.describe()),
+        AnyDomain::Volume(_) | AnyDomain::Tets(_) => Some(field.domain.describe()),
         _ => None,
     };
     let label = |i: usize| label(field, i);

@@ -3,12 +3,13 @@
 //! `--spacing`, `--derive` and `--fill-missing` applied.
 
 use crate::derive::{describe_missing, fill_missing, fill_missing_with, magnitude, vorticity};
-use crate::domain::{Domain, Grid2d, Grid3d, TriMesh};
+use crate::domain::{Grid2d, Grid3d};
 use crate::error::{Error, Result};
 use crate::io::export::Carried;
 use crate::io::grid::{raster_grid, read_grid_csv, read_raster, GridField};
 use crate::io::mesh::is_mesh_file;
 pub use crate::io::mesh::read_trimesh;
+use crate::io::mesh::AnyMesh;
 use crate::io::npy_input::{is_numpy, read_numpy, NumpyField, Wanted};
 use crate::io::series_csv::{read_series, SeriesCsv, SeriesCsvOptions};
 use crate::io::vtk::{read_any_image, AnyImage};
@@ -147,8 +148,8 @@ pub struct VolumeInput {
 /// A field on a triangle mesh, ready to smooth.
 #[derive(Clone, Debug)]
 pub struct MeshInput {
-    /// The validated mesh (orientation repaired where needed).
-    pub mesh: TriMesh,
+    /// The validated mesh (orientation repaired where needed): triangles, or tetrahedra.
+    pub mesh: crate::io::mesh::AnyMesh,
     /// The values to smooth.
     pub values: Vec<f64>,
     /// What the values are: the array read, the coordinate or the values file.
@@ -195,8 +196,8 @@ pub fn read_mesh_field(path: &Path, opts: &GridOptions) -> Result<MeshInput> {
     if opts.derive.is_some() || opts.uv.is_some() || opts.spacing.is_some() {
         return Err(Error::Usage(format!("{}: --derive, --u/--v and --spacing are for grids", path.display())));
     }
-    let (mesh, data) = read_trimesh(path)?;
-    let n = mesh.n_vertices();
+    let (mesh, data) = crate::io::mesh::read_any_mesh(path)?;
+    let n = data.positions.len();
     let (mut values, description, source): (Vec<f64>, String, PathBuf) = match (&opts.values, &opts.array) {
         (Some(_), Some(_)) => return Err(Error::Usage("give --values or --array, not both".into())),
         (Some(file), None) => {
@@ -260,7 +261,10 @@ pub fn read_mesh_field(path: &Path, opts: &GridOptions) -> Result<MeshInput> {
     let mut filled = None;
     if !bad.is_empty() {
         if opts.fill_missing && !infinite {
-            let k = crate::operators::positive_cotan_stiffness(mesh.positions(), mesh.faces());
+            let k = match &mesh {
+                AnyMesh::Tri(m) => crate::operators::positive_cotan_stiffness(m.positions(), m.faces()),
+                AnyMesh::Tet(m) => crate::operators::positive_tet_stiffness(m.positions(), m.tets()),
+            };
             crate::derive::fill_missing_with(&k, &mut values).map_err(|e| e.in_file(&source))?;
             let mut mask = vec![false; n];
             bad.iter().for_each(|&v| mask[v] = true);
@@ -278,7 +282,9 @@ pub fn read_mesh_field(path: &Path, opts: &GridOptions) -> Result<MeshInput> {
     }
     let mut notes = data.notes.clone();
     notes.extend(mesh.repairs().iter().cloned());
-    notes.extend(mesh.sliver_warning());
+    if let AnyMesh::Tri(m) = &mesh {
+        notes.extend(m.sliver_warning());
+    }
     // the field is the array of that name unless it came from a values file or a coordinate
     let source =
         (opts.values.is_none() && data.arrays.iter().any(|a| a.name == description)).then(|| description.clone());
@@ -1032,7 +1038,7 @@ impl FieldInput {
             },
             FieldInput::Mesh(m) => Field {
                 mask: None,
-                domain: AnyDomain::Mesh(m.mesh),
+                domain: m.mesh.into_domain(),
                 values: m.values,
                 path: m.path,
                 description: m.description,

@@ -41,6 +41,14 @@ enum DomainFacts<'a> {
         spacing: [f64; 3],
         origin: [f64; 3],
     },
+    Tets {
+        tetrahedra: usize,
+        components: usize,
+        boundary_triangles: usize,
+        euler_characteristic: i64,
+        volume: f64,
+        reading_notes: &'a [String],
+    },
 }
 
 /// The JSON report of a run: the files, the domain, the seconds around the pipeline's.
@@ -85,6 +93,11 @@ fn same_domain(a: &AnyDomain, b: &AnyDomain) -> bool {
             let bits =
                 |m: &crate::domain::TriMesh| m.positions().iter().flatten().map(|v| v.to_bits()).collect::<Vec<_>>();
             a.faces() == b.faces() && bits(a) == bits(b)
+        }
+        (AnyDomain::Tets(a), AnyDomain::Tets(b)) => {
+            let bits =
+                |m: &crate::domain::TetMesh| m.positions().iter().flatten().map(|v| v.to_bits()).collect::<Vec<_>>();
+            a.tets() == b.tets() && bits(a) == bits(b)
         }
         _ => false,
     }
@@ -358,6 +371,14 @@ fn facts(field: &Field, negative: usize) -> DomainFacts<'_> {
             reading_notes: &field.notes,
         },
         AnyDomain::Volume(g) => DomainFacts::Volume { dims: g.dims(), spacing: g.spacing(), origin: g.origin() },
+        AnyDomain::Tets(m) => DomainFacts::Tets {
+            tetrahedra: m.tets().len(),
+            components: m.n_components(),
+            boundary_triangles: m.boundary_faces().len(),
+            euler_characteristic: m.euler_characteristic(),
+            volume: m.volume(),
+            reading_notes: &field.notes,
+        },
     }
 }
 
@@ -381,6 +402,12 @@ fn read_line(field: &Field) -> String {
             g.ny(),
             g.nz(),
             g.n_vertices(),
+            field.description
+        ),
+        AnyDomain::Tets(m) => format!(
+            "{path}: tetrahedral mesh of {} vertices and {} tetrahedra, field `{}`",
+            m.n_vertices(),
+            m.tets().len(),
             field.description
         ),
     }
@@ -439,6 +466,12 @@ fn input_line(field: &Field, r: &Report, filled: usize, negative: usize) -> Stri
                 if filled > 0 { format!(", {filled} missing samples filled harmonically") } else { String::new() },
             )
         }
+        AnyDomain::Tets(m) => format!(
+            "{}{path}: {} on a tetrahedral mesh of {}; {extrema} (SoS, boundary included)\n",
+            if filled > 0 { format!("filled {filled} missing (NaN) values harmonically\n") } else { String::new() },
+            field.description,
+            m.describe(),
+        ),
     }
 }
 
@@ -508,6 +541,24 @@ fn stage_figure(path: &Path, args: &SmoothArgs, field: &Field, result: &Smoothed
                     p,
                     m.positions(),
                     m.faces(),
+                    &panels,
+                    &markers,
+                    &title,
+                    args.view,
+                    lo < 0.0 && hi > 0.0,
+                )?;
+                Ok(())
+            })?
+        }
+        AnyDomain::Tets(m) => {
+            // the boundary surface, shaded by the values at its vertices; kept extrema inside
+            // the mesh are counted as hidden
+            let markers = kept_markers(&result.roles);
+            stage_plot(path, |p| {
+                hidden = plot_mesh_fields(
+                    p,
+                    m.positions(),
+                    m.boundary_faces(),
                     &panels,
                     &markers,
                     &title,

@@ -1,6 +1,6 @@
 //! `toposmooth verify`: re-check an output file from what it carries, independently of `smooth`.
 
-use super::input::{read_field, read_trimesh, DomainKind, GridOptions};
+use super::input::{read_field, DomainKind, GridOptions};
 use crate::domain::{AnyDomain, Domain};
 use crate::error::{Error, Result};
 use crate::io::export::{read_results, results_on_mesh, Stored, MESH_OUTPUTS};
@@ -29,7 +29,11 @@ pub fn verify(args: &VerifyArgs) -> Result<String> {
     match ext.as_str() {
         // a legacy .vtk is a mesh's output or a grid's
         e if MESH_OUTPUTS.contains(&e) && (e != "vtk" || crate::io::mesh::is_mesh_file(&args.file)) => {
-            let (mesh, data) = read_trimesh(&args.file)?;
+            let (mesh, data) = crate::io::mesh::read_any_mesh(&args.file)?;
+            let mesh = match mesh {
+                crate::io::mesh::AnyMesh::Tri(m) => m,
+                tets => return verify_results(args, results_on_mesh(&args.file, tets.into_domain(), &data)?),
+            };
             if data.arrays.iter().any(|a| a.name.starts_with("weight_") && a.name.ends_with("_raw")) {
                 return verify_weights(args, &mesh, &data);
             }
@@ -39,7 +43,7 @@ pub fn verify(args: &VerifyArgs) -> Result<String> {
                     args.file.display()
                 )));
             }
-            verify_results(args, results_on_mesh(&args.file, mesh, &data)?)
+            verify_results(args, results_on_mesh(&args.file, AnyDomain::Mesh(mesh), &data)?)
         }
         "obj" | "off" if crate::io::mesh::is_mesh_file(&args.file) => Err(Error::Usage(format!(
             "{}: a mesh file holds no smoothing output; verify the .vtu, .vtp or .ply that `smooth` wrote",
@@ -196,7 +200,7 @@ fn compare_input(args: &VerifyArgs, orig: &Path, out: &Stored) -> Result<Option<
             }
             DomainKind::Grid
         }
-        AnyDomain::Mesh(_) => DomainKind::Mesh,
+        AnyDomain::Mesh(_) | AnyDomain::Tets(_) => DomainKind::Mesh,
     };
     let original = read_field(Some(orig), kind, &args.csv, &opts)?.into_field(orig)?;
     let (file, o) = (args.file.display(), orig.display());
@@ -205,6 +209,7 @@ fn compare_input(args: &VerifyArgs, orig: &Path, out: &Stored) -> Result<Option<
         (AnyDomain::Grid(a), AnyDomain::Grid(b)) => (a.nx(), a.ny()) == (b.nx(), b.ny()),
         (AnyDomain::Volume(a), AnyDomain::Volume(b)) => a.dims() == b.dims(),
         (AnyDomain::Mesh(a), AnyDomain::Mesh(b)) => a.n_vertices() == b.n_vertices() && a.faces() == b.faces(),
+        (AnyDomain::Tets(a), AnyDomain::Tets(b)) => a.n_vertices() == b.n_vertices() && a.tets() == b.tets(),
         _ => false,
     };
     if !same {

@@ -1,6 +1,6 @@
 //! A domain chosen at run time: what a file holds, a command runs on, or a binding passes.
 
-use super::{Domain, Grid2d, Grid3d, Series, TriMesh};
+use super::{Domain, Grid2d, Grid3d, Series, TetMesh, TriMesh};
 
 /// A domain chosen at run time.
 #[derive(Clone, Debug)]
@@ -13,6 +13,8 @@ pub enum AnyDomain {
     Mesh(TriMesh),
     /// An implicit volume grid.
     Volume(Grid3d),
+    /// A tetrahedral mesh.
+    Tets(TetMesh),
 }
 
 /// Runs `$body` with `$d` bound to the concrete domain inside an [`AnyDomain`] (every
@@ -31,6 +33,7 @@ macro_rules! with_domain {
             $crate::domain::AnyDomain::Grid($d) => $body,
             $crate::domain::AnyDomain::Mesh($d) => $body,
             $crate::domain::AnyDomain::Volume($d) => $body,
+            $crate::domain::AnyDomain::Tets($d) => $body,
         }
     };
 }
@@ -49,7 +52,7 @@ impl AnyDomain {
                 let (r, c) = g.row_col(v);
                 format!("(row {r}, column {c})")
             }
-            AnyDomain::Mesh(_) => format!("vertex {v}"),
+            AnyDomain::Mesh(_) | AnyDomain::Tets(_) => format!("vertex {v}"),
             AnyDomain::Volume(g) => {
                 let [i, j, k] = g.ijk(v);
                 format!("(i {i}, j {j}, k {k})")
@@ -64,6 +67,7 @@ impl AnyDomain {
             AnyDomain::Grid(g) => format!("{} × {} grid", g.nx(), g.ny()),
             AnyDomain::Mesh(m) => format!("mesh of {}", m.describe()),
             AnyDomain::Volume(g) => format!("{} × {} × {} volume", g.nx(), g.ny(), g.nz()),
+            AnyDomain::Tets(m) => format!("tetrahedral mesh of {}", m.describe()),
         }
     }
 }

@@ -4,12 +4,12 @@
 //! critical points and separatrices become VTK PolyData.
 
 use super::grid::stage_grid_csv;
-use super::mesh::{read_trimesh, stage_ply, MeshData};
+use super::mesh::{stage_ply, MeshData};
 use super::npz::{read_npz_nd, stage_npy, stage_npy_shaped, stage_npz, stage_npz_shaped};
 use super::series_csv::{read_series_output, stage_series_output, SeriesOutput};
 use super::vtk::{
     read_any_image, read_dataset, stage_legacy, stage_vti_arrays, stage_vtp, stage_vtp_cells, stage_vtu_cells,
-    triangle_cells, AnyImage, Cells, ImageBox, LegacyGeometry, OutArray, PointArray, PolyData, Scalar,
+    tet_cells, triangle_cells, AnyImage, Cells, ImageBox, LegacyGeometry, OutArray, PointArray, PolyData, Scalar,
 };
 use super::Staged;
 use crate::domain::{AnyDomain, Domain, Grid2d, Grid3d, Series, TriMesh};
@@ -24,6 +24,8 @@ pub const SERIES_OUTPUTS: &[&str] = &["csv"];
 pub const GRID_OUTPUTS: &[&str] = &["vti", "vtk", "npz", "npy", "csv"];
 /// Extensions of a mesh's output.
 pub const MESH_OUTPUTS: &[&str] = &["vtu", "vtp", "vtk", "ply"];
+/// Extensions of a tetrahedral mesh's output (VTK unstructured grids).
+pub const TET_OUTPUTS: &[&str] = &["vtu", "vtk"];
 /// Extensions of a volume's output (`.npy` and NIfTI hold the smoothed array only; `.npy` of
 /// shape (nz, ny, nx)).
 pub const VOLUME_OUTPUTS: &[&str] = &["vti", "vtk", "npz", "npy", "nii", "nii.gz"];
@@ -52,7 +54,7 @@ fn format_of(path: &Path, domain: &AnyDomain) -> String {
     match domain {
         AnyDomain::Series(_) => "csv".into(),
         AnyDomain::Grid(_) | AnyDomain::Volume(_) => "npy".into(),
-        AnyDomain::Mesh(_) => e,
+        AnyDomain::Mesh(_) | AnyDomain::Tets(_) => e,
     }
 }
 
@@ -63,6 +65,7 @@ fn formats(domain: &AnyDomain) -> (&'static [&'static str], &'static str) {
         AnyDomain::Grid(_) => (GRID_OUTPUTS, "a grid"),
         AnyDomain::Mesh(_) => (MESH_OUTPUTS, "a mesh"),
         AnyDomain::Volume(_) => (VOLUME_OUTPUTS, "a volume"),
+        AnyDomain::Tets(_) => (TET_OUTPUTS, "a tetrahedral mesh"),
     }
 }
 
@@ -114,8 +117,11 @@ pub fn check_complex_output(path: &Path, domain: &AnyDomain) -> Result<()> {
     if let AnyDomain::Series(_) = domain {
         return Err(Error::setting("complex", "is for grids and meshes (a series has no separatrices)"));
     }
-    if let AnyDomain::Volume(_) = domain {
-        return Err(Error::setting("complex", "is for grids and triangle meshes: volumes have no complex yet"));
+    if let AnyDomain::Volume(_) | AnyDomain::Tets(_) = domain {
+        return Err(Error::setting(
+            "complex",
+            "is for grids and triangle meshes: volumes and tetrahedral meshes have no complex yet",
+        ));
     }
     check_extension(path, &["vtp"], "the complex")
 }
@@ -310,6 +316,25 @@ pub fn stage_results(
             }
             _ => stage_mesh(path, m, &arrays),
         },
+        AnyDomain::Tets(m) => {
+            let plan = vtk_point_plan(&arrays, r.carried, r.output_array);
+            let point = planned(&plan, &arrays, r.smoothed, r.carried);
+            let tetra;
+            let (cells, cell_arrays) = match r.carried.and_then(|c| c.cells.as_ref()) {
+                Some(cells) => (cells, carried_cells(r.carried)),
+                None => {
+                    tetra = tet_cells(m.tets());
+                    (&tetra, Vec::new())
+                }
+            };
+            let active = Some(active_of(&plan));
+            if extension(path) == "vtu" {
+                stage_vtu_cells(path, m.positions(), cells, (&point, &cell_arrays), active)
+            } else {
+                let geometry = LegacyGeometry::Unstructured { points: m.positions(), cells };
+                stage_legacy(path, &geometry, (&point, &cell_arrays), active)
+            }
+        }
         AnyDomain::Volume(g) => match format_of(path, domain).as_str() {
             e @ ("vti" | "vtk") => {
                 let plan = vtk_point_plan(&arrays, r.carried, r.output_array);
@@ -516,6 +541,7 @@ pub fn stage_complex(path: &Path, domain: &AnyDomain, h: &[f64], roles: &[Role],
         AnyDomain::Grid(g) => grid_point(g, v),
         AnyDomain::Mesh(m) => m.point(v),
         AnyDomain::Volume(g) => g.world(v),
+        AnyDomain::Tets(m) => m.point(v),
     };
     // each vertex's critical type and diagram pair (the first pair that names it)
     let mut critical_of: std::collections::BTreeMap<usize, (i32, usize)> = std::collections::BTreeMap::new();
@@ -660,8 +686,8 @@ pub fn read_results(path: &Path) -> Result<Stored> {
             stored(path, domain, names, arrays.into_iter().map(|(n, _, v)| (n, v)).collect())
         }
         e if MESH_OUTPUTS.contains(&e) => {
-            let (mesh, data) = read_trimesh(path)?;
-            results_on_mesh(path, mesh, &data)
+            let (mesh, data) = super::mesh::read_any_mesh(path)?;
+            results_on_mesh(path, mesh.into_domain(), &data)
         }
         _ => {
             let out = read_series_output(path)?;
@@ -683,7 +709,7 @@ pub fn read_results(path: &Path) -> Result<Stored> {
 ///
 /// # Errors
 /// As [`read_results`]; an array that is not one scalar per vertex.
-pub fn results_on_mesh(path: &Path, mesh: TriMesh, data: &MeshData) -> Result<Stored> {
+pub fn results_on_mesh(path: &Path, mesh: AnyDomain, data: &MeshData) -> Result<Stored> {
     let n = mesh.n_vertices();
     let mut arrays = Vec::new();
     for a in data.arrays.iter().filter(|a| VERIFIABLE.contains(&a.name.as_str())) {
@@ -699,7 +725,7 @@ pub fn results_on_mesh(path: &Path, mesh: TriMesh, data: &MeshData) -> Result<St
         arrays.push((a.name.clone(), a.values.clone()));
     }
     let names = data.arrays.iter().map(|a| a.name.clone()).collect();
-    stored(path, AnyDomain::Mesh(mesh), names, arrays)
+    stored(path, mesh, names, arrays)
 }
 
 /// The arrays a verifiable output holds.

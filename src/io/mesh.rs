@@ -19,6 +19,9 @@ pub struct MeshData {
     pub positions: Vec<[f64; 3]>,
     /// Triangles (0-based vertex indices, not yet validated).
     pub triangles: Vec<[usize; 3]>,
+    /// Tetrahedra (VTK tetra cells; 0-based, not yet validated). A file with tetrahedra is a
+    /// tetrahedral mesh: its triangles, lines and vertex cells are carried, not smoothed on.
+    pub tets: Vec<[usize; 4]>,
     /// Per-vertex arrays found in the file.
     pub arrays: Vec<PointArray>,
     /// What reading did to the data (fan triangulation of polygons, dropped cells).
@@ -30,12 +33,21 @@ pub struct MeshData {
     pub cell_arrays: Vec<PointArray>,
 }
 
-/// Reads a mesh and validates it.
+/// Reads a triangle mesh and validates it.
 ///
 /// # Errors
-/// Input errors naming the file.
+/// Input errors naming the file; a file of tetrahedra (the command needs a surface).
 pub fn read_trimesh(path: &Path) -> Result<(crate::domain::TriMesh, MeshData)> {
     let mut data = read_mesh(path)?;
+    if !data.tets.is_empty() {
+        return Err(input(
+            path,
+            format!(
+                "the file holds {} tetrahedra: this command needs a triangle surface (`smooth` and `verify` take tetrahedral meshes)",
+                data.tets.len()
+            ),
+        ));
+    }
     // the triangles move into the mesh; the positions stay for `MeshData::array("x")`
     let triangles = std::mem::take(&mut data.triangles);
     let mesh = crate::domain::TriMesh::new(data.positions.clone(), triangles).map_err(|e| e.in_file(path))?;
@@ -70,6 +82,49 @@ impl MeshData {
 
 fn input(path: &Path, msg: impl Into<String>) -> Error {
     Error::input(msg).in_file(path)
+}
+
+/// A mesh as read: a triangle surface or, when the file holds tetra cells, a tetrahedral mesh.
+#[derive(Clone, Debug)]
+pub enum AnyMesh {
+    /// Triangles.
+    Tri(crate::domain::TriMesh),
+    /// Tetrahedra.
+    Tet(crate::domain::TetMesh),
+}
+
+impl AnyMesh {
+    /// The mesh as a run-time domain.
+    pub fn into_domain(self) -> crate::domain::AnyDomain {
+        match self {
+            AnyMesh::Tri(m) => crate::domain::AnyDomain::Mesh(m),
+            AnyMesh::Tet(m) => crate::domain::AnyDomain::Tets(m),
+        }
+    }
+
+    /// What validation repaired (reoriented triangles or tetrahedra).
+    pub fn repairs(&self) -> &[String] {
+        match self {
+            AnyMesh::Tri(m) => m.repairs(),
+            AnyMesh::Tet(m) => m.repairs(),
+        }
+    }
+}
+
+/// Reads a triangle or tetrahedral mesh (VTK files with tetra cells) and validates it.
+///
+/// # Errors
+/// Input errors naming the file.
+pub fn read_any_mesh(path: &Path) -> Result<(AnyMesh, MeshData)> {
+    let mut data = read_mesh(path)?;
+    if data.tets.is_empty() {
+        let triangles = std::mem::take(&mut data.triangles);
+        let mesh = crate::domain::TriMesh::new(data.positions.clone(), triangles).map_err(|e| e.in_file(path))?;
+        return Ok((AnyMesh::Tri(mesh), data));
+    }
+    let tets = std::mem::take(&mut data.tets);
+    let mesh = crate::domain::TetMesh::new(data.positions.clone(), tets).map_err(|e| e.in_file(path))?;
+    Ok((AnyMesh::Tet(mesh), data))
 }
 
 /// Which reader a path goes to, by extension.
@@ -117,10 +172,16 @@ pub fn read_mesh(path: &Path) -> Result<MeshData> {
         "vtu" | "vtp" | "vtk" => read_vtk(&bytes),
         other => Err(Error::input(format!("`.{other}` is not a mesh format (obj, off, ply, vtu, vtp, vtk)"))),
     })?;
-    if data.triangles.is_empty() {
+    if data.triangles.is_empty() && data.tets.is_empty() {
         return Err(input(path, "the file holds no triangle"));
     }
     let n = data.positions.len();
+    if let Some((t, tet)) = data.tets.iter().enumerate().find(|(_, t)| t.iter().any(|&v| v >= n)) {
+        return Err(input(
+            path,
+            format!("tetrahedron {t} refers to vertex {} but there are {n} vertices", tet.iter().max().unwrap_or(&0)),
+        ));
+    }
     if let Some((t, tri)) = data.triangles.iter().enumerate().find(|(_, t)| t.iter().any(|&v| v >= n)) {
         return Err(input(
             path,
@@ -439,17 +500,29 @@ fn read_vtk(bytes: &[u8]) -> Result<MeshData> {
             }
             cell::TRIANGLE_STRIP => strip(corners, &mut data.triangles),
             cell::VERTEX | cell::POLY_VERTEX | cell::LINE | cell::POLY_LINE => dropped += 1,
+            cell::TETRA => match corners {
+                &[a, b, c, d] => data.tets.push([a, b, c, d]),
+                _ => return Err(Error::input(format!("cell {c} is a tetrahedron with {} corners", corners.len()))),
+            },
             other => {
                 return Err(Error::input(format!(
-                    "cell {c} is a {} cell: only surface cells (triangles, quads, polygons, strips) are supported",
+                    "cell {c} is a {} cell: only surface cells (triangles, quads, polygons, strips) and tetrahedra are supported",
                     cell::name(other)
                 )))
             }
         }
     }
+    if !data.tets.is_empty() {
+        // a tetrahedral mesh: its surface cells (a mesher's boundary triangles) are carried
+        // through to VTK outputs but not smoothed on
+        data.triangles.clear();
+        dropped = ds.cells.len() - data.tets.len();
+        split = 0;
+    }
     polygon_note(split, &mut data.notes);
     if dropped > 0 {
-        data.notes.push(format!("{dropped} vertex and line cells ignored"));
+        let what = if data.tets.is_empty() { "vertex and line cells" } else { "cells other than tetrahedra" };
+        data.notes.push(format!("{dropped} {what} ignored"));
     }
     data.cells = Some(ds.cells);
     data.cell_arrays = ds.cell_data;

@@ -174,6 +174,7 @@ pub fn diagram_from_table(domain: &AnyDomain, h: &[f64], table: &[ExtremumInfo])
         AnyDomain::Grid(d) => diagram_pairs(d, h, table, true),
         AnyDomain::Mesh(d) => diagram_pairs(d, h, table, true),
         AnyDomain::Volume(d) => diagram_pairs(d, h, table, true),
+        AnyDomain::Tets(d) => diagram_pairs(d, h, table, true),
     }
 }
 

@@ -25,8 +25,8 @@ pub use collection::{read_pvd, stage_pvd, CollectionEntry};
 pub use data::{cell, AnyImage, Cells, Dataset, ImageData, ImageGeometry, PointArray, Scalar, VolumeData};
 pub use legacy_write::{stage_legacy, LegacyGeometry};
 pub use write::{
-    stage_vti, stage_vti_arrays, stage_vtp, stage_vtp_cells, stage_vtu, stage_vtu_cells, triangle_cells, ImageBox,
-    OutArray, PolyData,
+    stage_vti, stage_vti_arrays, stage_vtp, stage_vtp_cells, stage_vtu, stage_vtu_cells, tet_cells, triangle_cells,
+    ImageBox, OutArray, PolyData,
 };
 
 use crate::error::{Error, Result};

@@ -131,6 +131,9 @@ cases = [
     ("types.ascii.vtp", ["vtp", "vtu", "vtk"]),
     ("surf.binary-zlib-u64.vtu", ["vtu", "vtp", "vtk"]),
     ("surf.legacy-ugrid-binary-v51.vtk", ["vtu", "vtk"]),
+    # tetrahedral meshes: the tetra cells and their arrays go through
+    ("tets.ascii.vtu", ["vtu", "vtk"]),
+    ("tets.legacy-ugrid-binary-v51.vtk", ["vtu", "vtk"]),
 ]
 for name, outputs in cases:
     inp = os.path.join(FIXTURES, name)
@@ -142,6 +145,11 @@ for name, outputs in cases:
         if run("smooth", inp, "--array", "f", "--persistence", "20%", "-o", out):
             check_smoothed(inp, out, "f")
             run("verify", out)
+            if name.startswith("tets"):
+                res, _ = read(out)
+                types = {res.GetCellType(c) for c in range(res.GetNumberOfCells())}
+                if types != {vtk.VTK_TETRA}:
+                    fail(out, f"cell types {types}, not tetrahedra only")
 
 # the other writers: the complex, geodesic distance, weights
 karman = os.path.join(DATASETS, "karman_vortex_street_ttk_example1.vti")

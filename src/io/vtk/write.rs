@@ -332,6 +332,15 @@ pub fn triangle_cells(triangles: &[[usize; 3]]) -> Cells {
     }
 }
 
+/// Tetrahedra as cells.
+pub fn tet_cells(tets: &[[usize; 4]]) -> Cells {
+    Cells {
+        types: vec![cell::TETRA; tets.len()],
+        offsets: (0..=tets.len()).map(|k| 4 * k).collect(),
+        connectivity: tets.iter().flatten().copied().collect(),
+    }
+}
+
 /// Checks the points and the cells' corners.
 fn check_geometry(path: &Path, points: &[[f64; 3]], cells: &Cells) -> Result<()> {
     let n = points.len();

@@ -730,3 +730,66 @@ fn tetrahedral_vtk_meshes_are_smoothed_written_with_their_cells_and_verified() {
     assert_eq!(o.status.code(), Some(3), "{}", text(&o));
     assert!(text(&o).contains("tets.ascii.vtu") && text(&o).contains("needs a triangle surface"), "{}", text(&o));
 }
+
+#[test]
+fn plots_show_a_volume_s_three_slices_and_a_tetrahedral_mesh_s_boundary() {
+    let dir = scratch("volume-plots");
+    let (vol, png) = (dir.join("t1.vti"), dir.join("t1.png"));
+    let t1 = dataset("mri_anatomical_33x41x25.vti");
+    let o = succeeds(&[
+        "smooth",
+        &t1,
+        "--persistence",
+        "20%",
+        "-o",
+        vol.to_str().unwrap(),
+        "--plot",
+        png.to_str().unwrap(),
+    ]);
+    assert!(text(&o).contains("certified:"), "{}", text(&o));
+    let img = image::open(&png).unwrap();
+    // three rows of two panels: taller than a single row of the same panels
+    assert!(img.height() > img.width(), "{}×{}", img.width(), img.height());
+    let png = dir.join("tets.png");
+    succeeds(&[
+        "smooth",
+        &vtk_fixture("tets.ascii.vtu"),
+        "--array",
+        "f",
+        "-o",
+        dir.join("t.vtu").to_str().unwrap(),
+        "--plot",
+        png.to_str().unwrap(),
+    ]);
+    assert!(image::open(&png).unwrap().width() > 400);
+}
+
+#[test]
+fn the_bundled_spot_tetrahedral_mesh_is_smoothed_certified_and_verified() {
+    let dir = scratch("volume-spot");
+    let src = dataset("spot_tets.vtu");
+    let ds = toposmooth::io::vtk::read_dataset(Path::new(&src)).unwrap();
+    let tets = tetra_of(&ds);
+    let n = ds.points.len();
+    let h = &ds.point_data.iter().find(|a| a.name == "f").unwrap().values;
+    let (m0, x0, _) = tet_extrema(n, &tets, h);
+    assert!(m0.len() > 50 && x0.len() > 50, "{} minima, {} maxima in the noisy input", m0.len(), x0.len());
+    for (args, want) in [(vec![], None), (vec!["--minima", "3", "--maxima", "2"], Some((3, 2)))] {
+        let out = dir.join("spot.vtu");
+        let mut all = vec!["smooth", src.as_str(), "-o", out.to_str().unwrap()];
+        all.extend(args);
+        let o = succeeds(&all);
+        let s = stored(&out);
+        let (mins, maxs, flat) = tet_extrema(n, &tets, &s.smoothed);
+        assert!(flat.is_empty(), "{}", text(&o));
+        assert_eq!(mins, (0..n).filter(|&v| s.roles[v] == Role::Min).collect::<Vec<_>>());
+        assert_eq!(maxs, (0..n).filter(|&v| s.roles[v] == Role::Max).collect::<Vec<_>>());
+        if let Some(w) = want {
+            assert_eq!((mins.len(), maxs.len()), w);
+        }
+        for &v in mins.iter().chain(&maxs) {
+            assert_eq!(s.smoothed[v], h[v]);
+        }
+        succeeds(&["verify", out.to_str().unwrap(), "--input", &src]);
+    }
+}

@@ -143,9 +143,6 @@ pub(super) fn smooth_shared(args: &SmoothArgs, shared: Option<&mut Option<Shared
             field.path.display()
         )));
     }
-    if args.plot.is_some() && matches!(field.domain, AnyDomain::Volume(_)) {
-        return Err(Error::setting("plot", "is not drawn for volumes yet (write a .vti and open it in ParaView)"));
-    }
     if args.grid.mask.is_some() && !matches!(field.domain, AnyDomain::Grid(_) | AnyDomain::Volume(_)) {
         return Err(Error::Usage(format!(
             "{}: --mask and --mask-below restrict grids and volumes; this input is {}",
@@ -530,6 +527,8 @@ fn stage_figure(path: &Path, args: &SmoothArgs, field: &Field, result: &Smoothed
                 diverging: lo < 0.0 && hi > 0.0,
                 origin: g.origin(),
                 spacing: g.spacing(),
+                range: None,
+                axes: ["x", "y"],
             };
             let markers = kept_markers(&result.roles);
             stage_plot(path, |p| plot_grid_fields(p, g.nx(), g.ny(), &panels, &markers, &title, &options))?
@@ -568,8 +567,19 @@ fn stage_figure(path: &Path, args: &SmoothArgs, field: &Field, result: &Smoothed
                 Ok(())
             })?
         }
-        AnyDomain::Volume(_) => {
-            return Err(Error::setting("plot", "is not drawn for volumes yet (write a .vti and open it in ParaView)"))
+        AnyDomain::Volume(g) => {
+            let markers = kept_markers(&result.roles);
+            let plot = crate::plot::VolumePlot {
+                dims: g.dims(),
+                spacing: g.spacing(),
+                origin: g.origin(),
+                panels: &panels,
+                markers: &markers,
+                title: &title,
+                isolines: args.isolines,
+                diverging: lo < 0.0 && hi > 0.0,
+            };
+            stage_plot(path, |p| crate::plot::plot_volume_slices(p, &plot))?
         }
     };
     Ok((staged, hidden))

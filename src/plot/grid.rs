@@ -51,11 +51,23 @@ pub struct GridPlotOptions {
     /// Spacing (dx, dy), signs kept: vertex (r, c) lies at `origin + (c·dx, r·dy)`. The cells
     /// are drawn |dy| / |dx| as tall as wide, so that the picture is not distorted.
     pub spacing: [f64; 2],
+    /// The colour scale's range instead of the panels' own (figures of several plots that
+    /// share one scale, such as a volume's slices); a diverging map takes its largest |value|.
+    pub range: Option<[f64; 2]>,
+    /// The names of the horizontal and vertical axes (a volume's slices: `x`/`z`, `y`/`z`).
+    pub axes: [&'static str; 2],
 }
 
 impl Default for GridPlotOptions {
     fn default() -> Self {
-        GridPlotOptions { isolines: 0, diverging: false, origin: [0.0, 0.0], spacing: [1.0, 1.0] }
+        GridPlotOptions {
+            isolines: 0,
+            diverging: false,
+            origin: [0.0, 0.0],
+            spacing: [1.0, 1.0],
+            range: None,
+            axes: ["x", "y"],
+        }
     }
 }
 
@@ -263,8 +275,11 @@ pub(super) struct Scale {
 impl Scale {
     /// The scale over all panels' finite values: symmetric about 0 if `diverging`, widened around
     /// a constant, 0..1 if there is no finite value.
-    pub(super) fn new(panels: &[GridPanel], diverging: bool) -> Scale {
-        let (lo, hi) = min_max(panels.iter().flat_map(|p| p.values.iter().copied()));
+    pub(super) fn new(panels: &[GridPanel], diverging: bool, range: Option<[f64; 2]>) -> Scale {
+        let (lo, hi) = match range {
+            Some([lo, hi]) => (lo, hi),
+            None => min_max(panels.iter().flat_map(|p| p.values.iter().copied())),
+        };
         if diverging {
             let m = lo.abs().max(hi.abs());
             let m = if m > 0.0 && m.is_finite() { m } else { 1.0 };
@@ -400,7 +415,7 @@ pub fn plot_grid_fields(
         return Err(fail(&format!("grid origin {o:?} and spacing {d:?} do not give finite, non-degenerate cells")));
     }
     let layout = Layout::new(nx, ny, panels.len(), aspect);
-    let scale = Scale::new(panels, options.diverging);
+    let scale = Scale::new(panels, options.diverging, options.range);
     let n_lev = options.isolines;
     let levels: Vec<f64> =
         (1..=n_lev).map(|k| scale.lo + (scale.hi - scale.lo) * k as f64 / (n_lev + 1) as f64).collect();
@@ -417,7 +432,7 @@ pub fn plot_grid_fields(
             let buf = heat_map(panel.values, &view, layout.panel, &scale);
             root.draw(&BitMapElement::with_owned_buffer((x0, y0), layout.panel, buf).ok_or("heat map buffer")?)?;
             root.draw(&Rectangle::new([(x0 - 1, y0 - 1), (x0 + pw as i32, y0 + ph as i32)], BLACK))?;
-            draw_axes(root, &view, (x0, y0), layout.panel)?;
+            draw_axes(root, &view, (x0, y0), layout.panel, options.axes)?;
             let at = |(x, y): (f64, f64)| (x0 + x.round() as i32, y0 + y.round() as i32);
             let line = ISOLINE.stroke_width(1);
             for (a, b) in contour_segments(panel.values, &view, layout.panel, &levels) {
@@ -464,7 +479,13 @@ fn axis_marks(view: &View, k: usize, size: (u32, u32)) -> Vec<(i32, String)> {
 
 /// Draws the x axis below and the y axis left of the panel whose heat map's top-left pixel is
 /// `(x0, y0)` and size `(pw, ph)`: ticks and labels from [`axis_marks`], and the axis names.
-fn draw_axes(root: &Area<'_>, view: &View, (x0, y0): (i32, i32), (pw, ph): (u32, u32)) -> Result<(), Box<dyn Error>> {
+fn draw_axes(
+    root: &Area<'_>,
+    view: &View,
+    (x0, y0): (i32, i32),
+    (pw, ph): (u32, u32),
+    [across, up]: [&str; 2],
+) -> Result<(), Box<dyn Error>> {
     let style = |h: HPos, v: VPos| TextStyle::from((FONT, 14.0).into_font()).pos(Pos::new(h, v));
     let (bottom, left) = (y0 + ph as i32, x0 - 1);
     for (x, label) in axis_marks(view, 0, (pw, ph)) {
@@ -472,13 +493,13 @@ fn draw_axes(root: &Area<'_>, view: &View, (x0, y0): (i32, i32), (pw, ph): (u32,
         root.draw(&Text::new(label, (x0 + x, bottom + 7), style(HPos::Center, VPos::Top)))?;
     }
     let name = (x0 + pw as i32 / 2, bottom + AXIS_H as i32 - 4);
-    root.draw(&Text::new("x", name, style(HPos::Center, VPos::Bottom)))?;
+    root.draw(&Text::new(across, name, style(HPos::Center, VPos::Bottom)))?;
     for (y, label) in axis_marks(view, 1, (pw, ph)) {
         root.draw(&PathElement::new(vec![(left - 5, y0 + y), (left, y0 + y)], BLACK))?;
         root.draw(&Text::new(label, (left - 7, y0 + y), style(HPos::Right, VPos::Center)))?;
     }
     let name = (x0 - AXIS_W as i32 + 2, y0 + ph as i32 / 2);
-    root.draw(&Text::new("y", name, style(HPos::Left, VPos::Center)))?;
+    root.draw(&Text::new(up, name, style(HPos::Left, VPos::Center)))?;
     Ok(())
 }
 

@@ -156,7 +156,7 @@ pub fn plot_mesh_fields(
     if !(view.azimuth.is_finite() && view.elevation.is_finite()) {
         return Err(fail("the view angles must be finite"));
     }
-    let scale = Scale::new(panels, diverging);
+    let scale = Scale::new(panels, diverging, None);
     let (screen, towards) = project(positions, view);
     let k = panels.len() as u32;
     let size = (2 * MARGIN + k * PANEL + (k - 1) * GAP + BAR_ROOM, TITLE_H + PANEL_TITLE_H + PANEL + MARGIN);

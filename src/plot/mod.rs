@@ -16,9 +16,11 @@ use std::sync::OnceLock;
 mod grid;
 mod mesh;
 mod triangulation;
+mod volume;
 pub use grid::{plot_grid_fields, GridMarker, GridPanel, GridPlotOptions};
 pub use mesh::{plot_mesh_colours, plot_mesh_fields, MeshView};
 pub use triangulation::plot_triangulation;
+pub use volume::{plot_volume_slices, VolumePlot};
 
 /// Error of a plot: carries a message.
 #[derive(Debug, thiserror::Error)]

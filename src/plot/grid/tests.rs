@@ -137,7 +137,7 @@ fn grid_wide_stacks_panels() {
     let d = plot("wide", nx, ny, &panels, &markers, &GridPlotOptions::default());
     assert_eq!((d.l.size, d.l.panel, d.l.stacked), ((1789, 614), (1539, 195), true));
     assert!(d.l.origin(1).1 > d.l.origin(0).1 + 195 && d.l.origin(1).0 == d.l.origin(0).0);
-    let scale = Scale::new(&panels, false);
+    let scale = Scale::new(&panels, false, None);
     let (x0, y0) = d.l.origin(0);
     let rgb = |v: f64| {
         let c = scale.colour(v);
@@ -191,7 +191,7 @@ fn grid_constant_and_degenerate() {
         let d = plot("constant", nx, ny, &[panel("c", &constant)], &m, &opts);
         assert_eq!((d.l.panel, d.l.stacked), ((400, 400), false));
         assert!(reddish(d.at_cell(0, 210)));
-        let c = Scale::new(&[panel("c", &constant)], diverging).colour(5.0);
+        let c = Scale::new(&[panel("c", &constant)], diverging, None).colour(5.0);
         assert_eq!(d.at_cell(0, 5 * nx + 5), [c.0, c.1, c.2]);
         let (top, bottom) = bar_ends(&d.img, &d.l, false);
         assert_ne!(top, bottom);
@@ -350,7 +350,7 @@ fn larger_y_is_drawn_on_top_whatever_the_spacing_sign() {
         let v = sample(&o);
         let m = marks(&v);
         let d = plot(name, nx, ny, &[panel("h", &v)], &m, &o);
-        let scale = Scale::new(&[panel("h", &v)], false);
+        let scale = Scale::new(&[panel("h", &v)], false, None);
         let (x0, y0) = d.l.origin(0);
         let (pw, ph) = d.l.panel;
         // the top of the middle column is the point (15, 19), its bottom (15, 0)

@@ -181,7 +181,7 @@ mod tests {
             diverging: true,
         };
         let cuts = slices(&p, [3, 2, 2]);
-        assert_eq!(cuts.map(|c| (c.nx, c.ny, c.index.len())), [(6, 5, 30), (6, 4, 24), (5, 4, 20)]);
+        assert_eq!(cuts.each_ref().map(|c| (c.nx, c.ny, c.index.len())), [(6, 5, 30), (6, 4, 24), (5, 4, 20)]);
         assert_eq!(cuts[1].index[6 * 3 + 4], 4 + 6 * (2 + 5 * 3));
         let mut png = Vec::new();
         plot_volume_slices(&mut png, &p).unwrap();

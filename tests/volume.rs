@@ -262,7 +262,6 @@ fn numpy_volumes_in_and_out_and_the_volume_errors() {
     for (args, needle) in [
         (vec!["--representative", "separatrix"], "--representative separatrix"),
         (vec!["--spacing", "1,1"], "three numbers"),
-        (vec!["--plot", "p.png"], "--plot"),
     ] {
         let mut all = vec!["smooth", inp, "-o", out];
         all.extend(args);

@@ -194,8 +194,18 @@ fn check(entry: &Value) -> Result<(), String> {
             check_cells_and_points(&ds, entry)?;
             let mesh = read_mesh(&path);
             if kind == "tets" {
-                let e = mesh.err().ok_or("tetrahedra read as a surface")?.to_string();
-                return if e.contains(file) && e.contains("tetrahedron") { Ok(()) } else { Err(format!("error: {e}")) };
+                // a tetrahedral mesh, every cell VTK wrote one of its tetrahedra; surface
+                // commands refuse it naming the file
+                let (m, _) = toposmooth::io::mesh::read_any_mesh(&path).map_err(|e| e.to_string())?;
+                let toposmooth::io::mesh::AnyMesh::Tet(t) = m else {
+                    return Err("tetrahedra read as a surface".into());
+                };
+                if t.tets().len() != ds.cells.len() {
+                    return Err(format!("{} tetrahedra for {} cells", t.tets().len(), ds.cells.len()));
+                }
+                let e = toposmooth::io::mesh::read_trimesh(&path).err().ok_or("tetrahedra read as a triangle mesh")?;
+                let e = e.to_string();
+                return if e.contains(file) && e.contains("tetrahedra") { Ok(()) } else { Err(format!("error: {e}")) };
             }
             let mesh = mesh.map_err(|e| e.to_string())?;
             let want = triangles_of(&csv(entry["cells"].as_str().unwrap()));

@@ -533,37 +533,17 @@ fn stage_figure(path: &Path, args: &SmoothArgs, field: &Field, result: &Smoothed
             let markers = kept_markers(&result.roles);
             stage_plot(path, |p| plot_grid_fields(p, g.nx(), g.ny(), &panels, &markers, &title, &options))?
         }
-        AnyDomain::Mesh(m) => {
+        AnyDomain::Mesh(_) | AnyDomain::Tets(_) => {
+            // a tetrahedral mesh shows its boundary surface; kept extrema inside it are hidden
+            let (positions, faces) = match &field.domain {
+                AnyDomain::Tets(m) => (m.positions(), m.boundary_faces()),
+                AnyDomain::Mesh(m) => (m.positions(), m.faces()),
+                _ => unreachable!("matched above"),
+            };
             let markers = kept_markers(&result.roles);
             stage_plot(path, |p| {
-                hidden = plot_mesh_fields(
-                    p,
-                    m.positions(),
-                    m.faces(),
-                    &panels,
-                    &markers,
-                    &title,
-                    args.view,
-                    lo < 0.0 && hi > 0.0,
-                )?;
-                Ok(())
-            })?
-        }
-        AnyDomain::Tets(m) => {
-            // the boundary surface, shaded by the values at its vertices; kept extrema inside
-            // the mesh are counted as hidden
-            let markers = kept_markers(&result.roles);
-            stage_plot(path, |p| {
-                hidden = plot_mesh_fields(
-                    p,
-                    m.positions(),
-                    m.boundary_faces(),
-                    &panels,
-                    &markers,
-                    &title,
-                    args.view,
-                    lo < 0.0 && hi > 0.0,
-                )?;
+                hidden =
+                    plot_mesh_fields(p, positions, faces, &panels, &markers, &title, args.view, lo < 0.0 && hi > 0.0)?;
                 Ok(())
             })?
         }

@@ -508,6 +508,27 @@ fn a_masked_volume_is_smoothed_inside_its_tetrahedra_and_verified_and_nan_backgr
     let o = succeeds(&["verify", out.to_str().unwrap()]);
     assert!(text(&o).contains("inside a mask of"), "{}", text(&o));
 
+    // a voxel outside the mask changed in the file: verify refuses it (exit 1)
+    {
+        let mask = s.mask.as_ref().unwrap();
+        let v = (0..mask.len()).find(|&v| !mask[v]).unwrap();
+        let mut smoothed = s.smoothed.clone();
+        smoothed[v] += 1.0;
+        let codes: Vec<f64> = s.roles.iter().map(|r| f64::from(r.code())).collect();
+        let inside: Vec<f64> = mask.iter().map(|&b| f64::from(u8::from(b))).collect();
+        let bad = dir.join("outside_changed.npz");
+        let arrays: [(&str, &[f64]); 5] = [
+            ("input", &s.input),
+            ("smoothed", &smoothed),
+            ("representative", &s.representative),
+            ("role", &codes),
+            ("mask", &inside),
+        ];
+        toposmooth::io::npz::stage_npz_shaped(&bad, &[25, 41, 33], &arrays).unwrap().commit().unwrap();
+        let o = toposmooth(&["verify", bad.to_str().unwrap()]);
+        assert_eq!(o.status.code(), Some(1), "{}", text(&o));
+        assert!(text(&o).contains("outside"), "{}", text(&o));
+    }
     // NaN background outside the mask is not missing data; NaN inside still is
     let m = [8, 7, 6];
     let count: usize = m.iter().product();

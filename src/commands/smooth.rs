@@ -83,22 +83,19 @@ pub(super) struct Shared {
     smoother: AnySmoother,
 }
 
+/// Whether two point sets hold the same coordinates bit for bit.
+fn same_bits(a: &[[f64; 3]], b: &[[f64; 3]]) -> bool {
+    a.len() == b.len() && a.iter().flatten().zip(b.iter().flatten()).all(|(x, y)| x.to_bits() == y.to_bits())
+}
+
 /// Whether two domains are the same: the same series coordinates, grid geometry or mesh.
 fn same_domain(a: &AnyDomain, b: &AnyDomain) -> bool {
     match (a, b) {
         (AnyDomain::Series(a), AnyDomain::Series(b)) => a == b,
         (AnyDomain::Grid(a), AnyDomain::Grid(b)) => a == b,
         (AnyDomain::Volume(a), AnyDomain::Volume(b)) => a == b,
-        (AnyDomain::Mesh(a), AnyDomain::Mesh(b)) => {
-            let bits =
-                |m: &crate::domain::TriMesh| m.positions().iter().flatten().map(|v| v.to_bits()).collect::<Vec<_>>();
-            a.faces() == b.faces() && bits(a) == bits(b)
-        }
-        (AnyDomain::Tets(a), AnyDomain::Tets(b)) => {
-            let bits =
-                |m: &crate::domain::TetMesh| m.positions().iter().flatten().map(|v| v.to_bits()).collect::<Vec<_>>();
-            a.tets() == b.tets() && bits(a) == bits(b)
-        }
+        (AnyDomain::Mesh(a), AnyDomain::Mesh(b)) => a.faces() == b.faces() && same_bits(a.positions(), b.positions()),
+        (AnyDomain::Tets(a), AnyDomain::Tets(b)) => a.tets() == b.tets() && same_bits(a.positions(), b.positions()),
         _ => false,
     }
 }

@@ -293,48 +293,11 @@ pub fn stage_results(
             _ => stage_grid_csv(path, g.nx(), r.smoothed),
         },
         AnyDomain::Mesh(m) => match extension(path).as_str() {
-            e @ ("vtu" | "vtp" | "vtk") => {
-                let plan = vtk_point_plan(&arrays, r.carried, r.output_array);
-                let point = planned(&plan, &arrays, r.smoothed, r.carried);
-                let triangles;
-                let (cells, cell_arrays) = match r.carried.and_then(|c| c.cells.as_ref()) {
-                    Some(cells) => (cells, carried_cells(r.carried)),
-                    None => {
-                        triangles = triangle_cells(m.faces());
-                        (&triangles, Vec::new())
-                    }
-                };
-                let active = Some(active_of(&plan));
-                match e {
-                    "vtu" => stage_vtu_cells(path, m.positions(), cells, (&point, &cell_arrays), active),
-                    "vtp" => stage_vtp_cells(path, m.positions(), cells, (&point, &cell_arrays), active),
-                    _ => {
-                        let geometry = LegacyGeometry::Unstructured { points: m.positions(), cells };
-                        stage_legacy(path, &geometry, (&point, &cell_arrays), active)
-                    }
-                }
-            }
+            "vtu" | "vtp" | "vtk" => stage_cells(path, m.positions(), || triangle_cells(m.faces()), &arrays, r),
             _ => stage_mesh(path, m, &arrays),
         },
-        AnyDomain::Tets(m) => {
-            let plan = vtk_point_plan(&arrays, r.carried, r.output_array);
-            let point = planned(&plan, &arrays, r.smoothed, r.carried);
-            let tetra;
-            let (cells, cell_arrays) = match r.carried.and_then(|c| c.cells.as_ref()) {
-                Some(cells) => (cells, carried_cells(r.carried)),
-                None => {
-                    tetra = tet_cells(m.tets());
-                    (&tetra, Vec::new())
-                }
-            };
-            let active = Some(active_of(&plan));
-            if extension(path) == "vtu" {
-                stage_vtu_cells(path, m.positions(), cells, (&point, &cell_arrays), active)
-            } else {
-                let geometry = LegacyGeometry::Unstructured { points: m.positions(), cells };
-                stage_legacy(path, &geometry, (&point, &cell_arrays), active)
-            }
-        }
+        // `.vtu` or legacy `.vtk` (check_output refused the rest)
+        AnyDomain::Tets(m) => stage_cells(path, m.positions(), || tet_cells(m.tets()), &arrays, r),
         AnyDomain::Volume(g) => match format_of(path, domain).as_str() {
             e @ ("vti" | "vtk") => {
                 let plan = vtk_point_plan(&arrays, r.carried, r.output_array);
@@ -355,6 +318,36 @@ pub fn stage_results(
             }
             _ => stage_npy_shaped(path, &[g.nz(), g.ny(), g.nx()], r.smoothed),
         },
+    }
+}
+
+/// A mesh's result as a VTK unstructured output (`.vtu`, `.vtp`, legacy `.vtk`): the input's
+/// cells and cell arrays when it carried them (as a VTK filter passes them), else `own` cells.
+fn stage_cells(
+    path: &Path,
+    positions: &[[f64; 3]],
+    own: impl FnOnce() -> Cells,
+    arrays: &[(&str, &[f64])],
+    r: &Results,
+) -> Result<Staged> {
+    let plan = vtk_point_plan(arrays, r.carried, r.output_array);
+    let point = planned(&plan, arrays, r.smoothed, r.carried);
+    let own_cells;
+    let (cells, cell_arrays) = match r.carried.and_then(|c| c.cells.as_ref()) {
+        Some(cells) => (cells, carried_cells(r.carried)),
+        None => {
+            own_cells = own();
+            (&own_cells, Vec::new())
+        }
+    };
+    let active = Some(active_of(&plan));
+    match extension(path).as_str() {
+        "vtu" => stage_vtu_cells(path, positions, cells, (&point, &cell_arrays), active),
+        "vtp" => stage_vtp_cells(path, positions, cells, (&point, &cell_arrays), active),
+        _ => {
+            let geometry = LegacyGeometry::Unstructured { points: positions, cells };
+            stage_legacy(path, &geometry, (&point, &cell_arrays), active)
+        }
     }
 }
 

@@ -813,3 +813,160 @@ fn the_bundled_spot_tetrahedral_mesh_is_smoothed_certified_and_verified() {
         succeeds(&["verify", out.to_str().unwrap(), "--input", &src]);
     }
 }
+
+/// Components of the lower (`below`) or upper link of `v`: the neighbours on that side of `v`
+/// in SoS order, joined by the link's edges (`link_edges`, pairs of neighbours that span a
+/// triangle with `v`).
+fn link_components(h: &[f64], v: usize, nbrs: &[usize], link_edges: &[(usize, usize)], below: bool) -> usize {
+    let side = |w: usize| ((h[w], w) < (h[v], v)) == below;
+    let members: Vec<usize> = nbrs.iter().copied().filter(|&w| side(w)).collect();
+    let mut part: std::collections::BTreeMap<usize, usize> = members.iter().map(|&w| (w, w)).collect();
+    fn root(part: &mut std::collections::BTreeMap<usize, usize>, mut w: usize) -> usize {
+        while part[&w] != w {
+            w = part[&w];
+        }
+        w
+    }
+    for &(a, b) in link_edges {
+        if part.contains_key(&a) && part.contains_key(&b) {
+            let (ra, rb) = (root(&mut part, a), root(&mut part, b));
+            part.insert(ra, rb);
+        }
+    }
+    let keys: Vec<usize> = part.keys().copied().collect();
+    keys.iter().map(|&w| root(&mut part, w)).collect::<std::collections::BTreeSet<_>>().len()
+}
+
+/// Checks a volume's `--complex` against the input: its vertex cells are exactly the SoS
+/// extrema (TTK's codes 0 and 3) and merge saddles, a 1-saddle (1) with a disconnected lower
+/// link, a 2-saddle (2) with a disconnected upper link, a degenerate vertex (4) with both;
+/// `Kept` on exactly the kept extrema; no separatrices. `link(v)` gives the neighbours of `v`
+/// and the link's edges.
+fn check_solid_complex(
+    path: &Path,
+    h: &[f64],
+    roles: &[Role],
+    link: &dyn Fn(usize) -> (Vec<usize>, Vec<(usize, usize)>),
+) -> [usize; 5] {
+    let c = toposmooth::io::vtk::read_dataset(path).unwrap();
+    let point = |name: &str| c.point_data.iter().find(|a| a.name == name).unwrap().values.clone();
+    let (ty, vertex, kept, value) =
+        (point("CriticalType"), point("ttkVertexScalarField"), point("Kept"), point("input"));
+    assert!(c.cells.types.iter().all(|&t| t == 1), "vertex cells only in a volume's complex");
+    assert_eq!(c.cells.len(), c.points.len());
+    let mut counts = [0; 5];
+    let listed: std::collections::BTreeMap<usize, usize> =
+        vertex.iter().zip(&ty).map(|(&v, &t)| (v as usize, t as usize)).collect();
+    assert_eq!(listed.len(), vertex.len(), "a vertex listed twice");
+    for v in 0..h.len() {
+        let (nbrs, edges) = link(v);
+        let lower = link_components(h, v, &nbrs, &edges, true);
+        let upper = link_components(h, v, &nbrs, &edges, false);
+        match listed.get(&v) {
+            Some(&t) => {
+                counts[t] += 1;
+                match t {
+                    0 => assert_eq!(lower, 0, "vertex {v} listed as a minimum"),
+                    3 => assert_eq!(upper, 0, "vertex {v} listed as a maximum"),
+                    1 => assert!(lower >= 2, "vertex {v}: a 1-saddle with {lower} lower link components"),
+                    2 => assert!(upper >= 2, "vertex {v}: a 2-saddle with {upper} upper link components"),
+                    4 => assert!(lower >= 2 && upper >= 2, "vertex {v}: degenerate with links {lower}, {upper}"),
+                    _ => panic!("vertex {v}: CriticalType {t}"),
+                }
+            }
+            // every SoS extremum is born or dies in a pair
+            None => assert!(lower > 0 && upper > 0, "extremum {v} not listed"),
+        }
+    }
+    for i in 0..vertex.len() {
+        let v = vertex[i] as usize;
+        assert_eq!(value[i], h[v]);
+        if ty[i] == 0.0 || ty[i] == 3.0 {
+            assert_eq!(kept[i] == 1.0, matches!(roles[v], Role::Min | Role::Max), "vertex {v}");
+        }
+    }
+    // one connected domain: every minimum but the global one dies at a 1-saddle, every
+    // maximum but the global one at a 2-saddle, and a saddle can kill several
+    assert!(counts[1] + counts[4] < counts[0] && counts[2] + counts[4] < counts[3], "{counts:?}");
+    assert!(counts[1] + counts[4] > 0 && counts[2] + counts[4] > 0, "{counts:?}");
+    counts
+}
+
+#[test]
+fn the_complex_of_a_volume_and_of_a_tetrahedral_mesh_lists_their_critical_points_in_ttk_s_3d_codes() {
+    let dir = scratch("volume-complex");
+    // the anatomical MRI, 14-neighbour grid
+    let (out, complex, diagram) = (dir.join("t1.vti"), dir.join("c.vtp"), dir.join("d.vtu"));
+    let nii = dataset("mri_anatomical_33x41x25.nii");
+    let paths = [out.to_str().unwrap(), complex.to_str().unwrap(), diagram.to_str().unwrap()];
+    succeeds(&["smooth", &nii, "--persistence", "10%", "-o", paths[0], "--complex", paths[1], "--diagram", paths[2]]);
+    let s = stored(&out);
+    let n = [33i64, 41, 25];
+    let index = |p: [i64; 3]| {
+        (p.iter().zip(n).all(|(&a, m)| (0..m).contains(&a))).then(|| (p[0] + n[0] * (p[1] + n[1] * p[2])) as usize)
+    };
+    let grid_link = |v: usize| {
+        let p = [v as i64 % n[0], v as i64 / n[0] % n[1], v as i64 / (n[0] * n[1])];
+        let nbrs: Vec<usize> = OFFSETS.iter().filter_map(|d| index([p[0] + d[0], p[1] + d[1], p[2] + d[2]])).collect();
+        // Freudenthal's triangulation is a flag complex: two neighbours of v that are
+        // neighbours of each other span a triangle with it
+        let mut edges = vec![];
+        for (a, da) in OFFSETS.iter().enumerate() {
+            for db in &OFFSETS[a + 1..] {
+                let d = [db[0] - da[0], db[1] - da[1], db[2] - da[2]];
+                let (Some(x), Some(y)) = (
+                    index([p[0] + da[0], p[1] + da[1], p[2] + da[2]]),
+                    index([p[0] + db[0], p[1] + db[1], p[2] + db[2]]),
+                ) else {
+                    continue;
+                };
+                if OFFSETS.contains(&d) {
+                    edges.push((x, y));
+                }
+            }
+        }
+        (nbrs, edges)
+    };
+    let counts = check_solid_complex(&complex, &s.input, &s.roles, &grid_link);
+    assert!(counts[0] > 10 && counts[3] > 10, "{counts:?}");
+    // the diagram's pairs: minimum–1-saddle (0) and 2-saddle–maximum (2), TTK's volume types
+    let d = toposmooth::io::vtk::read_dataset(&diagram).unwrap();
+    let pair_type = &d.cell_data.iter().find(|a| a.name == "PairType").unwrap().values;
+    let critical = &d.point_data.iter().find(|a| a.name == "CriticalType").unwrap().values;
+    // the last cell is the diagonal
+    for (c, &t) in pair_type.iter().enumerate().take(pair_type.len() - 1) {
+        let k = d.cells.corners(c);
+        let ends = (critical[k[0]], critical[k[1]]);
+        match t as i32 {
+            0 => assert!(ends == (0.0, 1.0) || (c == 0 && ends == (0.0, 3.0)), "pair {c}: {ends:?}"),
+            2 => assert_eq!(ends, (2.0, 3.0), "pair {c}"),
+            t => panic!("pair {c}: type {t}"),
+        }
+    }
+    assert!(pair_type.contains(&2.0));
+
+    // the bundled tetrahedral mesh: the link's edges are the tetrahedra's faces at v
+    let src = dataset("spot_tets.vtu");
+    let ds = toposmooth::io::vtk::read_dataset(Path::new(&src)).unwrap();
+    let tets = tetra_of(&ds);
+    let mut at = vec![vec![]; ds.points.len()];
+    for (t, k) in tets.iter().enumerate() {
+        for &v in k {
+            at[v].push(t);
+        }
+    }
+    let tet_link = |v: usize| {
+        let (mut nbrs, mut edges) = (std::collections::BTreeSet::new(), vec![]);
+        for &t in &at[v] {
+            let others: Vec<usize> = tets[t].iter().copied().filter(|&w| w != v).collect();
+            nbrs.extend(&others);
+            edges.extend([(others[0], others[1]), (others[1], others[2]), (others[0], others[2])]);
+        }
+        (nbrs.into_iter().collect(), edges)
+    };
+    let (out, complex) = (dir.join("spot.vtu"), dir.join("spot_complex.vtp"));
+    succeeds(&["smooth", &src, "-o", out.to_str().unwrap(), "--complex", complex.to_str().unwrap()]);
+    let s = stored(&out);
+    let counts = check_solid_complex(&complex, &s.input, &s.roles, &tet_link);
+    assert!(counts[0] > 50 && counts[3] > 50, "{counts:?}");
+}

@@ -400,7 +400,8 @@ struct SmoothCli {
     csv: CsvArgs,
     #[command(flatten)]
     grid: GridCli,
-    /// Grids and meshes: kept extrema, saddles and separatrices as VTK PolyData (.vtp).
+    /// Critical points and, on grids and meshes, the kept separatrices as VTK PolyData (.vtp,
+    /// TTK's layout; volumes with TTK's 3D codes).
     #[arg(long, value_name = "VTP")]
     complex: Option<PathBuf>,
     /// Grids and meshes: representative function. Given, it is built or the run fails (exit 3

@@ -170,7 +170,7 @@ fn list<D: Domain>(args: &ExtremaArgs, field: &Field, domain: &D) -> Result<Stri
         stage_diagram(plot_path, path, column, &table, h, &kept, surface)?.commit()?;
     }
     if let Some(d) = &args.diagram {
-        let pairs = crate::io::ttk::diagram_pairs(domain, h, &table, surface);
+        let pairs = crate::io::ttk::diagram_pairs(domain, h, &table, field.domain.dimension());
         crate::io::ttk::stage_diagram(d, &field.domain, &pairs, &kept.roles)?.commit()?;
     }
     if args.json {

@@ -221,12 +221,14 @@ pub(super) fn smooth_shared(args: &SmoothArgs, shared: Option<&mut Option<Shared
     check_written(&output, &field.domain, &results).map_err(|e| e.in_file(&field.path))?;
     let mut staged = vec![output];
     if let Some(path) = &args.complex {
-        let Some(ms) = &result.complex else {
+        // surfaces write the kept complex's separatrices; volumes only the critical points
+        let ms = result.complex.as_ref();
+        if ms.is_none() && field.domain.dimension() == 2 {
             return Err(Error::Internal {
                 path: Some(field.path.clone()),
                 message: format!("no Morse-Smale complex to write ({})", result.report.representative),
             });
-        };
+        }
         staged.push(stage_complex(path, &field.domain, &field.values, &result.roles, ms)?);
     }
     if let Some(path) = &args.diagram {

@@ -18,7 +18,7 @@ pub struct SmoothArgs {
     pub csv: SeriesCsvOptions,
     /// Array, spacing, derivation and NaN policy (grids).
     pub grid: GridOptions,
-    /// Kept critical points and separatrices as VTK PolyData (grids).
+    /// Critical points (and separatrices on surfaces) as VTK PolyData.
     pub complex: Option<PathBuf>,
     /// Isolines in the grid plot.
     pub isolines: usize,

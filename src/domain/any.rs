@@ -44,6 +44,16 @@ impl AnyDomain {
         crate::with_domain!(self, d => d.n_vertices())
     }
 
+    /// The dimension of the domain's cells: 1 (series), 2 (grids, triangle meshes), 3
+    /// (volumes, tetrahedral meshes).
+    pub fn dimension(&self) -> usize {
+        match self {
+            AnyDomain::Series(_) => 1,
+            AnyDomain::Grid(_) | AnyDomain::Mesh(_) => 2,
+            AnyDomain::Volume(_) | AnyDomain::Tets(_) => 3,
+        }
+    }
+
     /// A vertex as a reader finds it: `sample i`, `(row r, column c)` or `vertex i`.
     pub fn describe_vertex(&self, v: usize) -> String {
         match self {

@@ -109,19 +109,13 @@ pub fn check_mesh_output(path: &Path) -> Result<()> {
     check_extension(path, MESH_OUTPUTS, "a mesh")
 }
 
-/// Checks that the complex can be written at `path` (`.vtp`, surfaces only).
+/// Checks that the complex can be written at `path` (`.vtp`; grids, meshes and volumes).
 ///
 /// # Errors
 /// [`Error::Usage`] for a series (it has no separatrices) or another extension.
 pub fn check_complex_output(path: &Path, domain: &AnyDomain) -> Result<()> {
     if let AnyDomain::Series(_) = domain {
-        return Err(Error::setting("complex", "is for grids and meshes (a series has no separatrices)"));
-    }
-    if let AnyDomain::Volume(_) | AnyDomain::Tets(_) = domain {
-        return Err(Error::setting(
-            "complex",
-            "is for grids and triangle meshes: volumes and tetrahedral meshes have no complex yet",
-        ));
+        return Err(Error::setting("complex", "is for grids, meshes and volumes (a series has no separatrices)"));
     }
     check_extension(path, &["vtp"], "the complex")
 }
@@ -515,17 +509,26 @@ fn grid_point(grid: &Grid2d, v: usize) -> [f64; 3] {
 /// Stages the critical points and the kept complex at `path` as `.vtp` in TTK's layout
 /// ([`super::ttk`]): one vertex cell per critical vertex of the input's persistence pairs
 /// (extrema and merge saddles, cancelled ones included; a series' end maxima, unpaired, are
-/// left out), then one polyline
-/// per separatrix of the kept complex. Point data: `CriticalType`, `ttkVertexScalarField`,
-/// `input` (the value), `Persistence` and `PairIdentifier` of the vertex's diagram pair (the
-/// ids of `--diagram`; NaN and −1 for regular vertices on separatrices), `Kept` (UInt8: a kept
-/// extremum or a saddle of the kept complex). Cell data: `SeparatrixType` (−1 on vertex
-/// cells), `SourceId` and `DestinationId` (the saddle's and the extremum's vertex; the vertex
-/// itself and −1 on vertex cells).
+/// left out), then, on surfaces, one polyline per separatrix of the kept complex `ms`
+/// (volumes and tetrahedral meshes have no separatrices here: `ms` is `None` and only the
+/// critical points are written). Point data: `CriticalType` (in volumes the saddle a minimum
+/// dies at is a 1-saddle, the one a maximum dies at a 2-saddle, a vertex that is both is
+/// degenerate, 4), `ttkVertexScalarField`, `input` (the value), `Persistence` and
+/// `PairIdentifier` of the vertex's diagram pair (the ids of `--diagram`; NaN and −1 for
+/// regular vertices on separatrices), `Kept` (UInt8: a kept extremum, a saddle of the kept
+/// complex, or in a volume the saddle of a pair whose extremum is kept). Cell data:
+/// `SeparatrixType` (−1 on vertex cells), `SourceId` and `DestinationId` (the saddle's and the
+/// extremum's vertex; the vertex itself and −1 on vertex cells).
 ///
 /// # Errors
 /// As [`check_complex_output`]; I/O errors naming the file.
-pub fn stage_complex(path: &Path, domain: &AnyDomain, h: &[f64], roles: &[Role], ms: &MorseSmale) -> Result<Staged> {
+pub fn stage_complex(
+    path: &Path,
+    domain: &AnyDomain,
+    h: &[f64],
+    roles: &[Role],
+    ms: Option<&MorseSmale>,
+) -> Result<Staged> {
     use super::ttk::critical;
     check_complex_output(path, domain)?;
     let pairs = super::ttk::diagram_of(domain, h);
@@ -536,14 +539,22 @@ pub fn stage_complex(path: &Path, domain: &AnyDomain, h: &[f64], roles: &[Role],
         AnyDomain::Volume(g) => g.world(v),
         AnyDomain::Tets(m) => m.point(v),
     };
-    // each vertex's critical type and diagram pair (the first pair that names it)
+    // each vertex's critical type and diagram pair (the first pair that names it); a vertex
+    // named as a 1-saddle and as a 2-saddle is degenerate
     let mut critical_of: std::collections::BTreeMap<usize, (i32, usize)> = std::collections::BTreeMap::new();
+    let mut saddles: std::collections::HashSet<usize> =
+        ms.map(|ms| ms.saddles.iter().copied().collect()).unwrap_or_default();
     for (i, p) in pairs.iter().enumerate() {
         for k in 0..2 {
-            critical_of.entry(p.vertices[k]).or_insert((p.types[k], i));
+            let entry = critical_of.entry(p.vertices[k]).or_insert((p.types[k], i));
+            if entry.0 != p.types[k] {
+                entry.0 = critical::DEGENERATE;
+            }
+        }
+        if ms.is_none() && p.finite && matches!(roles[p.extremum], Role::Min | Role::Max) {
+            saddles.insert(p.vertices[usize::from(p.extremum == p.vertices[0])]);
         }
     }
-    let saddles: std::collections::HashSet<usize> = ms.saddles.iter().copied().collect();
     let mut slot = std::collections::HashMap::new();
     let mut points: Vec<[f64; 3]> = Vec::new();
     let mut vertex_of: Vec<usize> = Vec::new();
@@ -564,7 +575,7 @@ pub fn stage_complex(path: &Path, domain: &AnyDomain, h: &[f64], roles: &[Role],
         source.push(v as f64);
         destination.push(-1.0);
     }
-    for (list, t) in [(&ms.descending, 0.0), (&ms.ascending, 1.0)] {
+    for (list, t) in ms.iter().flat_map(|ms| [(&ms.descending, 0.0), (&ms.ascending, 1.0)]) {
         for sep in list {
             for &v in &sep.path {
                 cells.connectivity.push(id(v, &mut points, &mut vertex_of));

@@ -3,9 +3,11 @@
 //! `core/base/common/DataTypes.h` and `ttkPersistenceDiagramUtils.cpp`).
 //!
 //! * `CriticalType` (Int32): 0 minimum, 1 1-saddle, 2 2-saddle, 3 maximum, 4 degenerate,
-//!   5 regular. On surfaces every saddle is a 1-saddle; volumes use 2 for 2-saddles.
+//!   5 regular. On surfaces every saddle is a 1-saddle; in volumes the saddle a minimum dies
+//!   at is a 1-saddle and the saddle a maximum dies at a 2-saddle.
 //! * `PairType` (Int32): 0 minimum–saddle, 1 saddle–maximum on surfaces (in volumes: 0
-//!   minimum–1-saddle, 1 1-saddle–2-saddle, 2 2-saddle–maximum); −1 the diagonal.
+//!   minimum–1-saddle, 2 2-saddle–maximum; TTK's 1 1-saddle–2-saddle pairs are not
+//!   computed); −1 the diagonal.
 //! * `SeparatrixType` (Int32): 0 descending (saddle to minimum), 1 ascending on surfaces
 //!   (volumes: 0 descending, 1 saddle connector, 2 ascending).
 //!
@@ -37,6 +39,8 @@ pub mod critical {
     pub const SADDLE2: i32 = 2;
     /// A local maximum.
     pub const MAXIMUM: i32 = 3;
+    /// A vertex of more than one kind (in a volume: a 1-saddle and a 2-saddle).
+    pub const DEGENERATE: i32 = 4;
     /// A regular vertex.
     pub const REGULAR: i32 = 5;
 }
@@ -91,16 +95,21 @@ fn components<D: Domain + ?Sized>(domain: &D) -> Vec<usize> {
     part
 }
 
-/// The persistence pairs of `h` in TTK's terms, the essential pairs first: on a series each
-/// minimum with the maximum it dies at; on a surface each minimum with its saddle and each
-/// maximum with its saddle; each connected part's global minimum with its global maximum.
+/// The persistence pairs of `h` in TTK's terms, the essential pairs first: on a series
+/// (`dimension` 1) each minimum with the maximum it dies at; on a surface (2) each minimum with
+/// its saddle and each maximum with its saddle; in a volume (3) each minimum with its 1-saddle
+/// (`PairType` 0) and each maximum with its 2-saddle (`PairType` 2; the 1-saddle–2-saddle
+/// pairs of TTK's diagram are not computed); each connected part's global minimum with its
+/// global maximum.
 pub fn diagram_pairs<D: Domain + ?Sized>(
     domain: &D,
     h: &[f64],
     table: &[ExtremumInfo],
-    surface: bool,
+    dimension: usize,
 ) -> Vec<DiagramPair> {
-    use critical::{MAXIMUM, MINIMUM, SADDLE1};
+    use critical::{MAXIMUM, MINIMUM, SADDLE1, SADDLE2};
+    let surface = dimension >= 2;
+    let (max_saddle, max_pair) = if dimension >= 3 { (SADDLE2, 2) } else { (SADDLE1, 1) };
     let part = components(domain);
     let parts = part.iter().max().map_or(0, |m| m + 1);
     let mut top: Vec<Option<usize>> = vec![None; parts];
@@ -134,8 +143,8 @@ pub fn diagram_pairs<D: Domain + ?Sized>(
             }),
             (ExtremumKind::Max, Some(p)) if surface => finite.push(DiagramPair {
                 vertices: [p, r.index],
-                types: [SADDLE1, MAXIMUM],
-                pair_type: 1,
+                types: [max_saddle, MAXIMUM],
+                pair_type: max_pair,
                 values: [h[p], h[r.index]],
                 finite: true,
                 extremum: r.index,
@@ -169,13 +178,7 @@ pub fn diagram_of(domain: &AnyDomain, h: &[f64]) -> Vec<DiagramPair> {
 
 /// [`diagram_pairs`] on a domain chosen at run time, from its extremum table.
 pub fn diagram_from_table(domain: &AnyDomain, h: &[f64], table: &[ExtremumInfo]) -> Vec<DiagramPair> {
-    match domain {
-        AnyDomain::Series(d) => diagram_pairs(d, h, table, false),
-        AnyDomain::Grid(d) => diagram_pairs(d, h, table, true),
-        AnyDomain::Mesh(d) => diagram_pairs(d, h, table, true),
-        AnyDomain::Volume(d) => diagram_pairs(d, h, table, true),
-        AnyDomain::Tets(d) => diagram_pairs(d, h, table, true),
-    }
+    crate::with_domain!(domain, d => diagram_pairs(d, h, table, domain.dimension()))
 }
 
 /// The position of vertex `v`.

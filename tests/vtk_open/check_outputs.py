@@ -302,9 +302,21 @@ if run("smooth", min_, "--array", "density", "--mask", "brain", "--persistence",
         print(f"ok masked volume .vti: {int(dom.sum())} of {dom.size} voxels smoothed, the rest unchanged")
 # the bundled real MRI volume (written by VTK's XML writer with its defaults)
 t1 = os.path.join(DATASETS, "mri_anatomical_33x41x25.vti")
-t1_out = os.path.join(WORK, "t1_out.vti")
-if run("smooth", t1, "-o", t1_out):
+t1_out, t1_cx, t1_d = (os.path.join(WORK, n) for n in ["t1_out.vti", "t1_complex.vtp", "t1_diagram.vtu"])
+if run("smooth", t1, "-o", t1_out, "--complex", t1_cx, "--diagram", t1_d):
     check_smoothed(t1, t1_out, "t1")
+    # the volume's critical points (TTK's 3D codes) sit on the image's own points
+    check_opens(t1_cx, ["CriticalType", "ttkVertexScalarField", "Kept"])
+    check_opens(t1_d, ["PairIdentifier", "PairType", "Persistence", "CriticalType"])
+    cx, _ = read(t1_cx)
+    img, _ = read(t1_out)
+    ids = vtk_to_numpy(cx.GetPointData().GetArray("ttkVertexScalarField"))
+    codes = set(vtk_to_numpy(cx.GetPointData().GetArray("CriticalType")).tolist())
+    off = [i for i in range(len(ids)) if max(abs(a - b) for a, b in zip(cx.GetPoint(i), img.GetPoint(int(ids[i])))) > 1e-9]
+    if off or not {0, 1, 2, 3} <= codes:
+        fail(t1_cx, f"{len(off)} critical points off their voxels; codes {sorted(codes)}")
+    else:
+        print(f"ok volume complex: {len(ids)} critical points on their voxels, codes {sorted(codes)}")
 
 if failures:
     print(f"{len(failures)} failures", file=sys.stderr)

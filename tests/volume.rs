@@ -413,6 +413,7 @@ fn ascii_vti(path: &Path, extent: &str, spacing: &str, values: &[f64]) {
 
 #[test]
 fn images_in_the_xz_and_yz_planes_are_2d_grids_over_their_two_axes() {
+    use toposmooth::io::vtk::read_dataset;
     let dir = scratch("volume-planes");
     let (na, nb) = (9, 7);
     let h: Vec<f64> = (0..na * nb).map(|v| ((v % na) as f64 / 2.0).sin() + ((v / na) as f64 / 3.0).cos()).collect();
@@ -430,6 +431,35 @@ fn images_in_the_xz_and_yz_planes_are_2d_grids_over_their_two_axes() {
         assert_eq!(s.input, h, "the points are already in the grid's order");
         let o = succeeds(&["verify", out.to_str().unwrap()]);
         assert!(text(&o).contains("certified"), "{}", text(&o));
+        // an image output lies in the input's plane, point for point, as do the complex's
+        // critical points
+        for ext in ["vti", "vtk"] {
+            let (img, cx) = (dir.join(format!("{plane}.out.{ext}")), dir.join(format!("{plane}.c.vtp")));
+            succeeds(&[
+                "smooth",
+                input.to_str().unwrap(),
+                "-o",
+                img.to_str().unwrap(),
+                "--complex",
+                cx.to_str().unwrap(),
+            ]);
+            let (a, b) = (read_dataset(&input).unwrap(), read_dataset(&img).unwrap());
+            let (ga, gb) = (a.image.as_ref().unwrap(), b.image.as_ref().unwrap());
+            // (the spacing along the flat axis moves no point and is not carried)
+            let flat = if plane == "x-z" { 1 } else { 0 };
+            let in_plane = |s: [f64; 3]| [0, 1, 2].map(|a| if a == flat { 1.0 } else { s[a] });
+            assert_eq!((gb.dims(), in_plane(gb.spacing), gb.origin), (ga.dims(), in_plane(ga.spacing), ga.origin));
+            let c = read_dataset(&cx).unwrap();
+            let ids = &c.point_data.iter().find(|a| a.name == "ttkVertexScalarField").unwrap().values;
+            for (p, &v) in c.points.iter().zip(ids) {
+                let [i, j, k] = [v as usize % na, 0, v as usize / na];
+                let (col, row) = (i as f64, k as f64);
+                let want = if plane == "x-z" { [col, j as f64, 0.5 * row] } else { [0.0, 0.25 * col, 0.5 * row] };
+                assert_eq!(*p, want, "critical point {v} of {}", cx.display());
+            }
+            assert!(text(&succeeds(&["verify", img.to_str().unwrap(), "--input", input.to_str().unwrap()]))
+                .contains("input matches"));
+        }
     }
     // VTK's own writer (tests/fixtures: extent 0 6 0 0 0 4, spacing 0.5 1 0.25, ParaView's
     // default appended raw zlib encoding)

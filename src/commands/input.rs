@@ -568,8 +568,7 @@ fn read_raw(path: &Path, array: Option<&str>) -> Result<Raw> {
         "vti" | "vtk" => {
             let (geometry, arrays, cell, skipped, active, notes) = match read_any_image(path)? {
                 AnyImage::Flat(img) => {
-                    let grid =
-                        Grid2d::with_geometry(img.nx, img.ny, img.spacing, img.origin).map_err(|e| e.in_file(path))?;
+                    let grid = img.grid().map_err(|e| e.in_file(path))?;
                     (Geometry::Flat(grid), img.arrays, img.cell_arrays, img.skipped, img.active_scalars, img.notes)
                 }
                 AnyImage::Volume(v) => {
@@ -620,6 +619,7 @@ fn read_nifti_raw(path: &Path) -> Result<Raw> {
         [_, _, _] => Geometry::Volume(Grid3d::with_geometry(v.dims, v.spacing, origin).map_err(|e| e.in_file(path))?),
         &[a, b] => Geometry::Flat(
             Grid2d::with_geometry(v.dims[a], v.dims[b], [v.spacing[a], v.spacing[b]], [origin[a], origin[b]])
+                .and_then(|g| g.in_plane(crate::domain::Plane { axes: [a, b], level: origin[3 - a - b] }))
                 .map_err(|e| e.in_file(path))?,
         ),
         _ => {
@@ -657,6 +657,7 @@ fn with_spacing(path: &Path, geometry: &Geometry, spacing: Option<&[f64]>) -> Re
             raster_grid(grid.nx(), grid.ny(), [dx, dy]).map(Geometry::Flat).map_err(|e| e.in_file(path))
         }
         (Geometry::Flat(grid), &[dx, dy]) => Grid2d::with_geometry(grid.nx(), grid.ny(), [dx, dy], grid.origin())
+            .and_then(|g| g.in_plane(grid.plane()))
             .map(Geometry::Flat)
             .map_err(|e| e.in_file(path)),
         (Geometry::Volume(grid), &[dx, dy, dz]) => Grid3d::with_geometry(grid.dims(), [dx, dy, dz], grid.origin())

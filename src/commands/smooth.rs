@@ -527,7 +527,8 @@ fn stage_figure(path: &Path, args: &SmoothArgs, field: &Field, result: &Smoothed
                 origin: g.origin(),
                 spacing: g.spacing(),
                 range: None,
-                axes: ["x", "y"],
+                // an image in the x-z or y-z plane is drawn with the file's axes
+                axes: g.plane().axes.map(|a| ["x", "y", "z"][a]),
             };
             let markers = kept_markers(&result.roles);
             stage_plot(path, |p| plot_grid_fields(p, g.nx(), g.ny(), &panels, &markers, &title, &options))?

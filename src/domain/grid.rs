@@ -10,14 +10,37 @@ pub const MIN_SPACING: f64 = 1e-100;
 /// Largest accepted spacing magnitude.
 pub const MAX_SPACING: f64 = 1e100;
 
+/// Where a grid lies in space: its columns run along physical axis `axes[0]` and its rows
+/// along `axes[1]` (0 x, 1 y, 2 z; `axes[0] < axes[1]`), at coordinate `level` along the third
+/// axis. An image in the x-z plane is `axes = [0, 2]`, `level` its y.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Plane {
+    /// The physical axes of the grid's x and y.
+    pub axes: [usize; 2],
+    /// The coordinate along the remaining axis.
+    pub level: f64,
+}
+
+impl Plane {
+    /// The x-y plane at z = 0.
+    pub const XY: Plane = Plane { axes: [0, 1], level: 0.0 };
+
+    /// The axis the plane is normal to.
+    pub fn normal(&self) -> usize {
+        3 - self.axes[0] - self.axes[1]
+    }
+}
+
 /// A grid of `nx` columns × `ny` rows with spacing `(dx, dy)` (signs kept for derived
-/// quantities; operators use |dx|, |dy|) and origin. Nothing per vertex is stored.
+/// quantities; operators use |dx|, |dy|) and origin, lying in a [`Plane`] of space (the x-y
+/// plane unless [`Grid2d::in_plane`] puts it elsewhere). Nothing per vertex is stored.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Grid2d {
     nx: usize,
     ny: usize,
     spacing: [f64; 2],
     origin: [f64; 2],
+    plane: Plane,
 }
 
 impl Grid2d {
@@ -50,7 +73,38 @@ impl Grid2d {
         if origin.iter().any(|o| !o.is_finite()) {
             return Err(Error::input(format!("grid origin must be finite, got {origin:?}")));
         }
-        Ok(Grid2d { nx, ny, spacing, origin })
+        Ok(Grid2d { nx, ny, spacing, origin, plane: Plane::XY })
+    }
+
+    /// The grid placed in `plane` (its geometry otherwise unchanged).
+    ///
+    /// # Errors
+    /// Axes that are not two increasing axes of x, y, z; a non-finite level.
+    pub fn in_plane(mut self, plane: Plane) -> Result<Self> {
+        let [a, b] = plane.axes;
+        if !(a < b && b < 3 && plane.level.is_finite()) {
+            return Err(Error::input(format!(
+                "a grid's plane needs two increasing axes of 0, 1, 2 and a finite level, got {plane:?}"
+            )));
+        }
+        self.plane = plane;
+        Ok(self)
+    }
+
+    /// The plane the grid lies in.
+    pub fn plane(&self) -> Plane {
+        self.plane
+    }
+
+    /// Physical position of a vertex: origin + (c·dx, r·dy) with the signed spacing, along the
+    /// plane's axes, as VTK places an image's points.
+    pub fn world(&self, v: usize) -> [f64; 3] {
+        let (r, c) = self.row_col(v);
+        let mut p = [0.0; 3];
+        p[self.plane.axes[0]] = self.origin[0] + c as f64 * self.spacing[0];
+        p[self.plane.axes[1]] = self.origin[1] + r as f64 * self.spacing[1];
+        p[self.plane.normal()] = self.plane.level;
+        p
     }
 
     /// Columns.
@@ -173,5 +227,16 @@ mod tests {
         let g = Grid2d::with_geometry(3, 2, [0.5, -2.0], [0.0, 0.0]).unwrap();
         assert_eq!(g.diameter(), 1.0f64.hypot(2.0));
         assert_eq!(g.position(5), [1.0, 2.0]);
+    }
+
+    #[test]
+    fn a_grid_in_the_x_z_plane_places_its_points_along_x_and_z_at_its_level() {
+        let g = Grid2d::with_geometry(3, 2, [0.5, -2.0], [1.0, 4.0]).unwrap();
+        assert_eq!(g.world(5), [2.0, 2.0, 0.0]);
+        let xz = g.clone().in_plane(Plane { axes: [0, 2], level: 7.0 }).unwrap();
+        assert_eq!(xz.world(5), [2.0, 7.0, 2.0]);
+        assert_ne!(xz, g);
+        assert!(g.clone().in_plane(Plane { axes: [2, 0], level: 0.0 }).is_err());
+        assert!(g.in_plane(Plane { axes: [1, 2], level: f64::NAN }).is_err());
     }
 }

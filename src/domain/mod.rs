@@ -21,7 +21,7 @@ pub mod vec3;
 mod volume;
 
 pub use any::AnyDomain;
-pub use grid::{Grid2d, MAX_SPACING, MIN_SPACING};
+pub use grid::{Grid2d, Plane, MAX_SPACING, MIN_SPACING};
 pub use masked::{MaskedGrid, MaskedVolume, Restriction};
 pub use mesh::{shapes, triangle_area, TriMesh};
 pub use order::{sos_greater, sos_less, sos_sort, sos_untied, value_range};

@@ -275,7 +275,7 @@ pub fn stage_results(
                 let plan = vtk_point_plan(&arrays, r.carried, r.output_array);
                 let point = planned(&plan, &arrays, r.smoothed, r.carried);
                 let cells: Vec<OutArray> = carried_cells(r.carried);
-                let b = ImageBox::flat(g.nx(), g.ny(), g.spacing(), g.origin());
+                let b = ImageBox::of_grid(g);
                 if e == "vti" {
                     stage_vti_arrays(path, b, &point, &cells, Some(active_of(&plan)))
                 } else {
@@ -498,14 +498,6 @@ fn stage_mesh_unchecked(path: &Path, mesh: &TriMesh, arrays: &[(&str, &[f64])]) 
     }
 }
 
-/// Physical position of a grid vertex: origin + (c·dx, r·dy) with the signed spacing, as VTK
-/// places ImageData points.
-fn grid_point(grid: &Grid2d, v: usize) -> [f64; 3] {
-    let (r, c) = grid.row_col(v);
-    let ([dx, dy], [ox, oy]) = (grid.spacing(), grid.origin());
-    [ox + c as f64 * dx, oy + r as f64 * dy, 0.0]
-}
-
 /// Stages the critical points and the kept complex at `path` as `.vtp` in TTK's layout
 /// ([`super::ttk`]): one vertex cell per critical vertex of the input's persistence pairs
 /// (extrema and merge saddles, cancelled ones included; a series' end maxima, unpaired, are
@@ -534,7 +526,7 @@ pub fn stage_complex(
     let pairs = super::ttk::diagram_of(domain, h);
     let place = |v: usize| match domain {
         AnyDomain::Series(_) => [v as f64, 0.0, 0.0],
-        AnyDomain::Grid(g) => grid_point(g, v),
+        AnyDomain::Grid(g) => g.world(v),
         AnyDomain::Mesh(m) => m.point(v),
         AnyDomain::Volume(g) => g.world(v),
         AnyDomain::Tets(m) => m.point(v),
@@ -648,8 +640,7 @@ pub fn read_results(path: &Path) -> Result<Stored> {
         "vti" | "vtk" if extension(path) == "vti" || legacy_image => {
             let (domain, arrays) = match read_any_image(path)? {
                 AnyImage::Flat(img) => {
-                    let grid =
-                        Grid2d::with_geometry(img.nx, img.ny, img.spacing, img.origin).map_err(|e| e.in_file(path))?;
+                    let grid = img.grid().map_err(|e| e.in_file(path))?;
                     (AnyDomain::Grid(grid), img.arrays)
                 }
                 AnyImage::Volume(v) => {

@@ -181,9 +181,13 @@ pub fn diagram_from_table(domain: &AnyDomain, h: &[f64], table: &[ExtremumInfo])
     crate::with_domain!(domain, d => diagram_pairs(d, h, table, domain.dimension()))
 }
 
-/// The position of vertex `v`.
+/// The position of vertex `v` (a grid's in the file's coordinates).
 fn point_of(domain: &AnyDomain, v: usize) -> [f64; 3] {
-    crate::with_domain!(domain, d => d.point(v))
+    match domain {
+        AnyDomain::Grid(g) => g.world(v),
+        AnyDomain::Volume(g) => g.world(v),
+        _ => crate::with_domain!(domain, d => d.point(v)),
+    }
 }
 
 /// Stages the diagram of `pairs` at `path` (`.vtu`) in TTK's layout; `roles` marks the kept

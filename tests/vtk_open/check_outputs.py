@@ -230,6 +230,34 @@ if run("smooth", png, "--minima", "1", "--maxima", "1", "-o", ramp):
     else:
         print("ok raster .vti: every pixel where vtkPNGReader puts it")
 
+# images in the x-z and y-z planes written by VTK itself, off the origin: the outputs
+# (.vti, legacy .vtk) put every point where the input has it
+for dims, name in [((6, 1, 5), "xz"), ((1, 6, 5), "yz")]:
+    flat_img = vtk.vtkImageData()
+    flat_img.SetDimensions(*dims)
+    flat_img.SetSpacing(0.5, 2.0, 0.25)
+    flat_img.SetOrigin(1.0, 3.0, -2.0)
+    n_pts = flat_img.GetNumberOfPoints()
+    vals = np.array([np.sin(0.9 * q) + 0.1 * ((q * 7) % 5) for q in range(n_pts)])
+    arr = numpy_to_vtk(vals, deep=True, array_type=vtk.VTK_DOUBLE)
+    arr.SetName("f")
+    flat_img.GetPointData().SetScalars(arr)
+    fin = os.path.join(WORK, f"plane_{name}.vti")
+    w = vtk.vtkXMLImageDataWriter()
+    w.SetInputData(flat_img)
+    w.SetFileName(fin)
+    w.Write()
+    for ext in ["vti", "vtk"]:
+        fout = os.path.join(WORK, f"plane_{name}.out.{ext}")
+        if run("smooth", fin, "--minima", "1", "--maxima", "1", "-o", fout):
+            check_smoothed(fin, fout, "f")
+            res, _ = read(fout)
+            moved = [q for q in range(n_pts) if res.GetPoint(q) != flat_img.GetPoint(q)]
+            if res.GetNumberOfPoints() != n_pts or moved:
+                fail(fout, f"{len(moved)} points are not where the input has them")
+            else:
+                print(f"ok {name} image .{ext}: every point where the input has it")
+
 # a volume written by VTK itself (Int16 field plus a carried Float32 array), smoothed to
 # .vti, legacy .vtk and .nii.gz; the NIfTI output read by VTK's own vtkNIFTIImageReader
 vol = vtk.vtkImageData()

@@ -18,6 +18,8 @@ pub struct ImageData {
     pub spacing: [f64; 2],
     /// Position of point (row 0, column 0): the file's origin shifted by the extent's start.
     pub origin: [f64; 2],
+    /// The plane the image lies in (its x and y are the file's `plane.axes`).
+    pub plane: crate::domain::Plane,
     /// Point data arrays, in file order.
     pub arrays: Vec<PointArray>,
     /// Cell data arrays, in file order: `(nx − 1) · (ny − 1)` tuples, x fastest.
@@ -301,12 +303,12 @@ impl ImageData {
         })
     }
 
-    /// The image's grid.
+    /// The image's grid, in the image's plane.
     ///
     /// # Errors
     /// A spacing or origin that [`Grid2d::with_geometry`] refuses (zero or non-finite).
     pub fn grid(&self) -> Result<Grid2d> {
-        Grid2d::with_geometry(self.nx, self.ny, self.spacing, self.origin)
+        Grid2d::with_geometry(self.nx, self.ny, self.spacing, self.origin)?.in_plane(self.plane)
     }
 }
 

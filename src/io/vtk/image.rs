@@ -75,6 +75,7 @@ pub(super) fn image_of(ds: Dataset) -> Result<ImageData> {
         ny: nyg,
         spacing,
         origin,
+        plane: crate::domain::Plane { axes: [0, 1], level: coord(2, ext[4]) },
         arrays,
         cell_arrays,
         notes,
@@ -86,7 +87,7 @@ pub(super) fn image_of(ds: Dataset) -> Result<ImageData> {
 /// An image in the x-z or y-z plane (one point along x or y): a 2D grid over its other two
 /// axes, whose points are already in the grid's order (x fastest, the flat axis contributes
 /// nothing to the index). The grid's x and y are the file's two axes; outputs are written in
-/// the x-y plane (a note says so).
+/// the same plane.
 fn plane_of(ds: Dataset, g: &super::data::ImageGeometry) -> Result<ImageData> {
     let dims = g.dims();
     let axes = axes_of(&g.direction)?;
@@ -109,11 +110,12 @@ fn plane_of(ds: Dataset, g: &super::data::ImageGeometry) -> Result<ImageData> {
         ny: dims[v],
         spacing: [g.spacing[u], g.spacing[v]],
         origin: [start(u), start(v)],
+        plane: crate::domain::Plane { axes: [u, v], level: start(3 - u - v) },
         arrays: ds.point_data,
         // cells of a flat image: none along the flat axis, the same order
         cell_arrays: ds.cell_data,
         notes: vec![format!(
-            "the image lies in the {}-{} plane: smoothed as a 2D grid with the file's {} and {} as its x and y (outputs lie in the x-y plane)",
+            "the image lies in the {}-{} plane: smoothed as a 2D grid with the file's {} and {} as its x and y (image outputs lie in the same plane)",
             names[u], names[v], names[u], names[v]
         )],
         skipped: ds.skipped,

@@ -202,6 +202,19 @@ impl ImageBox {
     pub fn flat(nx: usize, ny: usize, spacing: [f64; 2], origin: [f64; 2]) -> ImageBox {
         ImageBox { dims: [nx, ny, 1], spacing: [spacing[0], spacing[1], 1.0], origin: [origin[0], origin[1], 0.0] }
     }
+    /// The image of a grid, in the grid's plane: one point along the plane's normal, at its
+    /// level.
+    pub fn of_grid(g: &crate::domain::Grid2d) -> ImageBox {
+        let plane = g.plane();
+        let mut b = ImageBox { dims: [1; 3], spacing: [1.0; 3], origin: [0.0; 3] };
+        for (k, &a) in plane.axes.iter().enumerate() {
+            b.dims[a] = [g.nx(), g.ny()][k];
+            b.spacing[a] = g.spacing()[k];
+            b.origin[a] = g.origin()[k];
+        }
+        b.origin[plane.normal()] = plane.level;
+        b
+    }
     /// Points.
     pub fn points(&self) -> usize {
         self.dims.iter().product()

@@ -79,7 +79,7 @@ impl TriMesh {
                 components[v] = o.tri_comp[t];
             }
         }
-        let (start, adj) = connect::adjacency(n, &table.edges);
+        let (start, adj) = super::cells::adjacency(n, &table.edges);
         Ok(TriMesh {
             positions,
             triangles,

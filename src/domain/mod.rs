@@ -11,6 +11,7 @@
 //! ```
 
 mod any;
+mod cells;
 mod grid;
 mod masked;
 mod mesh;

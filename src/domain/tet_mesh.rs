@@ -119,7 +119,7 @@ impl TetMesh {
             })
             .collect();
         let (components, n_components) = components(n, &tets);
-        let (start, adj) = adjacency(n, &edges.edges);
+        let (start, adj) = super::cells::adjacency(n, &edges.edges);
         Ok(TetMesh {
             positions,
             tets,
@@ -258,28 +258,4 @@ fn components(n: usize, tets: &[[usize; 4]]) -> (Vec<usize>, usize) {
         }
     }
     ((0..n).map(|v| label[root(&mut parent, v)]).collect(), count)
-}
-
-/// The neighbours of every vertex as compressed rows: `adj[start[v]..start[v + 1]]`, sorted.
-fn adjacency(n: usize, edges: &[(usize, usize)]) -> (Vec<usize>, Vec<usize>) {
-    let mut start = vec![0usize; n + 1];
-    for &(a, b) in edges {
-        start[a + 1] += 1;
-        start[b + 1] += 1;
-    }
-    for v in 0..n {
-        start[v + 1] += start[v];
-    }
-    let mut fill = start.clone();
-    let mut adj = vec![0usize; start[n]];
-    for &(a, b) in edges {
-        adj[fill[a]] = b;
-        fill[a] += 1;
-        adj[fill[b]] = a;
-        fill[b] += 1;
-    }
-    for v in 0..n {
-        adj[start[v]..start[v + 1]].sort_unstable();
-    }
-    (start, adj)
 }

@@ -188,6 +188,30 @@ pub fn smooth_with<D: Smoothable + Sync>(
     smooth_on(domain, &mut DomainOperators::new(domain), h, settings, analyses, false)
 }
 
+/// [`smooth_on`] again with the interior-point method, `why` the active-set point was not
+/// taken (in the report's `solver_fallback`).
+fn structured_again<D: Smoothable + Sync>(
+    domain: &D,
+    ops: &mut DomainOperators,
+    h: &[f64],
+    settings: &SmoothSettings,
+    analyses: &mut Analyses,
+    keep_analyses: bool,
+    why: String,
+) -> Result<Smoothed> {
+    let structured = SmoothSettings {
+        qp: crate::solve::QpSettings { method: Method::Structured, ..settings.qp.clone() },
+        ..settings.clone()
+    };
+    ops.own_fill = domain.own_fill_stiffness();
+    let mut again = smooth_on(domain, ops, h, &structured, analyses, keep_analyses)?;
+    again.report.solver_fallback = Some(match again.report.solver_fallback.take() {
+        Some(more) => format!("{why}; {more}"),
+        None => why,
+    });
+    Ok(again)
+}
+
 /// The pipeline on a domain whose operators are built; `keep_analyses`: the fills' analysis
 /// stays in `analyses` through the solve (else it is dropped first, for memory).
 pub(crate) fn smooth_on<D: Smoothable + Sync>(
@@ -282,6 +306,19 @@ pub(crate) fn smooth_on<D: Smoothable + Sync>(
     let stage = Stage::begin("certificate");
     let certificate = certify(domain, &f, &kept.roles, Some(h));
     seconds.verify = stage.end(|| if certificate.passed { "passed".into() } else { "FAILED".into() });
+    // an active-set point (one that stalled, say) whose repaired output does not certify is
+    // solved again by the interior-point method
+    if !certificate.passed && sol.method == Method::ActiveSet {
+        let why = format!(
+            "the active-set output ({:?} after {} outer iterations), after the margin repair moved {} vertices by up to {:.1e}, did not certify: {}",
+            sol.status,
+            sol.iterations,
+            margin_repair.changed_vertices,
+            margin_repair.max_change,
+            certificate.summary()
+        );
+        return structured_again(domain, ops, h, settings, analyses, keep_analyses, why);
+    }
     if !certificate.passed {
         return Err(Error::Uncertified {
             path: None,
@@ -312,22 +349,14 @@ pub(crate) fn smooth_on<D: Smoothable + Sync>(
     // the optimum than the fit's target is solved again by the interior-point method
     if sol.method == Method::ActiveSet && report.fit.gap_over_data.is_some_and(|g| g > ACTIVE_SET_FIT) {
         let why = format!(
-            "the active-set output, after the margin repair moved {} vertices by up to {:.1e}, was {:.1e} × the data term from the optimum",
+            "the active-set output ({:?} after {} outer iterations), after the margin repair moved {} vertices by up to {:.1e}, was {:.1e} × the data term from the optimum",
+            sol.status,
+            sol.iterations,
             report.margin_repair.changed_vertices,
             report.margin_repair.max_change,
             report.fit.gap_over_data.unwrap_or(f64::NAN)
         );
-        let structured = SmoothSettings {
-            qp: crate::solve::QpSettings { method: Method::Structured, ..settings.qp.clone() },
-            ..settings.clone()
-        };
-        ops.own_fill = domain.own_fill_stiffness();
-        let mut again = smooth_on(domain, ops, h, &structured, analyses, keep_analyses)?;
-        again.report.solver_fallback = Some(match again.report.solver_fallback.take() {
-            Some(more) => format!("{why}; {more}"),
-            None => why,
-        });
-        return Ok(again);
+        return structured_again(domain, ops, h, settings, analyses, keep_analyses, why);
     }
     let Ordered { u, complex, .. } = ordered;
     Ok(Smoothed { output: f, u, roles: kept.roles, report, complex })

@@ -815,10 +815,15 @@ pub(super) fn solve(
         let mut swapped = vec![false; nc];
         let mut swaps = 0usize;
         let mut stuck = [0usize; 5];
-        // the rows within the share of the worst; the rest too when none of those could join
-        let mut joined_any = false;
-        for (rank, &(_, k)) in violated.iter().enumerate() {
-            if rank >= joining && (joined_any || changed > 0) {
+        // the rows within the share of the worst; when none of those could join, the rows
+        // within the share of the worst one that can (rows stuck at the top would otherwise
+        // let one row join per iteration)
+        let mut beyond: Option<f64> = None;
+        for (rank, &(violation, k)) in violated.iter().enumerate() {
+            if rank == joining && changed > 0 {
+                break;
+            }
+            if beyond.is_some_and(|v| violation < JOIN_SHARE * v) {
                 break;
             }
             let before = changed;
@@ -893,7 +898,9 @@ pub(super) fn solve(
                     }
                 }
             }
-            joined_any |= changed > before;
+            if changed > before && rank >= joining && beyond.is_none() {
+                beyond = Some(violation);
+            }
         }
         let gap = gap_bound(&rows, &x, &z, &g, &r.d);
         let t5 = std::time::Instant::now();

@@ -110,6 +110,14 @@ def check_smoothed(inp, out, array):
     print(f"ok {os.path.basename(out)}: {len(got)} point arrays, {len(got_c)} cell arrays")
 
 
+def write_vti(data, path):
+    """Writes image data with VTK's XML writer and its defaults."""
+    w = vtk.vtkXMLImageDataWriter()
+    w.SetInputData(data)
+    w.SetFileName(path)
+    w.Write()
+
+
 def check_opens(path, want_arrays):
     data, said = read(path)
     if said.strip():
@@ -243,10 +251,7 @@ for dims, name in [((6, 1, 5), "xz"), ((1, 6, 5), "yz")]:
     arr.SetName("f")
     flat_img.GetPointData().SetScalars(arr)
     fin = os.path.join(WORK, f"plane_{name}.vti")
-    w = vtk.vtkXMLImageDataWriter()
-    w.SetInputData(flat_img)
-    w.SetFileName(fin)
-    w.Write()
+    write_vti(flat_img, fin)
     for ext in ["vti", "vtk"]:
         fout = os.path.join(WORK, f"plane_{name}.out.{ext}")
         if run("smooth", fin, "--minima", "1", "--maxima", "1", "-o", fout):
@@ -274,10 +279,7 @@ extra.SetName("extra")
 vol.GetPointData().SetScalars(f_arr)
 vol.GetPointData().AddArray(extra)
 vin = os.path.join(WORK, "volume_in.vti")
-w = vtk.vtkXMLImageDataWriter()
-w.SetInputData(vol)
-w.SetFileName(vin)
-w.Write()
+write_vti(vol, vin)
 for ext in ["vti", "vtk"]:
     vout = os.path.join(WORK, f"volume_out.{ext}")
     if run("smooth", vin, "--array", "density", "--persistence", "10%", "-o", vout):
@@ -307,10 +309,7 @@ m_arr = _to_vtk(brain.ravel(), deep=True, array_type=vtk.VTK_UNSIGNED_CHAR)
 m_arr.SetName("brain")
 vol.GetPointData().AddArray(m_arr)
 min_ = os.path.join(WORK, "volume_masked_in.vti")
-w = vtk.vtkXMLImageDataWriter()
-w.SetInputData(vol)
-w.SetFileName(min_)
-w.Write()
+write_vti(vol, min_)
 mout = os.path.join(WORK, "volume_masked_out.vti")
 if run("smooth", min_, "--array", "density", "--mask", "brain", "--persistence", "10%", "-o", mout):
     check_smoothed(min_, mout, "density")

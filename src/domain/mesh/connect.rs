@@ -1,5 +1,5 @@
 //! How a validated mesh hangs together: triangles oriented consistently per component, the
-//! vertex adjacency, the boundary loops.
+//! boundary loops (the vertex adjacency is `domain::cells`).
 
 use super::validate::EdgeTable;
 
@@ -56,30 +56,6 @@ pub(super) fn orient(triangles: &mut [[usize; 3]], table: &EdgeTable) -> Orienta
         n_components += 1;
     }
     Orientation { tri_comp, n_components, flipped, non_orientable }
-}
-
-/// The neighbours of every vertex as compressed rows: `adj[start[v]..start[v + 1]]`, sorted.
-pub(super) fn adjacency(n: usize, edges: &[(usize, usize)]) -> (Vec<usize>, Vec<usize>) {
-    let mut start = vec![0usize; n + 1];
-    for &(a, b) in edges {
-        start[a + 1] += 1;
-        start[b + 1] += 1;
-    }
-    for v in 0..n {
-        start[v + 1] += start[v];
-    }
-    let mut fill = start.clone();
-    let mut adj = vec![0usize; start[n]];
-    for &(a, b) in edges {
-        adj[fill[a]] = b;
-        fill[a] += 1;
-        adj[fill[b]] = a;
-        fill[b] += 1;
-    }
-    for v in 0..n {
-        adj[start[v]..start[v + 1]].sort_unstable();
-    }
-    (start, adj)
 }
 
 /// Boundary loops: the components of the boundary edges (manifold vertices: each boundary

@@ -103,43 +103,18 @@ pub(super) fn check_elements(positions: &[[f64; 3]], triangles: &[[usize; 3]]) -
         ))
         .at(Location::Triangle(bad[0])));
     }
-    let mut keyed: Vec<([usize; 3], usize)> = triangles
-        .iter()
-        .enumerate()
-        .map(|(t, tri)| {
-            let mut key = *tri;
-            key.sort_unstable();
-            (key, t)
-        })
-        .collect();
-    keyed.sort_unstable();
-    let mut dups: Vec<(usize, usize)> =
-        keyed.windows(2).filter(|w| w[0].0 == w[1].0).map(|w| (w[1].1, w[0].1)).collect();
-    dups.sort_unstable();
-    drop(keyed);
+    let dups = crate::domain::cells::duplicate_cells(triangles);
     if let Some(&(first, _)) = dups.first() {
         let shown: Vec<String> = dups.iter().map(|(t, first)| format!("{t} (= {first})")).collect();
         return Err(Error::input(format!("duplicate triangles {}", list(&shown))).at(Location::Triangle(first)));
     }
-    let mut used = vec![false; n];
-    for tri in triangles {
-        for &v in tri {
-            used[v] = true;
-        }
-    }
-    let bad: Vec<usize> = (0..n).filter(|&v| !used[v]).collect();
+    let bad = crate::domain::cells::unused_vertices(n, triangles);
     if !bad.is_empty() {
         return Err(
             Error::input(format!("vertices {} are used by no triangle", list(&bad))).at(Location::Vertex(bad[0]))
         );
     }
-    let mut order: Vec<usize> = (0..n).collect();
-    order.sort_unstable_by(|&a, &b| positions[a].partial_cmp(&positions[b]).expect("finite"));
-    let pairs: Vec<(usize, usize)> = order
-        .windows(2)
-        .filter(|w| positions[w[0]] == positions[w[1]])
-        .map(|w| (w[0].min(w[1]), w[0].max(w[1])))
-        .collect();
+    let pairs = crate::domain::cells::coincident_vertices(positions);
     if let Some(&(first, _)) = pairs.first() {
         let shown: Vec<String> = pairs.iter().map(|(a, b)| format!("{a} and {b}")).collect();
         return Err(Error::input(format!(

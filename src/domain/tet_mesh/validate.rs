@@ -87,54 +87,19 @@ pub(super) fn check_elements(positions: &[[f64; 3]], tets: &[[usize; 4]]) -> Res
         })
         .collect();
     refuse(&bad, "have zero volume (degenerate: coplanar or coincident corners)")?;
-    let mut keyed: Vec<([usize; 4], usize)> = tets
-        .iter()
-        .enumerate()
-        .map(|(t, tet)| {
-            let mut key = *tet;
-            key.sort_unstable();
-            (key, t)
-        })
-        .collect();
-    keyed.sort_unstable();
-    // every later copy with the first of its corners (the same key, sorted by index)
-    let mut dups: Vec<(usize, usize)> = Vec::new();
-    let mut i = 0;
-    while i < keyed.len() {
-        let mut j = i + 1;
-        while j < keyed.len() && keyed[j].0 == keyed[i].0 {
-            dups.push((keyed[j].1, keyed[i].1));
-            j += 1;
-        }
-        i = j;
-    }
-    drop(keyed);
-    dups.sort_unstable();
+    let dups = crate::domain::cells::duplicate_cells(tets);
     if let Some(&(first, _)) = dups.first() {
         let shown: Vec<String> = dups.iter().map(|(t, first)| format!("{t} (= {first})")).collect();
         return Err(Error::input(format!("duplicate tetrahedra {} (the same corners)", list(&shown)))
             .at(Location::Tetrahedron(first)));
     }
-    let mut used = vec![false; n];
-    for tet in tets {
-        for &v in tet {
-            used[v] = true;
-        }
-    }
-    let bad: Vec<usize> = (0..n).filter(|&v| !used[v]).collect();
+    let bad = crate::domain::cells::unused_vertices(n, tets);
     if !bad.is_empty() {
         return Err(
             Error::input(format!("vertices {} are used by no tetrahedron", list(&bad))).at(Location::Vertex(bad[0]))
         );
     }
-    let mut order: Vec<usize> = (0..n).collect();
-    order.sort_unstable_by(|&a, &b| positions[a].partial_cmp(&positions[b]).expect("finite"));
-    let mut pairs: Vec<(usize, usize)> = order
-        .windows(2)
-        .filter(|w| positions[w[0]] == positions[w[1]])
-        .map(|w| (w[0].min(w[1]), w[0].max(w[1])))
-        .collect();
-    pairs.sort_unstable();
+    let pairs = crate::domain::cells::coincident_vertices(positions);
     if let Some(&(first, _)) = pairs.first() {
         let shown: Vec<String> = pairs.iter().map(|(a, b)| format!("{a} and {b}")).collect();
         return Err(Error::input(format!(

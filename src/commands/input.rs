@@ -103,16 +103,17 @@ pub enum MaskRule {
     Below(f64),
 }
 
-/// A grid field ready to smooth.
+/// A field on an image grid, ready to smooth: a 2D grid ([`GridInput`]) or a volume
+/// ([`VolumeInput`]).
 #[derive(Clone, Debug)]
-pub struct GridInput {
+pub struct ImageInput<G> {
     /// The grid with its spacing and origin.
-    pub grid: Grid2d,
+    pub grid: G,
     /// The values to smooth (after deriving and filling).
     pub values: Vec<f64>,
     /// What the values are: the array read or the derivation.
     pub description: String,
-    /// Samples filled by `--fill-missing` (1) or not (0), when any were.
+    /// Samples filled by `--fill-missing` (true), when any were.
     pub filled: Option<Vec<bool>>,
     /// The file the grid came from (the first velocity file with `--u/--v`).
     pub path: PathBuf,
@@ -120,30 +121,15 @@ pub struct GridInput {
     pub carried: Option<Carried>,
     /// What reading found worth saying (an oblique NIfTI affine).
     pub notes: Vec<String>,
-    /// The pixels inside `--mask` / `--mask-below`, when given.
+    /// The pixels or voxels inside `--mask` / `--mask-below`, when given.
     pub mask: Option<Vec<bool>>,
 }
 
+/// A 2D grid field ready to smooth.
+pub type GridInput = ImageInput<Grid2d>;
+
 /// A volume field ready to smooth.
-#[derive(Clone, Debug)]
-pub struct VolumeInput {
-    /// The volume grid with its spacing and origin.
-    pub grid: Grid3d,
-    /// The values to smooth (after deriving and filling).
-    pub values: Vec<f64>,
-    /// What the values are: the array read or the derivation.
-    pub description: String,
-    /// Samples filled by `--fill-missing`, when any were.
-    pub filled: Option<Vec<bool>>,
-    /// The file the volume came from.
-    pub path: PathBuf,
-    /// A VTK image's arrays (or a NIfTI file's affine), for outputs that carry them through.
-    pub carried: Option<Carried>,
-    /// What reading found worth saying (an oblique NIfTI affine).
-    pub notes: Vec<String>,
-    /// The voxels inside `--mask` / `--mask-below`, when given.
-    pub mask: Option<Vec<bool>>,
-}
+pub type VolumeInput = ImageInput<Grid3d>;
 
 /// A field on a triangle mesh, ready to smooth.
 #[derive(Clone, Debug)]

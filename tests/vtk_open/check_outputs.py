@@ -345,6 +345,15 @@ if run("smooth", t1, "-o", t1_out, "--complex", t1_cx, "--diagram", t1_d):
     else:
         print(f"ok volume complex: {len(ids)} critical points on their voxels, codes {sorted(codes)}")
 
+# the synthetic ABC flow: a derived field (|curl u|) from a 3-component velocity volume
+abc = os.path.join(DATASETS, "abc_flow_noisy_32x32x32.vti")
+abc_out = os.path.join(WORK, "abc_out.vti")
+if run("smooth", abc, "--derive", "vorticity-magnitude", "--persistence", "10%", "-o", abc_out):
+    check_opens(abc_out, ["smoothed", "input", "representative", "role"])
+    a, _ = read(abc_out)
+    if a.GetDimensions() != (32, 32, 32) or a.GetPointData().GetScalars().GetName() != "smoothed":
+        fail(abc_out, f"dimensions {a.GetDimensions()}; the active scalars are not `smoothed`")
+
 if failures:
     print(f"{len(failures)} failures", file=sys.stderr)
     sys.exit(1)

@@ -745,9 +745,9 @@ pub(super) fn solve(
     let mut history: Vec<(usize, usize, usize)> = Vec::new();
     let margin = rows.iter().map(|r| if let Row::Pair(_, _, b) = *r { -b } else { 0.0 }).fold(0.0, f64::max);
     let stuck_above = (STUCK_SHARE * margin).max(ADD_ABOVE);
-    // rows that once joined two anchored clusters (an anchor left for them): not again, as
-    // the next cut tends to undo it
-    let mut tabu = vec![false; rows.len()];
+    // how often a row joined two anchored clusters (an anchor left for it): twice at most,
+    // once per anchor, as the next cut tends to undo it
+    let mut tabu = vec![0u8; rows.len()];
     while outer < MAX_OUTER {
         outer += 1;
         let t0 = std::time::Instant::now();
@@ -854,7 +854,7 @@ pub(super) fn solve(
                         in_set[k] = true;
                         changed += 1;
                     } else if a != b
-                        && !tabu[k]
+                        && tabu[k] < 2
                         && (a, b) == (ci, cj)
                         && !swapped[ci as usize]
                         && !swapped[cj as usize]
@@ -862,13 +862,15 @@ pub(super) fn solve(
                         && anchor_row[cj as usize] != usize::MAX
                     {
                         // two clusters on their bounds that the row pulls together: one
-                        // leaves its bound (the one holding it less), the row joins them
+                        // leaves its bound, the row joins them; the bound holding its cluster
+                        // less leaves first, the other one if the row comes back
                         let (ri, rj) = (anchor_row[ci as usize], anchor_row[cj as usize]);
-                        let out = if z[ri] <= z[rj] { ri } else { rj };
+                        let (weaker, stronger) = if z[ri] <= z[rj] { (ri, rj) } else { (rj, ri) };
+                        let out = if tabu[k] == 0 { weaker } else { stronger };
                         in_set[out] = false;
                         z[out] = 0.0;
                         in_set[k] = true;
-                        tabu[k] = true;
+                        tabu[k] += 1;
                         parent[a as usize] = b;
                         swapped[ci as usize] = true;
                         swapped[cj as usize] = true;

@@ -649,6 +649,15 @@ fn a_masked_2d_grid_is_smoothed_on_its_triangles_without_pinch_points_and_verifi
     let input = dir.join("disk.vti");
     ascii_vti(&input, &format!("0 {} 0 {} 0 0", nx - 1, ny - 1), "1 1 1", &values);
     let out = dir.join("disk_out.vti");
+    // the complex and the diagram would be the whole grid's: refused before any work
+    for flag in ["--complex", "--diagram"] {
+        let side = dir.join(if flag == "--complex" { "c.vtp" } else { "d.vtu" });
+        let args = ["smooth", input.to_str().unwrap(), "--mask-below", "-10", "-o", out.to_str().unwrap()];
+        let o = toposmooth(&[&args[..], &[flag, side.to_str().unwrap()]].concat());
+        assert_eq!(o.status.code(), Some(2), "{}", text(&o));
+        assert!(text(&o).contains(flag) && text(&o).contains("mask"), "{}", text(&o));
+        assert!(!out.exists() && !side.exists());
+    }
     let o = succeeds(&["smooth", input.to_str().unwrap(), "--mask-below", "-10", "-o", out.to_str().unwrap()]);
     assert!(text(&o).contains("mask: ") && text(&o).contains("certified"), "{}", text(&o));
     let s = stored(&out);

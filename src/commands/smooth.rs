@@ -124,6 +124,17 @@ pub(super) fn smooth_shared(args: &SmoothArgs, shared: Option<&mut Option<Shared
     if let Some(d) = &args.diagram {
         crate::io::ttk::check_diagram_output(d)?;
     }
+    // the pairs and critical points would be the whole grid's, background included
+    if args.grid.mask.is_some() {
+        if let Some(flag) = [("--complex", args.complex.is_some()), ("--diagram", args.diagram.is_some())]
+            .into_iter()
+            .find_map(|(flag, given)| given.then_some(flag))
+        {
+            return Err(Error::Usage(format!(
+                "{flag} is not written for a run inside a mask (--mask, --mask-below) yet: the diagram and the critical points would be the whole grid's"
+            )));
+        }
+    }
     let start = Instant::now();
     let mut field = read_field(args.input.as_deref(), args.kind, &args.csv, &args.grid)?.into_field(&input_path)?;
     if let Some(c) = &args.complex {

@@ -524,13 +524,7 @@ pub fn stage_complex(
     use super::ttk::critical;
     check_complex_output(path, domain)?;
     let pairs = super::ttk::diagram_of(domain, h);
-    let place = |v: usize| match domain {
-        AnyDomain::Series(_) => [v as f64, 0.0, 0.0],
-        AnyDomain::Grid(g) => g.world(v),
-        AnyDomain::Mesh(m) => m.point(v),
-        AnyDomain::Volume(g) => g.world(v),
-        AnyDomain::Tets(m) => m.point(v),
-    };
+    let place = |v: usize| super::ttk::point_of(domain, v);
     // each vertex's critical type and diagram pair (the first pair that names it); a vertex
     // named as a 1-saddle and as a 2-saddle is degenerate
     let mut critical_of: std::collections::BTreeMap<usize, (i32, usize)> = std::collections::BTreeMap::new();

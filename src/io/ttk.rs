@@ -181,8 +181,9 @@ pub fn diagram_from_table(domain: &AnyDomain, h: &[f64], table: &[ExtremumInfo])
     crate::with_domain!(domain, d => diagram_pairs(d, h, table, domain.dimension()))
 }
 
-/// The position of vertex `v` (a grid's in the file's coordinates).
-fn point_of(domain: &AnyDomain, v: usize) -> [f64; 3] {
+/// The position of vertex `v` (a grid's and a volume's in the file's coordinates, as VTK
+/// places the image's points).
+pub(crate) fn point_of(domain: &AnyDomain, v: usize) -> [f64; 3] {
     match domain {
         AnyDomain::Grid(g) => g.world(v),
         AnyDomain::Volume(g) => g.world(v),

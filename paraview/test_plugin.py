@@ -59,3 +59,35 @@ full = servermanager.Fetch(diagram)
 kept_flags = numpy_support.vtk_to_numpy(full.GetCellData().GetArray("Kept"))
 assert int((ids >= 0).sum()) == int(kept_flags[:-1].sum()), (int((ids >= 0).sum()), int(kept_flags.sum()))
 print(f"ok Persistence Diagram: Threshold on Persistence keeps the {int((ids >= 0).sum())} kept pairs")
+
+# every property of the filters is a setting of the library's schema (toposmooth.SETTINGS, from
+# which the CLI's flags are made), with the schema's default: a property added to the plugin
+# alone fails here
+import toposmooth  # noqa: E402
+
+schema = {s["name"]: s for s in toposmooth.SETTINGS}
+for proxy, algorithm in ((TopologyControlledSmoothing(Input=speed), "smoothing"), (PersistenceDiagramtoposmooth(Input=speed), "diagram")):  # noqa: F821
+    proxy.UpdateVTKObjects()
+    defaults = proxy.GetClientSideObject().settings()
+    assert set(defaults) <= set(schema), (algorithm, set(defaults) - set(schema))
+    fresh = type(proxy.GetClientSideObject())().settings()
+    assert defaults == fresh, (algorithm, "the properties' defaults are the algorithm's", defaults, fresh)
+    for name in proxy.ListProperties():
+        if name in ("Input", "Scalars"):
+            continue
+        before = proxy.GetClientSideObject().settings()
+        value = getattr(proxy, name)
+        if isinstance(value, str):
+            other = [v for v in proxy.GetProperty(name).Available if v != value][0]
+        elif isinstance(value, int):
+            other = value + 1
+        else:
+            other = value / 2 + 0.01
+        setattr(proxy, name, other)
+        proxy.UpdateVTKObjects()
+        after = proxy.GetClientSideObject().settings()
+        changed = {k for k in set(before) | set(after) if before.get(k) != after.get(k)}
+        assert changed and changed <= set(schema), (algorithm, name, "changes no setting of the schema", changed)
+        setattr(proxy, name, value)
+        proxy.UpdateVTKObjects()
+    print(f"ok {algorithm}: {len(proxy.ListProperties()) - 2} properties, each a setting of toposmooth.SETTINGS")

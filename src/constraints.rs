@@ -20,17 +20,20 @@ use crate::domain::{sos_less, sos_sort, Domain};
 use crate::error::{Error, Result};
 
 /// Which edges carry an ordering constraint.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[cfg_attr(feature = "serde", serde(rename_all = "lowercase"))]
 #[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 pub enum EdgeSet {
     /// Per free vertex its lowest and highest neighbour in u, plus every edge between a fixed
     /// and a free vertex.
+    #[default]
     Minimal,
     /// Every edge with at least one free end.
     All,
 }
+
+named_enum!(EdgeSet, "edge set", [(EdgeSet::Minimal, "minimal"), (EdgeSet::All, "all")]);
 
 /// Constrained edges `(i, j)` meaning `f_j − f_i ≥ ε`, sorted and without duplicates.
 pub fn constraint_edges<D: Domain>(domain: &D, u: &[f64], fixed: &[Option<f64>], set: EdgeSet) -> Vec<(usize, usize)> {

@@ -80,6 +80,10 @@ pub enum Error {
         /// Solver status as text.
         status: String,
     },
+    /// The run was cancelled: the caller's [`crate::progress::CancelToken`], or SIGINT in the
+    /// command-line tool (exit 130). Nothing is left behind.
+    #[error("cancelled")]
+    Cancelled,
     /// Reading or writing a file failed.
     #[error("{}: {source}", path.display())]
     Io {
@@ -165,6 +169,8 @@ pub enum ErrorKind {
     Internal,
     /// The solver returned no point (exit 4).
     NoSolution,
+    /// The run was cancelled (exit 130, as a shell reports SIGINT).
+    Cancelled,
 }
 
 impl ErrorKind {
@@ -175,6 +181,7 @@ impl ErrorKind {
             ErrorKind::Usage => 2,
             ErrorKind::Input | ErrorKind::Infeasible | ErrorKind::Io => 3,
             ErrorKind::NoSolution => 4,
+            ErrorKind::Cancelled => 130,
         }
     }
 }
@@ -243,6 +250,7 @@ impl Error {
             Error::NoSolution { path, status } => Error::NoSolution { path: file(path), status: text(status) },
             Error::Usage(m) => Error::Usage(text(m)),
             Error::Setting { setting, message } => Error::Setting { setting, message: text(message) },
+            Error::Cancelled => Error::Cancelled,
             Error::Io { path, source } => {
                 Error::Io { path: if path == from { to.to_path_buf() } else { path }, source }
             }
@@ -262,7 +270,7 @@ impl Error {
                     *path = Some(file.into());
                 }
             }
-            Error::Usage(_) | Error::Setting { .. } | Error::Io { .. } => {}
+            Error::Usage(_) | Error::Setting { .. } | Error::Io { .. } | Error::Cancelled => {}
         }
         self
     }
@@ -277,6 +285,7 @@ impl Error {
             Error::Uncertified { .. } => ErrorKind::Uncertified,
             Error::Representative { .. } | Error::Internal { .. } => ErrorKind::Internal,
             Error::NoSolution { .. } => ErrorKind::NoSolution,
+            Error::Cancelled => ErrorKind::Cancelled,
         }
     }
 
@@ -290,7 +299,7 @@ impl Error {
             | Error::Uncertified { path, .. }
             | Error::NoSolution { path, .. } => path.as_deref(),
             Error::Io { path, .. } => Some(path),
-            Error::Usage(_) | Error::Setting { .. } => None,
+            Error::Usage(_) | Error::Setting { .. } | Error::Cancelled => None,
         }
     }
 
@@ -327,6 +336,7 @@ mod tests {
             (Error::internal("b"), ErrorKind::Internal, 1),
             (Error::Representative { path: None, message: "r".into() }, ErrorKind::Internal, 1),
             (Error::NoSolution { path: None, status: "s".into() }, ErrorKind::NoSolution, 4),
+            (Error::Cancelled, ErrorKind::Cancelled, 130),
         ];
         for (e, kind, code) in cases {
             assert_eq!((e.kind(), e.exit_code()), (kind, code), "{e}");

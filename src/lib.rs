@@ -35,6 +35,9 @@
 //! ```
 #![warn(missing_docs)]
 
+#[macro_use]
+mod named;
+
 #[cfg(feature = "serde")]
 pub mod apps;
 pub mod domain;

@@ -48,7 +48,8 @@ pub fn faer_par() -> faer::Par {
 }
 
 /// Runs `a` on this thread and `b` on another when two threads are allowed (the cap is split
-/// between them), else `a` then `b` here. A panic in either is propagated.
+/// between them), else `a` then `b` here. A panic in either is propagated; the run's
+/// cancellation token ([`crate::progress::cancellable`]) is checked on both.
 pub fn join<RA, RB: Send>(a: impl FnOnce() -> RA, b: impl FnOnce() -> RB + Send) -> (RA, RB) {
     let n = threads();
     if n < 2 {
@@ -56,8 +57,9 @@ pub fn join<RA, RB: Send>(a: impl FnOnce() -> RA, b: impl FnOnce() -> RB + Send)
         return (ra, b());
     }
     let (na, nb) = (n - n / 2, n / 2);
+    let token = crate::progress::token();
     std::thread::scope(|scope| {
-        let other = scope.spawn(move || with_threads(nb, b));
+        let other = scope.spawn(move || crate::progress::with_token(token, || with_threads(nb, b)));
         let ra = with_threads(na, a);
         (ra, other.join().unwrap_or_else(|e| std::panic::resume_unwind(e)))
     })

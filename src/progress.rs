@@ -1,7 +1,13 @@
 //! Progress of the stages that can take long (the complex, the representative's rounds, the
-//! solver's iterations with their gap), told to an [`Observer`] the caller installs for the
-//! calling thread with [`observe`]. Without one nothing is formatted and nothing is printed:
-//! the library never writes to a terminal itself; the command-line tool draws the bars.
+//! solver's iterations with their gap, and how far each is where that is known), told to an
+//! [`Observer`] the caller installs for the calling thread with [`observe`]. Without one
+//! nothing is formatted and nothing is printed: the library never writes to a terminal
+//! itself; the command-line tool draws the bars.
+//!
+//! A run can be stopped: the caller holds a [`CancelToken`], installs it with [`cancellable`]
+//! and cancels it from any thread (a signal handler, a "stop" button); the run checks it
+//! between stages and inside every iterative loop ([`checkpoint`]) and ends with
+//! [`Error::Cancelled`], having written nothing.
 //!
 //! ```
 //! use std::sync::{Arc, Mutex};
@@ -23,7 +29,9 @@
 //! # Ok::<(), toposmooth::Error>(())
 //! ```
 
+use crate::error::{Error, Result};
 use std::cell::RefCell;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::Instant;
 
@@ -38,6 +46,10 @@ pub trait Observer: Send + Sync {
     fn end(&self, stage: &str, seconds: f64, summary: &str);
     /// The stage stopped on an error (the error itself is reported by the caller).
     fn abandon(&self, _stage: &str) {}
+    /// How far the stage is, from 0 to 1, where that is known: the solver's gap on a log
+    /// scale from its first iterate to its target, the functions of `weights` done, the
+    /// inputs of a batch. It may go back (a solver handing over to another).
+    fn fraction(&self, _stage: &str, _done: f64) {}
 }
 
 thread_local! {
@@ -61,6 +73,84 @@ pub fn observe<R>(observer: Arc<dyn Observer>, work: impl FnOnce() -> R) -> R {
 /// The observer installed on this thread.
 pub(crate) fn current() -> Option<Arc<dyn Observer>> {
     CURRENT.with(|c| c.borrow().clone())
+}
+
+/// A flag the caller holds to stop a run: clones share it, [`CancelToken::cancel`] may be
+/// called from any thread (also from a signal handler's thread: it only stores a flag).
+#[derive(Clone, Debug, Default)]
+pub struct CancelToken(Arc<AtomicBool>);
+
+impl CancelToken {
+    /// A token not cancelled.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Asks every run holding this token to stop at its next check.
+    pub fn cancel(&self) {
+        self.0.store(true, Ordering::SeqCst);
+    }
+
+    /// Whether [`CancelToken::cancel`] was called.
+    pub fn is_cancelled(&self) -> bool {
+        self.0.load(Ordering::SeqCst)
+    }
+}
+
+thread_local! {
+    static TOKEN: RefCell<Option<CancelToken>> = const { RefCell::new(None) };
+}
+
+/// Runs `work` with `token` checked by the runs on this thread (and the threads they split
+/// into with [`crate::parallel::join`]); the token in place before is restored afterwards.
+pub fn cancellable<R>(token: CancelToken, work: impl FnOnce() -> R) -> R {
+    with_token(Some(token), work)
+}
+
+/// The token installed on this thread, to carry into a thread the work splits into.
+pub(crate) fn token() -> Option<CancelToken> {
+    TOKEN.with(|t| t.borrow().clone())
+}
+
+/// Runs `work` with `token` (or none) installed on this thread.
+pub(crate) fn with_token<R>(token: Option<CancelToken>, work: impl FnOnce() -> R) -> R {
+    struct Restore(Option<CancelToken>);
+    impl Drop for Restore {
+        fn drop(&mut self) {
+            let previous = self.0.take();
+            TOKEN.with(|t| *t.borrow_mut() = previous);
+        }
+    }
+    let _restore = Restore(TOKEN.with(|t| std::mem::replace(&mut *t.borrow_mut(), token)));
+    work()
+}
+
+/// Whether the run on this thread was cancelled.
+pub fn cancelled() -> bool {
+    TOKEN.with(|t| t.borrow().as_ref().is_some_and(CancelToken::is_cancelled))
+}
+
+/// `Err(Error::Cancelled)` once the run on this thread is cancelled: called between stages
+/// and in every iterative loop.
+///
+/// # Errors
+/// [`Error::Cancelled`].
+pub fn checkpoint() -> Result<()> {
+    if cancelled() {
+        Err(Error::Cancelled)
+    } else {
+        Ok(())
+    }
+}
+
+/// A run's result, [`Error::Cancelled`] if the run was cancelled: a loop that stops on the
+/// token ends with its own error (a solver's "stopped"), which must not reach the caller as
+/// a failure, nor start a fallback.
+pub(crate) fn settle<T>(result: Result<T>) -> Result<T> {
+    match result {
+        Err(_) if cancelled() => Err(Error::Cancelled),
+        r => r,
+    }
 }
 
 /// A stage in progress: [`Stage::end`] tells its summary; dropped without it (an error on the
@@ -88,6 +178,13 @@ impl Stage {
         }
     }
 
+    /// Tells how far the stage is (0 to 1).
+    pub fn fraction(&self, done: f64) {
+        if let Some(o) = &self.observer {
+            o.fraction(self.name, done.clamp(0.0, 1.0));
+        }
+    }
+
     /// Ends the stage with `summary`; returns its seconds.
     pub fn end(mut self, summary: impl FnOnce() -> String) -> f64 {
         let seconds = self.start.elapsed().as_secs_f64();
@@ -112,6 +209,22 @@ pub(crate) fn update(stage: &'static str, message: impl FnOnce() -> String) {
     if let Some(o) = current() {
         o.update(stage, &message());
     }
+}
+
+/// Tells the current stage's observer (if any) how far it is, as [`update`] does.
+pub(crate) fn fraction(stage: &'static str, done: f64) {
+    if let Some(o) = current() {
+        o.fraction(stage, done.clamp(0.0, 1.0));
+    }
+}
+
+/// How far a value that falls on a log scale from `first` towards `target` is (0 at `first`,
+/// 1 at or below `target`): an interior-point gap, a largest violation.
+pub(crate) fn log_fraction(first: f64, now: f64, target: f64) -> f64 {
+    if !(first > target && target > 0.0 && now.is_finite()) {
+        return if now <= target { 1.0 } else { 0.0 };
+    }
+    ((first / now.max(target)).ln() / (first / target).ln()).clamp(0.0, 1.0)
 }
 
 #[cfg(test)]

@@ -206,6 +206,9 @@ pub fn separatrix_representative<D: crate::domain::Domain>(
     };
     let mut prescribed = prescribed;
     for round in 1..=MAX_RELEASE_ROUNDS {
+        if crate::progress::cancelled() {
+            return Err(ConstructionError::Unfit("cancelled".into()));
+        }
         let fixed: Vec<Option<f64>> = (0..n).map(|v| if released[v] { None } else { prescribed[v] }).collect();
         let u = dirichlet.solve(&fixed)?;
         let bad = failing(domain, kept, &u);

@@ -6,9 +6,8 @@ mod common;
 
 use common::dataset;
 use std::path::Path;
-use toposmooth::commands::input::{read_field, read_trimesh, Derive, DomainKind, FieldInput, GridOptions};
 use toposmooth::domain::{Domain, Grid2d, TriMesh};
-use toposmooth::io::series_csv::SeriesCsvOptions;
+use toposmooth::io::import::{read, read_trimesh, Derive, DomainKind, ReadOptions};
 use toposmooth::operators::{
     cotan_stiffness, grid_mass, grid_stiffness, lumped_mass, positive_cotan_stiffness, Sparse,
 };
@@ -130,9 +129,9 @@ fn grid(file: &str) -> Grid2d {
     let path = dataset(file);
     // the Kármán .vti holds velocity: read as its vorticity, as the README runs it
     let derive = file.ends_with(".vti").then_some(Derive::Vorticity);
-    let options = GridOptions { derive, fill_missing: true, ..Default::default() };
-    match read_field(Some(Path::new(&path)), DomainKind::Grid, &SeriesCsvOptions::default(), &options).unwrap() {
-        FieldInput::Grid(g) => g.grid,
+    let options = ReadOptions { domain: DomainKind::Grid, derive, fill_missing: true, ..Default::default() };
+    match read(Some(Path::new(&path)), &options).unwrap().domain {
+        toposmooth::AnyDomain::Grid(g) => g,
         _ => panic!("{file} is not a grid"),
     }
 }

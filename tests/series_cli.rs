@@ -142,15 +142,11 @@ fn semicolons_tabs_and_decimal_commas_read_as_the_comma_file() {
 
 #[test]
 fn aware_timestamps_count_at_their_instant() {
-    use toposmooth::commands::input::{read_field, DomainKind, GridOptions};
-    use toposmooth::io::series_csv::SeriesCsvOptions;
+    use toposmooth::io::import::ReadOptions;
     let read = |name: &str, fill: bool| {
-        let grid = GridOptions { fill_missing: fill, ..Default::default() };
+        let options = ReadOptions { fill_missing: fill, ..Default::default() };
         let p = fixture(name);
-        read_field(Some(Path::new(&p)), DomainKind::Auto, &SeriesCsvOptions::default(), &grid)
-            .unwrap()
-            .into_field(Path::new(&p))
-            .unwrap()
+        toposmooth::io::import::read(Some(Path::new(&p)), &options).unwrap()
     };
     // `Z` and `+00:00` name the same instants, twelve hours apart
     for name in ["utc_z.csv", "utc_offset.csv"] {

@@ -119,6 +119,9 @@ fn long_grid(dir: &Path) -> PathBuf {
     p
 }
 
+/// SIGINT cancels the run, which stops at its next check and exits with 130; SIGTERM ends it
+/// at once as the signal does. Both remove the temporaries reserved before the work and write
+/// nothing.
 #[test]
 fn an_interrupted_run_removes_its_temporaries_and_writes_nothing() {
     for signal in [libc::SIGINT, libc::SIGTERM] {
@@ -141,12 +144,57 @@ fn an_interrupted_run_removes_its_temporaries_and_writes_nothing() {
         }
         // SAFETY: signalling our own child
         assert_eq!(unsafe { libc::kill(child.id() as libc::pid_t, signal) }, 0);
-        let status = child.wait().unwrap();
+        let o = child.wait_with_output().unwrap();
         use std::os::unix::process::ExitStatusExt;
-        assert_eq!(status.signal(), Some(signal), "ends as the signal ends a process: {status:?}");
+        if signal == libc::SIGINT {
+            assert_eq!(o.status.code(), Some(130), "cancelled: {}", text(&o));
+            assert!(String::from_utf8_lossy(&o.stderr).contains("error: cancelled"), "{}", text(&o));
+        } else {
+            assert_eq!(o.status.signal(), Some(signal), "ends as the signal ends a process: {:?}", o.status);
+        }
         assert!(temporaries(out.parent().unwrap()).is_empty(), "{:?}", temporaries(out.parent().unwrap()));
         assert!(!out.exists() && !report.exists());
     }
+}
+
+/// SIGINT while the solver iterates on a 300 × 300 grid: the run stops at its next iteration
+/// (exit 130, within the grace after which the tool ends itself as SIGINT does), leaving no
+/// temporary and no output.
+#[test]
+fn sigint_during_the_solve_cancels_the_run_and_leaves_nothing() {
+    use std::io::BufRead;
+    let dir = scratch("interrupt-solve");
+    let input = long_grid(&dir);
+    let out = dir.join("out").join("smoothed.vti");
+    std::fs::create_dir(out.parent().unwrap()).unwrap();
+    let report = out.with_file_name("run.json");
+    let mut child = Command::new(bin())
+        .args(["smooth", input.to_str().unwrap(), "-o", out.to_str().unwrap(), "--persistence", "1%"])
+        .args(["--report", report.to_str().unwrap()])
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    // off a terminal each finished stage is a line: the solve starts after the representative's
+    let mut lines = std::io::BufReader::new(child.stderr.take().unwrap()).lines();
+    let mut seen = Vec::new();
+    for line in lines.by_ref() {
+        let line = line.unwrap();
+        seen.push(line.clone());
+        if line.starts_with("representative:") {
+            break;
+        }
+    }
+    assert!(seen.last().is_some_and(|l| l.starts_with("representative:")), "{seen:?}");
+    // SAFETY: signalling our own child
+    assert_eq!(unsafe { libc::kill(child.id() as libc::pid_t, libc::SIGINT) }, 0);
+    let rest: Vec<String> = lines.map(|l| l.unwrap()).collect();
+    let status = child.wait().unwrap();
+    assert_eq!(status.code(), Some(130), "{seen:?} {rest:?}");
+    assert!(!rest.iter().any(|l| l.starts_with("solve:")), "the solve did not finish: {rest:?}");
+    assert!(rest.iter().any(|l| l.contains("error: cancelled")), "{rest:?}");
+    assert!(temporaries(out.parent().unwrap()).is_empty(), "{:?}", temporaries(out.parent().unwrap()));
+    assert!(!out.exists() && !report.exists());
 }
 
 #[test]
@@ -449,4 +497,24 @@ fn the_input_summary_is_printed_while_the_work_has_not_ended() {
     }
     assert!(first.starts_with("read: ") && first.contains("grid 300 × 300 (90000 vertices)"), "{first:?}");
     assert!(running && !solved_yet, "the summary came before the work ended");
+}
+
+/// Off a terminal, a stage that runs for more than a second prints how far it is each time it
+/// passes a further tenth: the solve of a 300 × 300 grid, its gap on a log scale to the target.
+#[test]
+fn a_long_solve_prints_its_fraction_in_a_log() {
+    let dir = scratch("fraction-lines");
+    let input = long_grid(&dir);
+    let out = dir.join("smoothed.npz");
+    let o = toposmooth(&["smooth", input.to_str().unwrap(), "-o", out.to_str().unwrap(), "--persistence", "1%"]);
+    assert!(o.status.success(), "{}", text(&o));
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    let percents: Vec<u32> = stderr
+        .lines()
+        .filter_map(|l| l.strip_prefix("solve: ")?.split_once(" % after ").map(|(p, _)| p.parse::<u32>().unwrap()))
+        .collect();
+    assert!(!percents.is_empty(), "no fraction line: {stderr}");
+    assert!(percents.iter().all(|p| p % 10 == 0 && *p <= 100), "{percents:?}");
+    assert!(percents.windows(2).all(|w| w[0] < w[1]), "each line a further tenth: {percents:?}");
+    assert!(stderr.lines().any(|l| l.starts_with("solve: ") && l.contains(" s (")), "the stage's own line: {stderr}");
 }

@@ -9,14 +9,15 @@
 
 use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::prelude::*;
-use pyo3::types::{PyDict, PyType};
+use pyo3::types::{PyBool, PyDict, PyString, PyType};
+use std::sync::{Arc, Condvar, Mutex};
 use toposmooth::apps::weights::{WeightMethod, WeightSettings};
 use toposmooth::domain::{AnyDomain, Domain as _, Grid2d, Grid3d, Series, TetMesh, TriMesh};
+use toposmooth::io::import::{InputOption, ReadOptions, INPUT_OPTIONS};
+use toposmooth::pipeline::schema::{self, Group, Kind, Setting};
+use toposmooth::progress::{CancelToken, Observer};
 use toposmooth::topology::{extrema_table, select, ExtremumKind, Role, Selection};
-use toposmooth::{
-    AnySmoother, EdgeSet, Energy, Error, ErrorKind, Formulation, Method, QpSettings, RepresentativeChoice,
-    SmoothSettings,
-};
+use toposmooth::{AnySmoother, Error, ErrorKind, SmoothSettings};
 
 /// The package's exception for a library error: `toposmooth.errors.<Class>(message)` with the
 /// attributes `kind`, `exit_code` and `path`.
@@ -29,6 +30,7 @@ fn to_py(py: Python<'_>, e: Error) -> PyErr {
         ErrorKind::Uncertified => "CertificateError",
         ErrorKind::Internal => "InternalError",
         ErrorKind::NoSolution => "SolverError",
+        ErrorKind::Cancelled => "Cancelled",
     };
     let raised = (|| -> PyResult<PyErr> {
         let ty = py.import("toposmooth.errors")?.getattr(class)?.cast_into::<PyType>()?;
@@ -40,6 +42,169 @@ fn to_py(py: Python<'_>, e: Error) -> PyErr {
         Ok(err)
     })();
     raised.unwrap_or_else(|import_failure| import_failure)
+}
+
+/// A token Python holds to stop a run (`toposmooth.CancelToken`): `cancel()`, from any thread,
+/// stops every call given it (`cancel=token`) at its next check; the call raises
+/// `toposmooth.Cancelled` and leaves no output or temporary behind.
+#[pyclass(module = "toposmooth._toposmooth", name = "CancelToken", frozen)]
+#[derive(Default)]
+struct PyCancelToken {
+    inner: CancelToken,
+}
+
+#[pymethods]
+impl PyCancelToken {
+    #[new]
+    fn new() -> Self {
+        Self::default()
+    }
+
+    /// Asks the runs holding this token to stop.
+    fn cancel(&self) {
+        self.inner.cancel();
+    }
+
+    /// Whether `cancel()` was called.
+    #[getter]
+    fn cancelled(&self) -> bool {
+        self.inner.is_cancelled()
+    }
+
+    fn __repr__(&self) -> String {
+        format!("CancelToken(cancelled={})", if self.inner.is_cancelled() { "True" } else { "False" })
+    }
+}
+
+/// What a long call is watched with: a progress callable `(stage, fraction, message)` and the
+/// caller's token.
+#[derive(Default)]
+struct Watch {
+    progress: Option<Py<PyAny>>,
+    cancel: Option<CancelToken>,
+}
+
+impl Watch {
+    fn new(progress: Option<Bound<'_, PyAny>>, cancel: Option<PyRef<'_, PyCancelToken>>) -> Self {
+        Watch {
+            progress: progress.filter(|p| !p.is_none()).map(Bound::unbind),
+            cancel: cancel.map(|c| c.inner.clone()),
+        }
+    }
+}
+
+/// One progress event for Python: stage, fraction (None where unknown), message.
+type Event = (String, Option<f64>, String);
+
+/// The stages of a run collected for the Python thread ([`watched`]), consecutive updates of
+/// one stage merged.
+#[derive(Default)]
+struct Relay {
+    events: Mutex<Vec<Event>>,
+    /// The last fraction and message per stage.
+    last: Mutex<std::collections::HashMap<String, (Option<f64>, String)>>,
+}
+
+impl Relay {
+    fn push(&self, stage: &str, fraction: Option<f64>, message: Option<&str>, merge: bool) {
+        let (f, m) = {
+            let mut last = self.last.lock().unwrap_or_else(|e| e.into_inner());
+            let entry = last.entry(stage.to_string()).or_insert((None, String::new()));
+            if let Some(f) = fraction {
+                entry.0 = Some(f);
+            }
+            if let Some(m) = message {
+                entry.1 = m.to_string();
+            }
+            entry.clone()
+        };
+        let mut events = self.events.lock().unwrap_or_else(|e| e.into_inner());
+        if merge {
+            if let Some(e) = events.last_mut().filter(|e| e.0 == stage && e.1 != Some(1.0)) {
+                *e = (stage.to_string(), f, m);
+                return;
+            }
+        }
+        events.push((stage.to_string(), f, m));
+    }
+
+    fn take(&self) -> Vec<Event> {
+        std::mem::take(&mut *self.events.lock().unwrap_or_else(|e| e.into_inner()))
+    }
+}
+
+impl Observer for Relay {
+    fn begin(&self, stage: &str) {
+        self.last.lock().unwrap_or_else(|e| e.into_inner()).remove(stage);
+        self.push(stage, None, Some(""), false);
+    }
+    fn update(&self, stage: &str, message: &str) {
+        self.push(stage, None, Some(message), true);
+    }
+    fn fraction(&self, stage: &str, done: f64) {
+        self.push(stage, Some(done), None, true);
+    }
+    fn end(&self, stage: &str, _seconds: f64, summary: &str) {
+        self.push(stage, Some(1.0), Some(summary), false);
+    }
+}
+
+/// How often the Python thread looks at its signals and hands on the progress.
+const WATCH_PERIOD: std::time::Duration = std::time::Duration::from_millis(50);
+
+/// Runs `work` without the GIL on a thread of its own, under the caller's token, while this
+/// thread, every [`WATCH_PERIOD`] and with the GIL, checks Python's signals (Ctrl-C cancels the
+/// run, and its `KeyboardInterrupt` is raised once the run has stopped) and calls the progress
+/// callable with what the run told (an exception it raises cancels the run and is raised).
+fn watched<T: Send>(py: Python<'_>, watch: &Watch, work: impl FnOnce() -> toposmooth::Result<T> + Send) -> PyResult<T> {
+    let token = watch.cancel.clone().unwrap_or_default();
+    let relay = watch.progress.as_ref().map(|_| Arc::new(Relay::default()));
+    let finished = (Mutex::new(false), Condvar::new());
+    let mut raised: Option<PyErr> = None;
+    let out = std::thread::scope(|scope| {
+        let worker = scope.spawn(|| {
+            let run = || match &relay {
+                Some(r) => toposmooth::progress::observe(r.clone(), work),
+                None => work(),
+            };
+            let out = toposmooth::progress::cancellable(token.clone(), run);
+            *finished.0.lock().unwrap_or_else(|e| e.into_inner()) = true;
+            finished.1.notify_all();
+            out
+        });
+        loop {
+            let done = py.detach(|| {
+                let guard = finished.0.lock().unwrap_or_else(|e| e.into_inner());
+                let (guard, _) =
+                    finished.1.wait_timeout_while(guard, WATCH_PERIOD, |d| !*d).unwrap_or_else(|e| e.into_inner());
+                *guard
+            });
+            if let (Some(callback), Some(relay)) = (&watch.progress, &relay) {
+                for (stage, fraction, message) in relay.take() {
+                    if raised.is_none() {
+                        if let Err(e) = callback.call1(py, (stage, fraction, message)) {
+                            token.cancel();
+                            raised = Some(e);
+                        }
+                    }
+                }
+            }
+            if done {
+                break;
+            }
+            if raised.is_none() {
+                if let Err(e) = py.check_signals() {
+                    token.cancel();
+                    raised = Some(e);
+                }
+            }
+        }
+        worker.join().unwrap_or_else(|payload| std::panic::resume_unwind(payload))
+    });
+    match raised {
+        Some(e) => Err(e),
+        None => out.map_err(|e| to_py(py, e)),
+    }
 }
 
 fn usage(py: Python<'_>, message: String) -> PyErr {
@@ -208,167 +373,135 @@ impl Domain {
     }
 }
 
-/// `persistence` as the CLI takes it: a number is absolute, `"5%"` relative to the range.
-fn persistence(py: Python<'_>, p: &Bound<'_, PyAny>) -> PyResult<Selection> {
-    let (v, relative) = if let Ok(text) = p.extract::<String>() {
-        let t = text.trim();
-        match t.strip_suffix('%') {
-            Some(num) => (num.trim().parse::<f64>().ok(), true),
-            None => (t.parse::<f64>().ok(), false),
+/// One keyword's value as the schema's text ([`schema::SETTINGS`]), its Python type checked
+/// here (a number is not a string, a count not a bool or a float, a list not a string); what
+/// the text holds is checked by the library, as for every front end. `None` and `False` are
+/// "not given".
+fn setting_text(py: Python<'_>, spec: &Setting, v: &Bound<'_, PyAny>) -> PyResult<Option<String>> {
+    if v.is_none() {
+        return Ok(None);
+    }
+    let type_name = || v.get_type().name().map(|n| n.to_string()).unwrap_or_else(|_| "?".into());
+    let wrong = |what: &str| usage(py, format!("{}: expected {what}, got {} {}", spec.name, type_name(), repr(v)));
+    let is_bool = v.is_instance_of::<PyBool>();
+    let is_text = v.is_instance_of::<PyString>();
+    let number = || -> PyResult<String> {
+        if is_bool || is_text {
+            return Err(wrong("a number"));
         }
-    } else {
-        (p.extract::<f64>().ok(), false)
+        // the shortest text that reads back to the same double
+        v.extract::<f64>().map(|x| format!("{x:?}")).map_err(|_| wrong("a number"))
     };
-    match v {
-        Some(v) if v.is_finite() && v > 0.0 => {
-            Ok(if relative { Selection::Relative(v / 100.0) } else { Selection::Absolute(v) })
+    let whole = |what: &str| -> PyResult<String> {
+        if is_bool || is_text {
+            return Err(wrong(what));
         }
-        _ => Err(usage(py, format!("persistence must be a number > 0 or a percentage such as \"5%\", got {p}"))),
-    }
-}
-
-fn get<'py, T: FromPyObjectOwned<'py>>(py: Python<'py>, d: &Bound<'py, PyDict>, key: &str) -> PyResult<Option<T>> {
-    match d.get_item(key)? {
-        None => Ok(None),
-        Some(v) if v.is_none() => Ok(None),
-        Some(v) => v.extract::<T>().map(Some).map_err(|e| usage(py, format!("{key}: {}", Into::<PyErr>::into(e)))),
-    }
-}
-
-/// The selection from `persistence`, `minima`/`maxima`, `pairs`, `keep_min`/`keep_max`,
-/// `keep_all_maxima`/`keep_all_minima` (exactly one rule; 5 % of the range when none is given).
-fn selection(py: Python<'_>, d: &Bound<'_, PyDict>) -> PyResult<Selection> {
-    let p = d.get_item("persistence")?.filter(|v| !v.is_none());
-    let (minima, maxima) = (get::<usize>(py, d, "minima")?, get::<usize>(py, d, "maxima")?);
-    let pairs = get::<usize>(py, d, "pairs")?;
-    let (keep_min, keep_max) = (get::<Vec<usize>>(py, d, "keep_min")?, get::<Vec<usize>>(py, d, "keep_max")?);
-    let all_max = get::<bool>(py, d, "keep_all_maxima")?.unwrap_or(false);
-    let all_min = get::<bool>(py, d, "keep_all_minima")?.unwrap_or(false);
-    let rules = [
-        ("persistence", p.is_some()),
-        ("minima/maxima", minima.is_some() || maxima.is_some()),
-        ("pairs", pairs.is_some()),
-        ("keep_min/keep_max", keep_min.is_some() || keep_max.is_some()),
-        ("keep_all_maxima", all_max),
-        ("keep_all_minima", all_min),
-    ];
-    let given: Vec<&str> = rules.iter().filter(|r| r.1).map(|r| r.0).collect();
-    if given.len() > 1 {
-        return Err(usage(py, format!("choose one selection rule, got {}", given.join(" and "))));
-    }
-    Ok(match given.first().copied() {
-        None => Selection::Relative(0.05),
-        Some("persistence") => persistence(py, &p.expect("given"))?,
-        Some("minima/maxima") => Selection::Count { minima: minima.unwrap_or(1), maxima: maxima.unwrap_or(1) },
-        Some("pairs") => Selection::Pairs(pairs.expect("given")),
-        Some("keep_min/keep_max") => {
-            Selection::Explicit { minima: keep_min.unwrap_or_default(), maxima: keep_max.unwrap_or_default() }
+        v.extract::<i64>().map(|n| n.to_string()).map_err(|_| wrong(what))
+    };
+    let text = |what: &str| -> PyResult<String> { v.extract::<String>().map_err(|_| wrong(what)) };
+    Ok(Some(match spec.kind {
+        Kind::Switch => match v.extract::<bool>() {
+            Ok(true) => "true".into(),
+            Ok(false) => return Ok(None),
+            Err(_) => return Err(wrong("True or False")),
+        },
+        Kind::Count { .. } => whole("a whole number")?,
+        Kind::Real { .. } => number()?,
+        Kind::Threshold if is_text => text("a number or a percentage")?,
+        Kind::Threshold => number().map_err(|_| wrong("a number or a percentage such as \"5%\""))?,
+        Kind::Choice(names) => text(&format!("one of {}", names.join(", ")))?,
+        Kind::Orders if is_text => text("an order")?,
+        Kind::Orders => whole("an order 1..4 or a blend such as \"1:0.2,2:1\"")?,
+        Kind::Indices => {
+            if is_text {
+                return Err(wrong("a list of vertex indices"));
+            }
+            let list = v.extract::<Vec<i64>>().map_err(|_| wrong("a list of vertex indices"))?;
+            list.iter().map(i64::to_string).collect::<Vec<_>>().join(",")
         }
-        Some("keep_all_maxima") => Selection::AllMaxima,
-        _ => Selection::AllMinima,
-    })
+    }))
 }
 
-fn choice<T: Copy>(py: Python<'_>, key: &str, text: Option<String>, options: &[(&str, T)], default: T) -> PyResult<T> {
-    let Some(text) = text else { return Ok(default) };
-    options.iter().find(|o| o.0 == text).map(|o| o.1).ok_or_else(|| {
-        let names: Vec<String> = options.iter().map(|o| format!("\"{}\"", o.0)).collect();
-        usage(py, format!("{key} must be one of {}, got \"{text}\"", names.join(", ")))
-    })
+fn repr(v: &Bound<'_, PyAny>) -> String {
+    v.repr().map(|r| r.to_string()).unwrap_or_default()
 }
 
-fn qp_settings(py: Python<'_>, d: &Bound<'_, PyDict>) -> PyResult<QpSettings> {
-    let solver = choice(
-        py,
-        "solver",
-        get(py, d, "solver")?,
-        &[
-            ("auto", Method::Auto),
-            ("structured", Method::Structured),
-            ("clarabel", Method::Clarabel),
-            ("clarabel-auxiliary", Method::ClarabelAuxiliary),
-            ("active-set", Method::ActiveSet),
-        ],
-        Method::Auto,
-    )?;
-    let formulation = choice(
-        py,
-        "formulation",
-        get(py, d, "formulation")?,
-        &[("auto", Formulation::Auto), ("assembled", Formulation::Assembled), ("factored", Formulation::Factored)],
-        Formulation::Auto,
-    )?;
-    let max_iter = get::<u32>(py, d, "max_iter")?.unwrap_or(200);
-    if max_iter == 0 {
-        return Err(usage(py, "max_iter must be at least 1".into()));
-    }
-    Ok(QpSettings { max_iter, method: solver, formulation, ..Default::default() })
-}
-
-fn edges(py: Python<'_>, d: &Bound<'_, PyDict>) -> PyResult<EdgeSet> {
-    choice(py, "edges", get(py, d, "edges")?, &[("minimal", EdgeSet::Minimal), ("all", EdgeSet::All)], EdgeSet::Minimal)
-}
-
-/// The library's settings from the package's keyword arguments (unknown keys are refused).
-fn smooth_settings(py: Python<'_>, d: &Bound<'_, PyDict>) -> PyResult<SmoothSettings> {
-    const KEYS: &[&str] = &[
-        "persistence",
-        "minima",
-        "maxima",
-        "pairs",
-        "keep_min",
-        "keep_max",
-        "keep_all_maxima",
-        "keep_all_minima",
-        "order",
-        "sharp",
-        "data_weight",
-        "smooth_weight",
-        "smooth_length",
-        "edges",
-        "representative",
-        "max_iter",
-        "solver",
-        "formulation",
-        "threads",
-    ];
-    for key in d.keys() {
+/// The `(name, text)` of the keywords in `d` (unknown ones refused), those of `groups` only.
+fn setting_texts(py: Python<'_>, d: &Bound<'_, PyDict>, groups: &[Group]) -> PyResult<Vec<(&'static str, String)>> {
+    let mut texts = Vec::new();
+    for (key, value) in d.iter() {
         let key: String = key.extract()?;
-        if !KEYS.contains(&key.as_str()) {
-            return Err(usage(py, format!("unknown setting `{key}`")));
+        let Some(spec) = schema::find(&key) else {
+            let names: Vec<&str> = schema::SETTINGS.iter().map(|s| s.name).collect();
+            return Err(usage(py, format!("unknown setting `{key}` (the settings are {})", names.join(", "))));
+        };
+        if !groups.contains(&spec.group) {
+            continue;
+        }
+        if let Some(text) = setting_text(py, spec, &value)? {
+            texts.push((spec.name, text));
         }
     }
-    let order = match d.get_item("order")?.filter(|v| !v.is_none()) {
-        None => "2".to_string(),
-        Some(o) => o.str()?.to_string(),
-    };
-    let mut energy = Energy::parse(&order).map_err(|e| to_py(py, e))?;
-    if let Some(sharp) = get::<Vec<usize>>(py, d, "sharp")? {
-        energy.sharp = sharp;
-    }
-    let representative = choice(
-        py,
-        "representative",
-        get::<String>(py, d, "representative")?.map(Some).unwrap_or(None),
-        &[
-            ("separatrix", Some(RepresentativeChoice::Separatrix)),
-            ("harmonic", Some(RepresentativeChoice::Harmonic)),
-            ("flooded", Some(RepresentativeChoice::Flooded)),
-        ],
-        None,
-    )?;
-    let settings = SmoothSettings {
-        selection: selection(py, d)?,
-        energy,
-        data_weight: get(py, d, "data_weight")?.unwrap_or(1.0),
-        smooth_weight: get(py, d, "smooth_weight")?,
-        smooth_length: get(py, d, "smooth_length")?,
-        edges: edges(py, d)?,
-        qp: qp_settings(py, d)?,
-        representative,
-    };
-    settings.validate().map_err(|e| to_py(py, e))?;
-    Ok(settings)
+    Ok(texts)
+}
+
+const ALL_GROUPS: [Group; 4] = [Group::Selection, Group::Energy, Group::Solver, Group::Run];
+
+/// The library's settings from the package's keyword arguments, read as every front end's are
+/// ([`SmoothSettings::from_texts`]).
+fn smooth_settings(py: Python<'_>, d: &Bound<'_, PyDict>) -> PyResult<SmoothSettings> {
+    let texts = setting_texts(py, d, &ALL_GROUPS)?;
+    SmoothSettings::from_texts(texts.iter().map(|(n, t)| (*n, t.as_str()))).map_err(|e| to_py(py, e))
+}
+
+/// The selection from the selection's keywords in `d` (other settings are not looked at).
+fn selection(py: Python<'_>, d: &Bound<'_, PyDict>) -> PyResult<Selection> {
+    let texts = setting_texts(py, d, &[Group::Selection])?;
+    let settings = SmoothSettings::from_texts(texts.iter().map(|(n, t)| (*n, t.as_str()))).map_err(|e| to_py(py, e))?;
+    Ok(settings.selection)
+}
+
+/// The settings' schema: one dict per setting with `name`, `kind`, `default` (text or None),
+/// `group`, `help`, `partner`, and per kind `choices`, `min`, `max`, `inclusive`.
+#[pyfunction]
+fn settings_schema(py: Python<'_>) -> PyResult<Vec<Bound<'_, PyDict>>> {
+    schema::SETTINGS
+        .iter()
+        .map(|s| {
+            let d = PyDict::new(py);
+            d.set_item("name", s.name)?;
+            d.set_item("default", s.default)?;
+            d.set_item("group", format!("{:?}", s.group).to_lowercase())?;
+            d.set_item("help", s.help)?;
+            d.set_item("partner", s.partner)?;
+            let kind = match s.kind {
+                Kind::Threshold => "threshold",
+                Kind::Count { min, max } => {
+                    d.set_item("min", min)?;
+                    d.set_item("max", max)?;
+                    "count"
+                }
+                Kind::Real { min, inclusive } => {
+                    d.set_item("min", min)?;
+                    d.set_item("inclusive", inclusive)?;
+                    "real"
+                }
+                Kind::Switch => "switch",
+                Kind::Choice(names) => {
+                    d.set_item("choices", names.to_vec())?;
+                    "choice"
+                }
+                Kind::Indices => "indices",
+                Kind::Orders => {
+                    d.set_item("min", 1)?;
+                    d.set_item("max", 4)?;
+                    "orders"
+                }
+            };
+            d.set_item("kind", kind)?;
+            Ok(d)
+        })
+        .collect()
 }
 
 fn role_codes(roles: &[Role]) -> Vec<i8> {
@@ -380,43 +513,38 @@ fn role_codes(roles: &[Role]) -> Vec<i8> {
 #[pyclass(module = "toposmooth._toposmooth")]
 struct Smoother {
     inner: AnySmoother,
-    /// The thread cap of each call ([`toposmooth::parallel::with_threads`]).
-    threads: usize,
-}
-
-/// The `threads` setting: at most this many threads per call (default the library's 2).
-fn threads(py: Python<'_>, d: &Bound<'_, PyDict>) -> PyResult<usize> {
-    match get::<usize>(py, d, "threads")? {
-        None => Ok(toposmooth::parallel::DEFAULT_THREADS),
-        Some(0) => Err(usage(py, "threads must be at least 1".into())),
-        Some(n) => Ok(n),
-    }
 }
 
 #[pymethods]
 impl Smoother {
     #[new]
     fn new(py: Python<'_>, domain: &Domain, settings: &Bound<'_, PyDict>) -> PyResult<Self> {
-        let threads = threads(py, settings)?;
         let settings = smooth_settings(py, settings)?;
         let domain = domain.inner.clone();
         let inner = py.detach(|| AnySmoother::new(domain, settings)).map_err(|e| to_py(py, e))?;
-        Ok(Smoother { inner, threads })
+        Ok(Smoother { inner })
     }
 
     /// Smooths one field: a dict with `smoothed`, `representative` (float64), `roles` (int8
     /// codes: −1 kept minimum, 1 kept maximum, 0 other, 2 fixed, 3 free end), `report` (the
     /// JSON report as text) and `certified`.
-    fn smooth<'py>(&mut self, py: Python<'py>, h: PyReadonlyArray1<'py, f64>) -> PyResult<Bound<'py, PyDict>> {
+    #[pyo3(signature = (h, progress=None, cancel=None))]
+    fn smooth<'py>(
+        &mut self,
+        py: Python<'py>,
+        h: PyReadonlyArray1<'py, f64>,
+        progress: Option<Bound<'py, PyAny>>,
+        cancel: Option<PyRef<'py, PyCancelToken>>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let watch = Watch::new(progress, cancel);
         let h = values(py, "values", &h)?;
         let n = self.inner.n_vertices();
         if h.len() != n {
             let msg = format!("values has {} entries, the domain {n} vertices", h.len());
             return Err(to_py(py, Error::input(msg)));
         }
-        let (inner, threads) = (&mut self.inner, self.threads);
-        let out =
-            py.detach(|| toposmooth::parallel::with_threads(threads, || inner.smooth(h))).map_err(|e| to_py(py, e))?;
+        let inner = &mut self.inner;
+        let out = watched(py, &watch, || inner.smooth(h))?;
         result_dict(py, out)
     }
 
@@ -443,14 +571,17 @@ fn result_dict(py: Python<'_>, out: toposmooth::pipeline::Smoothed) -> PyResult<
 /// the domain is the triangles (tetrahedra) with every corner inside; the outside comes back
 /// unchanged with role 0. The same dict as [`Smoother::smooth`].
 #[pyfunction]
+#[pyo3(signature = (domain, settings, h, mask, progress=None, cancel=None))]
 fn smooth_masked<'py>(
     py: Python<'py>,
     domain: &Domain,
     settings: &Bound<'py, PyDict>,
     h: PyReadonlyArray1<'py, f64>,
     mask: PyReadonlyArray1<'py, bool>,
+    progress: Option<Bound<'py, PyAny>>,
+    cancel: Option<PyRef<'py, PyCancelToken>>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let threads = threads(py, settings)?;
+    let watch = Watch::new(progress, cancel);
     let settings = smooth_settings(py, settings)?;
     // NaN outside the mask is background, as in the CLI: the pipeline checks the inside
     let h = values(py, "values", &h)?;
@@ -463,21 +594,17 @@ fn smooth_masked<'py>(
         return Err(to_py(py, Error::input(format!("mask has {} entries, the values {}", inside.len(), h.len()))));
     }
     let d = &domain.inner;
-    let out = py
-        .detach(|| {
-            toposmooth::parallel::with_threads(threads, || match d {
-                AnyDomain::Volume(g) => {
-                    let m = toposmooth::domain::MaskedVolume::new(g, inside)?;
-                    toposmooth::pipeline::smooth_masked(&m, h, &settings)
-                }
-                AnyDomain::Grid(g) => {
-                    let m = toposmooth::domain::MaskedGrid::new(g, inside)?;
-                    toposmooth::pipeline::smooth_masked_grid(&m, h, &settings)
-                }
-                _ => Err(Error::input("mask= is for grids and volumes (2-D and 3-D values)")),
-            })
-        })
-        .map_err(|e| to_py(py, e))?;
+    let out = watched(py, &watch, || match d {
+        AnyDomain::Volume(g) => {
+            let m = toposmooth::domain::MaskedVolume::new(g, inside)?;
+            toposmooth::pipeline::smooth_masked(&m, h, &settings)
+        }
+        AnyDomain::Grid(g) => {
+            let m = toposmooth::domain::MaskedGrid::new(g, inside)?;
+            toposmooth::pipeline::smooth_masked_grid(&m, h, &settings)
+        }
+        _ => Err(Error::input("mask= is for grids and volumes (2-D and 3-D values)")),
+    })?;
     result_dict(py, out)
 }
 
@@ -620,41 +747,52 @@ fn geodesic<'py>(py: Python<'py>, domain: &Domain, sources: Vec<usize>) -> PyRes
 /// per handle, a partition of unity), `raw` (as certified), `certified` and
 /// `max_normalisation_change`.
 #[pyfunction]
+#[pyo3(signature = (domain, handles, settings, progress=None, cancel=None))]
 fn weights<'py>(
     py: Python<'py>,
     domain: &Domain,
     handles: Vec<Vec<usize>>,
     settings: &Bound<'py, PyDict>,
+    progress: Option<Bound<'py, PyAny>>,
+    cancel: Option<PyRef<'py, PyCancelToken>>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let method = choice(
-        py,
-        "method",
-        get(py, settings, "method")?,
-        &[
-            ("monotone", WeightMethod::Monotone),
-            ("bounded", WeightMethod::Bounded),
-            ("unconstrained", WeightMethod::Unconstrained),
-            ("harmonic", WeightMethod::Harmonic),
-        ],
-        WeightMethod::Monotone,
-    )?;
-    let ws = WeightSettings {
-        order: get::<u8>(py, settings, "order")?.unwrap_or(2),
-        method,
-        edges: edges(py, settings)?,
-        qp: qp_settings(py, settings)?,
-        threads: get::<usize>(py, settings, "threads")?.unwrap_or(2).max(1),
+    let watch = Watch::new(progress, cancel);
+    let method = match settings.get_item("method")?.filter(|v| !v.is_none()) {
+        None => WeightMethod::Monotone,
+        Some(m) => {
+            let text: String =
+                m.extract().map_err(|_| usage(py, format!("method must be a string, got {}", repr(&m))))?;
+            text.parse::<WeightMethod>().map_err(|e| to_py(py, e))?
+        }
     };
+    // the constraint set and the solver as `smooth` reads them
+    let shared = PyDict::new(py);
+    for key in ["edges", "max_iter", "solver", "formulation"] {
+        if let Some(v) = settings.get_item(key)? {
+            shared.set_item(key, v)?;
+        }
+    }
+    let common = smooth_settings(py, &shared)?;
+    let order = match settings.get_item("order")?.filter(|v| !v.is_none()) {
+        None => 2,
+        Some(o) => o.extract::<u8>().map_err(|_| usage(py, format!("order must be 1, 2, 3 or 4, got {}", repr(&o))))?,
+    };
+    let threads = match settings.get_item("threads")?.filter(|v| !v.is_none()) {
+        None => 2,
+        Some(t) => t
+            .extract::<usize>()
+            .map_err(|_| usage(py, format!("threads must be a count ≥ 1, got {}", repr(&t))))?
+            .max(1),
+    };
+    let ws = WeightSettings { order, method, edges: common.edges, qp: common.qp, threads };
     let d = &domain.inner;
     let cap = ws.threads;
-    let w = py
-        .detach(|| {
-            toposmooth::parallel::with_threads(
-                cap,
-                || toposmooth::with_domain!(d, g => toposmooth::apps::weights::weights(g, &handles, &ws)),
-            )
-        })
-        .map_err(|e| to_py(py, e))?;
+    let w = watched(py, &watch, || {
+        toposmooth::parallel::with_threads(
+            cap,
+            || toposmooth::with_domain!(d, g => toposmooth::apps::weights::weights(g, &handles, &ws)),
+        )
+    })?;
     let out = PyDict::new(py);
     let certified = w.functions.iter().all(|f| f.certificate.passed);
     out.set_item("certified", certified)?;
@@ -714,17 +852,24 @@ fn fill_missing<'py>(py: Python<'py>, domain: &Domain, h: PyReadonlyArray1<'py, 
 /// Runs one CLI command in this process (`args` without the program's name, e.g.
 /// `["smooth", "a.vti", "-o", "b.vti"]`) and returns what the tool prints on standard output;
 /// errors are raised as the package's exceptions with the CLI's message.
-/// `threads` caps the threads the command uses (default 2).
+/// `threads` caps the threads the command uses (default 2); `progress` and `cancel` as for
+/// [`Smoother::smooth`] (a cancelled command leaves no output or temporary behind).
 #[pyfunction]
-#[pyo3(signature = (args, threads=None))]
-fn run(py: Python<'_>, args: Vec<String>, threads: Option<usize>) -> PyResult<String> {
+#[pyo3(signature = (args, threads=None, progress=None, cancel=None))]
+fn run<'py>(
+    py: Python<'py>,
+    args: Vec<String>,
+    threads: Option<usize>,
+    progress: Option<Bound<'py, PyAny>>,
+    cancel: Option<PyRef<'py, PyCancelToken>>,
+) -> PyResult<String> {
+    let watch = Watch::new(progress, cancel);
     let cap = threads.unwrap_or(toposmooth::parallel::DEFAULT_THREADS).max(1);
-    py.detach(|| {
+    watched(py, &watch, || {
         toposmooth::parallel::with_threads(cap, || {
             toposmooth::commands::catch_panics(|| toposmooth::commands::cli::run_args(&args))
         })
     })
-    .map_err(|e| to_py(py, e))
 }
 
 /// The `toposmooth` console script: the CLI's `main` on `argv` (program name first); returns
@@ -751,6 +896,137 @@ fn resolve_handles(py: Python<'_>, domain: &Domain, json: &str) -> PyResult<(Vec
     }
 }
 
+/// One input option's value as text (its Python type checked: a switch is a bool, a spacing a
+/// sequence of numbers, a threshold a number, the rest text or a path already made text).
+fn input_text(py: Python<'_>, spec: &InputOption, v: &Bound<'_, PyAny>) -> PyResult<Option<String>> {
+    if v.is_none() {
+        return Ok(None);
+    }
+    let wrong = |what: &str| usage(py, format!("{}: expected {what}, got {}", spec.name, repr(v)));
+    let is_text = v.is_instance_of::<PyString>();
+    let is_bool = v.is_instance_of::<PyBool>();
+    Ok(Some(match spec.name {
+        _ if spec.switch => match v.extract::<bool>() {
+            Ok(true) => "true".into(),
+            Ok(false) => return Ok(None),
+            Err(_) => return Err(wrong("True or False")),
+        },
+        "spacing" if !is_text => {
+            let s = v.extract::<Vec<f64>>().map_err(|_| wrong("a sequence of 2 or 3 numbers"))?;
+            s.iter().map(|d| format!("{d:?}")).collect::<Vec<_>>().join(",")
+        }
+        "mask_below" if !is_text && !is_bool => {
+            v.extract::<f64>().map(|t| format!("{t:?}")).map_err(|_| wrong("a number"))?
+        }
+        "column" | "x_column" if !is_text && !is_bool => {
+            v.extract::<i64>().map(|i| i.to_string()).map_err(|_| wrong("a column name or index"))?
+        }
+        _ => v.extract::<String>().map_err(|_| wrong("text"))?,
+    }))
+}
+
+/// A point array as numpy: `(n,)` for one component, `(n, c)` for more.
+fn array_of<'py>(py: Python<'py>, a: &toposmooth::io::vtk::PointArray) -> PyResult<Bound<'py, PyAny>> {
+    let flat = PyArray1::from_vec(py, a.values.clone());
+    if a.components == 1 {
+        return Ok(flat.into_any());
+    }
+    Ok(flat.reshape([a.values.len() / a.components.max(1), a.components])?.into_any())
+}
+
+/// Reads a file as the CLI reads its input (`toposmooth::io::import::read`): the options are
+/// the input options' names (`toposmooth.INPUT_OPTIONS`); returns a dict the package wraps as
+/// a `Dataset`.
+#[pyfunction]
+#[pyo3(signature = (path, options))]
+fn read<'py>(py: Python<'py>, path: Option<String>, options: &Bound<'py, PyDict>) -> PyResult<Bound<'py, PyDict>> {
+    let mut texts = Vec::new();
+    for (key, value) in options.iter() {
+        let key: String = key.extract()?;
+        let Some(spec) = INPUT_OPTIONS.iter().find(|o| o.name == key) else {
+            let names: Vec<&str> = INPUT_OPTIONS.iter().map(|o| o.name).collect();
+            return Err(usage(py, format!("unknown input option `{key}` (the options are {})", names.join(", "))));
+        };
+        if let Some(text) = input_text(py, spec, &value)? {
+            texts.push((spec.name, text));
+        }
+    }
+    let opts = ReadOptions::from_texts(texts.iter().map(|(n, t)| (*n, t.as_str()))).map_err(|e| to_py(py, e))?;
+    let field = py
+        .detach(|| toposmooth::io::import::read(path.as_deref().map(std::path::Path::new), &opts))
+        .map_err(|e| to_py(py, e))?;
+    let out = PyDict::new(py);
+    let domain = Domain { inner: field.domain.clone() };
+    out.set_item("kind", domain.kind())?;
+    let shape: Vec<usize> = match &field.domain {
+        AnyDomain::Grid(g) => {
+            out.set_item("spacing", g.spacing().to_vec())?;
+            out.set_item("origin", g.origin().to_vec())?;
+            vec![g.ny(), g.nx()]
+        }
+        AnyDomain::Volume(g) => {
+            out.set_item("spacing", g.spacing().to_vec())?;
+            out.set_item("origin", g.origin().to_vec())?;
+            vec![g.nz(), g.ny(), g.nx()]
+        }
+        AnyDomain::Mesh(m) => {
+            let v: Vec<f64> = m.positions().iter().flatten().copied().collect();
+            let f: Vec<i64> = m.faces().iter().flatten().map(|&i| i as i64).collect();
+            out.set_item("vertices", PyArray1::from_vec(py, v).reshape([m.n_vertices(), 3])?)?;
+            out.set_item("faces", PyArray1::from_vec(py, f).reshape([m.faces().len(), 3])?)?;
+            vec![m.n_vertices()]
+        }
+        AnyDomain::Tets(m) => {
+            let v: Vec<f64> = m.positions().iter().flatten().copied().collect();
+            let t: Vec<i64> = m.tets().iter().flatten().map(|&i| i as i64).collect();
+            out.set_item("vertices", PyArray1::from_vec(py, v).reshape([m.n_vertices(), 3])?)?;
+            out.set_item("faces", PyArray1::from_vec(py, t).reshape([m.tets().len(), 4])?)?;
+            vec![m.n_vertices()]
+        }
+        AnyDomain::Series(s) => vec![s.n_vertices()],
+    };
+    out.set_item("shape", shape)?;
+    if let Some(axis) = &field.axis {
+        out.set_item("x", PyArray1::from_vec(py, axis.x.clone()))?;
+        out.set_item("x_name", &axis.x_name)?;
+        out.set_item("x_text", axis.x_text.clone())?;
+        out.set_item("dates", matches!(axis.source, toposmooth::io::series_csv::XSource::Dates(..)))?;
+    }
+    out.set_item("domain", Py::new(py, domain)?)?;
+    out.set_item("values", PyArray1::from_vec(py, field.values))?;
+    out.set_item("description", field.description)?;
+    out.set_item("path", field.path.display().to_string())?;
+    out.set_item("notes", field.notes)?;
+    out.set_item("filled", field.filled.map(|m| PyArray1::from_vec(py, m)))?;
+    out.set_item("mask", field.mask.map(|m| PyArray1::from_vec(py, m)))?;
+    let arrays = PyDict::new(py);
+    if let Some(c) = &field.carried {
+        for a in &c.point {
+            arrays.set_item(&a.name, array_of(py, a)?)?;
+        }
+    }
+    out.set_item("arrays", arrays)?;
+    out.set_item("source_array", field.carried.as_ref().and_then(|c| c.source.clone()))?;
+    Ok(out)
+}
+
+/// The input options (`toposmooth.INPUT_OPTIONS`): one dict each with `name`, `switch`,
+/// `choices` and `help`.
+#[pyfunction]
+fn input_options(py: Python<'_>) -> PyResult<Vec<Bound<'_, PyDict>>> {
+    INPUT_OPTIONS
+        .iter()
+        .map(|o| {
+            let d = PyDict::new(py);
+            d.set_item("name", o.name)?;
+            d.set_item("switch", o.switch)?;
+            d.set_item("choices", o.choices.map(<[&str]>::to_vec))?;
+            d.set_item("help", o.help)?;
+            Ok(d)
+        })
+        .collect()
+}
+
 /// The library's version.
 #[pyfunction]
 fn version() -> &'static str {
@@ -761,6 +1037,7 @@ fn version() -> &'static str {
 fn _toposmooth(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Domain>()?;
     m.add_class::<Smoother>()?;
+    m.add_class::<PyCancelToken>()?;
     m.add_function(wrap_pyfunction!(extrema, m)?)?;
     m.add_function(wrap_pyfunction!(certify, m)?)?;
     m.add_function(wrap_pyfunction!(diagram, m)?)?;
@@ -772,5 +1049,8 @@ fn _toposmooth(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(run, m)?)?;
     m.add_function(wrap_pyfunction!(main, m)?)?;
     m.add_function(wrap_pyfunction!(version, m)?)?;
+    m.add_function(wrap_pyfunction!(settings_schema, m)?)?;
+    m.add_function(wrap_pyfunction!(read, m)?)?;
+    m.add_function(wrap_pyfunction!(input_options, m)?)?;
     Ok(())
 }

@@ -112,3 +112,43 @@ def test_the_diagram_thresholded_on_persistence_selects_the_kept_pairs(datasets)
     e = toposmooth.extrema(h.reshape(63, 63), persistence="5%")
     # every kept extremum is a pair's, the essential pair keeps two
     assert int((kept_ids >= 0).sum()) + 1 == int(e["kept"].sum())
+
+
+def test_the_filters_parameters_are_the_schema_s_settings_with_its_defaults():
+    schema = {s["name"]: s for s in toposmooth.SETTINGS}
+    default_selection = {"persistence": "5.0%"}
+    for algorithm in (TopologyControlledSmoothing(), PersistenceDiagram()):
+        given = algorithm.settings()
+        assert set(given) <= set(schema), set(given) - set(schema)
+        for name, value in given.items():
+            if name in default_selection:
+                assert value == default_selection[name]
+                continue
+            default = schema[name]["default"]
+            assert value is None or str(value) == default or float(value) == float(default), (name, value, default)
+        # every setter changes exactly one setting of the schema (or the selection's rule)
+        setters = [m for m in dir(algorithm) if m.startswith("Set") and m[3:] in ALGORITHM_PARAMETERS]
+        extra = [m for m in dir(type(algorithm)) if m.startswith("Set") and m not in dir(VTK_BASE)]
+        assert sorted(extra) == sorted(setters), "a parameter the schema does not know: " + str(set(extra) - set(setters))
+        for setter in setters:
+            a = type(algorithm)()
+            before = a.settings()
+            getattr(a, setter)(ALGORITHM_PARAMETERS[setter[3:]])
+            after = a.settings()
+            changed = {k for k in set(before) | set(after) if before.get(k) != after.get(k)}
+            assert changed and changed <= set(schema), (setter, changed)
+
+
+#: A value other than the default for each parameter of the VTK algorithms.
+ALGORITHM_PARAMETERS = {
+    "Persistence": 2.5,
+    "Minima": 3,
+    "Maxima": 2,
+    "Order": 3,
+    "DataWeight": 0.5,
+    "SmoothLength": 0.02,
+    "Edges": "all",
+    "Threads": 1,
+}
+
+from vtkmodules.util.vtkAlgorithm import VTKPythonAlgorithmBase as VTK_BASE  # noqa: E402

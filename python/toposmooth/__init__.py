@@ -15,11 +15,15 @@ Domains
 Functions
 ---------
 smooth     the field with exactly the kept extrema, certified
+read       any file the CLI reads, with its input options: a Dataset (numpy values, domain)
 extrema    every extremum with its persistence and whether a selection keeps it
 verify     re-check a field's certificate
 geodesic   geodesic distance on a mesh (heat method)
 weights    smooth, certified weight functions for handles
 Smoother   many fields on one domain, the domain's analysis reused
+
+Long calls take ``progress=`` (a callable told each stage and how far it is) and
+``cancel=`` (a :class:`CancelToken`); Ctrl-C stops them at their next check.
 
 Example
 -------
@@ -41,6 +45,7 @@ import numpy as np
 
 from . import _toposmooth
 from .errors import (
+    Cancelled,
     CertificateError,
     Error,
     InfeasibleError,
@@ -70,9 +75,33 @@ __all__ = [
     "CertificateError",
     "SolverError",
     "InternalError",
+    "Cancelled",
+    "CancelToken",
+    "SETTINGS",
+    "INPUT_OPTIONS",
+    "read",
+    "Dataset",
 ]
 
 Domain = _toposmooth.Domain
+
+#: A token to stop a long call from another thread: ``t = toposmooth.CancelToken()``, pass
+#: ``cancel=t``, then ``t.cancel()``; the call raises :class:`Cancelled` at its next check
+#: (between stages and solver iterations) and leaves no output or temporary file behind.
+CancelToken = _toposmooth.CancelToken
+
+#: The settings of a smoothing run, the library's schema (the CLI's flags are made from it;
+#: :func:`smooth`'s keywords follow it): one dict per setting with ``name``, ``kind``
+#: (``threshold``, ``count``, ``real``, ``switch``, ``choice``, ``indices``, ``orders``),
+#: ``default`` (text, None where the run chooses), ``group``, ``help``, ``partner`` and, per
+#: kind, ``choices``, ``min``, ``max``, ``inclusive``.
+SETTINGS: tuple = tuple(_toposmooth.settings_schema())
+_SETTING_NAMES = frozenset(s["name"] for s in SETTINGS)
+
+#: The input options of :func:`read` (the CLI's input flags: ``x_column`` is ``--x``): one
+#: dict each with ``name``, ``switch``, ``choices`` and ``help``.
+INPUT_OPTIONS: tuple = tuple(_toposmooth.input_options())
+_SELECTION_NAMES = tuple(s["name"] for s in SETTINGS if s["group"] == "selection")
 
 #: Role codes of ``SmoothResult.roles`` (the ``role`` array of the CLI's outputs).
 ROLE_MIN, ROLE_MAX, ROLE_OTHER, ROLE_FIXED, ROLE_END = -1, 1, 0, 2, 3
@@ -178,39 +207,6 @@ def _domain(
     return _toposmooth.Domain.volume(nx, ny, nz, step, at), h.reshape(-1), h.shape
 
 
-def _selection_kwargs(
-    persistence: Union[float, str, None],
-    minima: Optional[int],
-    maxima: Optional[int],
-    pairs: Optional[int],
-    keep_min: Optional[Sequence[int]],
-    keep_max: Optional[Sequence[int]],
-    keep_all_maxima: bool,
-    keep_all_minima: bool,
-) -> Dict[str, Any]:
-    def indices(name: str, v: Optional[Sequence[int]]) -> Optional[List[int]]:
-        if v is None:
-            return None
-        a = np.asarray(v)
-        if a.ndim != 1 or (a.size and a.dtype.kind not in "iu"):
-            raise UsageError(f"{name} must be a list of vertex indices")
-        if a.size and a.min() < 0:
-            raise UsageError(f"{name} holds a negative vertex index ({int(a.min())})")
-        return [int(i) for i in a]
-
-    explicit = keep_min is not None or keep_max is not None
-    return {
-        "persistence": persistence,
-        "minima": minima,
-        "maxima": maxima,
-        "pairs": pairs,
-        "keep_min": indices("keep_min", keep_min) if explicit else None,
-        "keep_max": (indices("keep_max", keep_max) or []) if explicit else None,
-        "keep_all_maxima": keep_all_maxima,
-        "keep_all_minima": keep_all_minima,
-    }
-
-
 class SmoothResult:
     """What :func:`smooth` returns.
 
@@ -311,69 +307,23 @@ class Smoother:
         """The domain (a ``toposmooth.Domain``)."""
         return self._domain
 
-    def smooth(self, values: Any) -> SmoothResult:
-        """Smooths one field of the smoother's shape; see :func:`smooth` for the result."""
+    def smooth(self, values: Any, *, progress: Any = None, cancel: Any = None) -> SmoothResult:
+        """Smooths one field of the smoother's shape; see :func:`smooth` for the result and
+        for ``progress`` and ``cancel``."""
         h = _float64("values", values)
         if h.shape != self._shape:
             raise InputError(f"values has shape {h.shape}, the smoother's domain {self._shape}")
         flat, filled = _fill(self._domain, h.reshape(-1), self._fill_missing, self._settings)
-        return SmoothResult(self._inner.smooth(flat), self._shape, filled)
-
-
-_SETTING_DEFAULTS: Dict[str, Any] = dict(
-    persistence=None,
-    minima=None,
-    maxima=None,
-    pairs=None,
-    keep_min=None,
-    keep_max=None,
-    keep_all_maxima=False,
-    keep_all_minima=False,
-    order=2,
-    data_weight=1.0,
-    smooth_length=None,
-    smooth_weight=None,
-    edges="minimal",
-    representative=None,
-    max_iter=200,
-    solver="auto",
-    formulation="auto",
-    threads=None,
-)
+        return SmoothResult(self._inner.smooth(flat, progress, cancel), self._shape, filled)
 
 
 def _resolve(settings: Dict[str, Any]) -> Dict[str, Any]:
-    unknown = sorted(set(settings) - set(_SETTING_DEFAULTS))
+    """The settings given (None is "not given"); their values are checked by the library,
+    which reads them as it reads the CLI's flags."""
+    unknown = sorted(set(settings) - _SETTING_NAMES)
     if unknown:
-        raise UsageError(f"unknown setting(s): {', '.join(unknown)}")
-    s = dict(_SETTING_DEFAULTS, **settings)
-    selection = _selection_kwargs(
-        s["persistence"],
-        s["minima"],
-        s["maxima"],
-        s["pairs"],
-        s["keep_min"],
-        s["keep_max"],
-        s["keep_all_maxima"],
-        s["keep_all_minima"],
-    )
-    out = dict(
-        selection,
-        order=str(s["order"]),
-        data_weight=float(s["data_weight"]),
-        smooth_length=None if s["smooth_length"] is None else float(s["smooth_length"]),
-        smooth_weight=None if s["smooth_weight"] is None else float(s["smooth_weight"]),
-        edges=s["edges"],
-        representative=s["representative"],
-        max_iter=int(s["max_iter"]),
-        solver=s["solver"],
-        formulation=s["formulation"],
-    )
-    if s["threads"] is not None:
-        if int(s["threads"]) < 1:
-            raise UsageError(f"threads must be at least 1, got {s['threads']}")
-        out["threads"] = int(s["threads"])
-    return out
+        raise UsageError(f"unknown setting(s): {', '.join(unknown)} (the settings are toposmooth.SETTINGS)")
+    return {k: v for k, v in settings.items() if v is not None}
 
 
 def _fill(
@@ -386,7 +336,9 @@ def _fill(
         return flat, None
     filled, mask = _toposmooth.fill_missing(domain, flat)
     for key in ("keep_min", "keep_max"):
-        bad = [i for i in (settings or {}).get(key) or [] if 0 <= i < mask.size and mask[i]]
+        given = (settings or {}).get(key)
+        listed = [] if given is None or isinstance(given, str) else np.asarray(given).reshape(-1).tolist()
+        bad = [i for i in listed if isinstance(i, int) and 0 <= i < mask.size and mask[i]]
         if bad:
             raise InputError(f"{key} names the missing sample {bad[0]}: a kept extremum must have an input value")
     return filled, mask
@@ -420,6 +372,9 @@ def smooth(
     solver: str = "auto",
     formulation: str = "auto",
     threads: Optional[int] = None,
+    sharp: Optional[Sequence[int]] = None,
+    progress: Any = None,
+    cancel: Any = None,
 ) -> SmoothResult:
     """Smooth a field keeping exactly the chosen extrema, with a certificate.
 
@@ -483,6 +438,17 @@ def smooth(
     threads : int, optional
         At most this many threads for the call (default 2). Results are bit-identical for
         every thread count; 1 suits one process per core (Dask workers, pvbatch ranks).
+    sharp : sequence of int, optional
+        Vertices where orders >= 2 are not penalised (a spike can stay C0).
+    progress : callable, optional
+        Called on this thread as the run goes, ``progress(stage, fraction, message)``: the
+        stage (``"selection"``, ``"complex"``, ``"representative"``, ``"solve"``,
+        ``"certificate"``), how far it is from 0 to 1 (None where not known; 1 when it ends)
+        and what it does now (the iteration and its gap) or, at its end, its summary. An
+        exception it raises stops the run and is raised.
+    cancel : CancelToken, optional
+        ``cancel.cancel()`` from another thread stops the run at its next check: the call
+        raises :class:`Cancelled`. Ctrl-C stops it the same way and raises ``KeyboardInterrupt``.
 
     Returns
     -------
@@ -503,6 +469,8 @@ def smooth(
         The output failed its certificate (a bug or a numerical failure).
     SolverError
         The solver returned no point.
+    Cancelled
+        The ``cancel`` token was cancelled.
 
     Notes
     -----
@@ -539,6 +507,7 @@ def smooth(
             solver=solver,
             formulation=formulation,
             threads=threads,
+            sharp=sharp,
         )
     )
     if mask is not None:
@@ -552,10 +521,10 @@ def smooth(
             gaps = np.isnan(flat) & inside
             if gaps.any():
                 raise UsageError("fill_missing= with mask=: give the mask without the NaN voxels, or fill first")
-        raw = _toposmooth.smooth_masked(domain, settings, flat, inside)
+        raw = _toposmooth.smooth_masked(domain, settings, flat, inside, progress, cancel)
         return SmoothResult(raw, shape, filled)
     flat, filled = _fill(domain, flat, fill_missing, settings)
-    raw = _toposmooth.Smoother(domain, settings).smooth(flat)
+    raw = _toposmooth.Smoother(domain, settings).smooth(flat, progress, cancel)
     return SmoothResult(raw, shape, filled)
 
 
@@ -599,7 +568,18 @@ def extrema(
     """
     domain, flat, _ = _domain(values, x, spacing, origin, vertices, faces)
     flat, _ = _fill(domain, flat, fill_missing)
-    sel = _selection_kwargs(persistence, minima, maxima, pairs, keep_min, keep_max, keep_all_maxima, keep_all_minima)
+    sel = _resolve(
+        dict(
+            persistence=persistence,
+            minima=minima,
+            maxima=maxima,
+            pairs=pairs,
+            keep_min=keep_min,
+            keep_max=keep_max,
+            keep_all_maxima=keep_all_maxima,
+            keep_all_minima=keep_all_minima,
+        )
+    )
     out = dict(_toposmooth.extrema(domain, flat, sel))
     # each extremum's persistence pair: a minimum is born at its value and dies at its partner's,
     # a maximum the other way round; essential extrema never die (death ±inf)
@@ -675,6 +655,8 @@ def weights(
     method: str = "monotone",
     edges: str = "minimal",
     threads: int = 2,
+    progress: Any = None,
+    cancel: Any = None,
 ) -> Dict[str, Any]:
     """Smooth weight functions, one per handle, with no spurious extrema (certified).
 
@@ -694,6 +676,8 @@ def weights(
     edges : {"minimal", "all"}
     threads : int
         Worker threads for the independent functions.
+    progress, cancel
+        As in :func:`smooth` (the stage ``"weights"`` tells the functions done).
 
     Returns
     -------
@@ -711,9 +695,160 @@ def weights(
         sets = [_indices(f"handle {k}", np.atleast_1d(h)) for k, h in enumerate(handles)]
         names = [str(k) for k in range(len(sets))]
     settings = {"order": int(order), "method": method, "edges": edges, "threads": int(threads)}
-    out = dict(_toposmooth.weights(domain, sets, settings))
+    out = dict(_toposmooth.weights(domain, sets, settings, progress, cancel))
     out.update(names=list(names), handles=sets)
     return out
+
+
+class Dataset:
+    """A field and its domain as a file holds them: what :func:`read` returns.
+
+    Attributes
+    ----------
+    values : ndarray of float64
+        The field, after deriving and filling: shape (n,) for a series or a mesh, (ny, nx) for
+        a grid, (nz, ny, nx) for a volume (x fastest, as numpy holds a VTK image).
+    kind : str
+        ``"series"``, ``"grid"``, ``"volume"``, ``"mesh"`` or ``"tetrahedra"``.
+    domain : Domain
+        The domain (validated), ready for :class:`Smoother` or :meth:`smooth`.
+    description : str
+        What the values are: the column, the array or the derivation read.
+    path : str
+        The file read (the first velocity file with ``u``/``v``).
+    notes : list of str
+        What reading found worth saying (polygons split, an oblique affine).
+    filled, mask : ndarray of bool or None
+        The samples ``fill_missing`` filled; the pixels or voxels inside ``mask``.
+    x, x_name, x_text, dates
+        Series: the x coordinates (days since 1970-01-01 for dates), the x column's name and
+        text, and whether x holds dates.
+    spacing, origin : tuple of float or None
+        Grids and volumes: the spacing and the first point (x first).
+    vertices, faces : ndarray or None
+        Meshes: positions (n, 3) and triangles (m, 3) or tetrahedra (m, 4).
+    arrays : dict of ndarray
+        Every point array of the file (VTK, PLY), (n,) or (n, components), the field's own
+        included.
+    """
+
+    __slots__ = (
+        "values", "kind", "domain", "description", "path", "notes", "filled", "mask", "x", "x_name",
+        "x_text", "dates", "spacing", "origin", "vertices", "faces", "arrays", "_flat",
+    )
+
+    def __init__(self, raw: Dict[str, Any]) -> None:
+        shape = tuple(raw["shape"])
+        self._flat: np.ndarray = raw["values"]
+        self.values: np.ndarray = self._flat.reshape(shape)
+        self.kind: str = raw["kind"]
+        self.domain = raw["domain"]
+        self.description: str = raw["description"]
+        self.path: str = raw["path"]
+        self.notes: List[str] = list(raw["notes"])
+        self.filled: Optional[np.ndarray] = None if raw["filled"] is None else raw["filled"].reshape(shape)
+        self.mask: Optional[np.ndarray] = None if raw["mask"] is None else raw["mask"].reshape(shape)
+        self.x: Optional[np.ndarray] = raw.get("x")
+        self.x_name: Optional[str] = raw.get("x_name")
+        self.x_text: Optional[List[str]] = raw.get("x_text")
+        self.dates: bool = bool(raw.get("dates", False))
+        self.spacing: Optional[tuple] = tuple(raw["spacing"]) if "spacing" in raw else None
+        self.origin: Optional[tuple] = tuple(raw["origin"]) if "origin" in raw else None
+        self.vertices: Optional[np.ndarray] = raw.get("vertices")
+        self.faces: Optional[np.ndarray] = raw.get("faces")
+        self.arrays: Dict[str, np.ndarray] = dict(raw["arrays"])
+
+    def smooth(self, *, progress: Any = None, cancel: Any = None, **settings: Any) -> SmoothResult:
+        """Smooths the field on its domain as the CLI's ``smooth`` does with the same input
+        options (inside the mask when one was read); the settings are :func:`smooth`'s."""
+        s = _resolve(settings)
+        if self.mask is not None:
+            inside = np.ascontiguousarray(self.mask.reshape(-1))
+            raw = _toposmooth.smooth_masked(self.domain, s, self._flat, inside, progress, cancel)
+        else:
+            raw = _toposmooth.Smoother(self.domain, s).smooth(self._flat, progress, cancel)
+        return SmoothResult(raw, self.values.shape, self.filled)
+
+    def __repr__(self) -> str:
+        return f"Dataset({self.kind} {self.values.shape} of {self.description!r} from {self.path!r})"
+
+
+def read(
+    path: Any = None,
+    *,
+    domain: Optional[str] = None,
+    column: Union[str, int, None] = None,
+    x_column: Union[str, int, None] = None,
+    array: Optional[str] = None,
+    spacing: Optional[Sequence[float]] = None,
+    derive: Optional[str] = None,
+    u: Any = None,
+    v: Any = None,
+    fill_missing: bool = False,
+    values: Any = None,
+    mask: Optional[str] = None,
+    mask_below: Optional[float] = None,
+) -> Dataset:
+    """Read a file as the CLI reads its input: every format it knows, the same options.
+
+    Parameters
+    ----------
+    path : str or os.PathLike, optional
+        A series (CSV, .npy), a grid or volume (.vti, .vtk, .npy, .npz, CSV matrix, PNG, TIFF,
+        .nii, .nii.gz) or a mesh (.obj, .off, .ply, .vtu, .vtp, legacy .vtk); None with ``u``
+        and ``v``.
+    domain : {"auto", "series", "grid", "mesh"}, optional
+        How to read it (default: by extension; a CSV whose first line is three or more numbers
+        is a grid matrix).
+    column, x_column : str or int, optional
+        Series: the value column and the x column (name or 0-based index; ``"none"``: x =
+        0, 1, 2, ...), as the CLI's ``--column`` and ``--x``.
+    array : str, optional
+        The point array of a VTK file or .npz, a PLY vertex property, or a mesh's ``x``,
+        ``y``, ``z``.
+    spacing : (dx, dy) or (dx, dy, dz), optional
+        Overrides the file's spacing (may be negative).
+    derive : str, optional
+        ``vorticity`` or ``magnitude`` of a 2D velocity; ``vorticity-magnitude``,
+        ``vorticity-x|y|z`` or ``magnitude`` of a volume's.
+    u, v : path, optional
+        Two velocity component files (with ``derive``), instead of ``path``.
+    fill_missing : bool
+        Fill NaN samples (harmonically on grids and meshes, linearly on series) instead of
+        raising :class:`InputError`.
+    values : path, optional
+        Meshes: one value per vertex and line of a text file.
+    mask, mask_below : optional
+        Grids and volumes: the point array that is non-zero inside, or the value below which
+        a voxel is outside.
+
+    Returns
+    -------
+    Dataset
+        The values as numpy (float64), the domain and what the file carries besides.
+
+    Raises
+    ------
+    InputError, IoError, UsageError
+        As the CLI: the file, the problem and what to do.
+    """
+    import os
+
+    options = dict(
+        domain=domain,
+        column=column,
+        x_column=x_column,
+        array=array,
+        spacing=spacing,
+        derive=derive,
+        u=None if u is None else os.fspath(u),
+        v=None if v is None else os.fspath(v),
+        fill_missing=fill_missing,
+        values=None if values is None else os.fspath(values),
+        mask=mask,
+        mask_below=mask_below,
+    )
+    return Dataset(_toposmooth.read(None if path is None else os.fspath(path), options))
 
 
 def _flags(settings: Dict[str, Any]) -> List[str]:
@@ -733,15 +868,17 @@ def _flags(settings: Dict[str, Any]) -> List[str]:
     return out
 
 
-def cli(*args: Any, threads: Optional[int] = None) -> str:
+def cli(*args: Any, threads: Optional[int] = None, progress: Any = None, cancel: Any = None) -> str:
     """Run one command of the command-line tool in this process and return what it prints.
 
     ``toposmooth.cli("smooth", "in.vti", "-o", "out.vti", "--minima", 3)`` is the CLI's
     ``toposmooth smooth in.vti -o out.vti --minima 3``, reading and writing the files the same
     way (every format the CLI knows, certified outputs, the JSON report). Errors are raised as
     this package's exceptions (:class:`UsageError` for arguments the CLI refuses).
+    ``progress`` and ``cancel`` as in :func:`smooth`: a cancelled command leaves no output or
+    temporary file behind.
     """
-    return _toposmooth.run([str(a) for a in args], threads)
+    return _toposmooth.run([str(a) for a in args], threads, progress, cancel)
 
 
 # the submodules for many fields (they import xarray and dask only when used)

@@ -1,7 +1,7 @@
 """Type stubs of the extension module (python/src/lib.rs); the package's functions in
 ``toposmooth/__init__.py`` are the documented interface."""
 
-from typing import Any, Dict, List, Optional, Tuple
+from typing import Any, Callable, Dict, List, Optional, Tuple
 
 import numpy as np
 import numpy.typing as npt
@@ -24,9 +24,21 @@ class Domain:
     @property
     def kind(self) -> str: ...
 
+class CancelToken:
+    """Stops the calls given it (``cancel=``) at their next check: they raise ``Cancelled``."""
+
+    def __init__(self) -> None: ...
+    def cancel(self) -> None: ...
+    @property
+    def cancelled(self) -> bool: ...
+
+Progress = Callable[[str, Optional[float], str], Any]
+
 class Smoother:
     def __init__(self, domain: Domain, settings: Dict[str, Any]) -> None: ...
-    def smooth(self, h: npt.NDArray[np.float64]) -> Dict[str, Any]:
+    def smooth(
+        self, h: npt.NDArray[np.float64], progress: Optional[Progress] = None, cancel: Optional[CancelToken] = None
+    ) -> Dict[str, Any]:
         """``smoothed``, ``representative`` (float64 (n,)), ``roles`` (int8 (n,)), ``report``
         (JSON text), ``certified`` (bool)."""
     @property
@@ -40,15 +52,34 @@ def certify(
     input: Optional[npt.NDArray[np.float64]] = None,
 ) -> Dict[str, Any]: ...
 def geodesic(domain: Domain, sources: List[int]) -> npt.NDArray[np.float64]: ...
-def weights(domain: Domain, handles: List[List[int]], settings: Dict[str, Any]) -> Dict[str, Any]: ...
+def weights(
+    domain: Domain,
+    handles: List[List[int]],
+    settings: Dict[str, Any],
+    progress: Optional[Progress] = None,
+    cancel: Optional[CancelToken] = None,
+) -> Dict[str, Any]: ...
 def fill_missing(
     domain: Domain, h: npt.NDArray[np.float64]
 ) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.bool_]]: ...
 def smooth_masked(
-    domain: Domain, settings: Dict[str, Any], h: npt.NDArray[np.float64], mask: npt.NDArray[np.bool_]
+    domain: Domain,
+    settings: Dict[str, Any],
+    h: npt.NDArray[np.float64],
+    mask: npt.NDArray[np.bool_],
+    progress: Optional[Progress] = None,
+    cancel: Optional[CancelToken] = None,
 ) -> Dict[str, Any]: ...
 def version() -> str: ...
-def run(args: List[str], threads: Optional[int] = None) -> str: ...
+def run(
+    args: List[str],
+    threads: Optional[int] = None,
+    progress: Optional[Progress] = None,
+    cancel: Optional[CancelToken] = None,
+) -> str: ...
+def settings_schema() -> List[Dict[str, Any]]: ...
 def main(argv: List[str]) -> int: ...
 def resolve_handles(domain: Domain, json: str) -> Tuple[List[str], List[List[int]]]: ...
 def diagram(domain: Domain, h: npt.NDArray[np.float64], settings: Dict[str, Any]) -> Dict[str, np.ndarray]: ...
+def read(path: Optional[str], options: Dict[str, Any]) -> Dict[str, Any]: ...
+def input_options() -> List[Dict[str, Any]]: ...

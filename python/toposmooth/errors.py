@@ -3,11 +3,14 @@
 Each carries the library's message (``str(e)``, the CLI's text) and the attributes
 
 kind : str
-    ``"usage"``, ``"input"``, ``"io"``, ``"infeasible"``, ``"uncertified"``, ``"internal"`` or
-    ``"nosolution"``.
+    ``"usage"``, ``"input"``, ``"io"``, ``"infeasible"``, ``"uncertified"``, ``"internal"``,
+    ``"nosolution"`` or ``"cancelled"``.
 exit_code : int
     The command-line tool's exit status for the same error (SPEC.md): 2 usage, 3 input, I/O
-    and infeasible, 1 uncertified and internal, 4 no solution.
+    and infeasible, 1 uncertified and internal, 4 no solution, 130 cancelled.
+
+Ctrl-C during a computation raises Python's own ``KeyboardInterrupt`` once the run has
+stopped (at its next check: between stages and solver iterations), not one of these.
 path : str or None
     The file the error is about, when there is one.
 """
@@ -21,6 +24,7 @@ __all__ = [
     "CertificateError",
     "SolverError",
     "InternalError",
+    "Cancelled",
 ]
 
 
@@ -72,3 +76,9 @@ class InternalError(Error, RuntimeError):
     """A bug or a numerical failure on valid input (exit 1)."""
 
     kind, exit_code = "internal", 1
+
+
+class Cancelled(Error):
+    """The run was stopped by its ``cancel=`` token (exit 130); nothing was written."""
+
+    kind, exit_code = "cancelled", 130

@@ -90,7 +90,10 @@ def domain_of(data: Any) -> Dict[str, Any]:
 
 
 class _Settings:
-    """The parameters both filters share: the selection."""
+    """The parameters both filters share: the selection. :meth:`settings` gives the filter's
+    parameters as the library's settings (``toposmooth.SETTINGS``' names and values), which
+    the tests check against the schema: every parameter is a setting, every default the
+    schema's."""
 
     def _init_settings(self) -> None:
         self._persistence = 5.0
@@ -121,6 +124,10 @@ class _Settings:
             return {"minima": max(self._minima, 1), "maxima": max(self._maxima, 1)}
         return {"persistence": f"{self._persistence}%"}
 
+    def settings(self) -> Dict[str, Any]:
+        """The filter's parameters as the settings of :func:`toposmooth.smooth`."""
+        return self._selection()
+
 
 class TopologyControlledSmoothing(_Settings, VTKPythonAlgorithmBase):
     """Smooths a point scalar keeping exactly the chosen extrema (certified)."""
@@ -132,7 +139,7 @@ class TopologyControlledSmoothing(_Settings, VTKPythonAlgorithmBase):
         self._data_weight = 1.0
         self._smooth_length = 0.0
         self._edges = "minimal"
-        self._threads = 2
+        self._threads: Optional[int] = None
         self.report: Optional[Dict[str, Any]] = None
 
     def FillInputPortInformation(self, port: int, info: Any) -> int:
@@ -164,9 +171,11 @@ class TopologyControlledSmoothing(_Settings, VTKPythonAlgorithmBase):
             self._edges = str(e)
             self.Modified()
 
-    def SetThreads(self, n: int) -> None:
+    def SetThreads(self, n: Optional[int]) -> None:
+        """At most n threads (None or 0: the library's default, 2)."""
+        n = int(n) if n else None
         if n != self._threads:
-            self._threads = max(int(n), 1)
+            self._threads = n
             self.Modified()
 
     def RequestDataObject(self, request: Any, inInfo: Any, outInfo: Any) -> int:
@@ -176,22 +185,23 @@ class TopologyControlledSmoothing(_Settings, VTKPythonAlgorithmBase):
             outInfo.GetInformationObject(0).Set(vtkDataObject.DATA_OBJECT(), inp.NewInstance())
         return 1
 
+    def settings(self) -> Dict[str, Any]:
+        return dict(
+            self._selection(),
+            order=self._order,
+            data_weight=self._data_weight,
+            smooth_length=self._smooth_length or None,
+            edges=self._edges,
+            threads=self._threads,
+        )
+
     def RequestData(self, request: Any, inInfo: Any, outInfo: Any) -> int:
         inp = vtkDataSet.GetData(inInfo[0])
         out = vtkDataSet.GetData(outInfo)
         name, values = _scalars(self, inInfo[0], inp)
         geometry = domain_of(inp)
         shape = geometry.pop("shape")
-        r = toposmooth.smooth(
-            values.reshape(shape),
-            order=self._order,
-            data_weight=self._data_weight,
-            smooth_length=self._smooth_length or None,
-            edges=self._edges,
-            threads=self._threads,
-            **geometry,
-            **self._selection(),
-        )
+        r = toposmooth.smooth(values.reshape(shape), **geometry, **self.settings())
         self.report = r.report
         out.ShallowCopy(inp)
         smoothed = numpy_support.numpy_to_vtk(np.ascontiguousarray(r.smoothed.ravel()), deep=1)
@@ -234,9 +244,7 @@ class PersistenceDiagram(_Settings, VTKPythonAlgorithmBase):
         geometry = domain_of(inp)
         shape = geometry.pop("shape")
         domain, flat, _ = toposmooth._domain(values.reshape(shape), **geometry)
-        selection = toposmooth._selection_kwargs(None, None, None, None, None, None, False, False)
-        selection.update(self._selection())
-        d = toposmooth._toposmooth.diagram(domain, flat, selection)
+        d = toposmooth._toposmooth.diagram(domain, flat, self.settings())
         k = len(d["pair_type"])
         b, dv = d["values"][:, 0], d["values"][:, 1]
         xy = np.zeros((2 * k, 3))

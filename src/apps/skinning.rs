@@ -29,6 +29,8 @@ pub enum Skinning {
     Dqs,
 }
 
+named_enum!(Skinning, "skinning", [(Skinning::Lbs, "lbs"), (Skinning::Dqs, "dqs")]);
+
 /// A linear part farther than this from its rotation part (`|A − R|_F / |R|_F`) has scale or
 /// shear.
 const NOT_ROTATION: f64 = 1e-6;

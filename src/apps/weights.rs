@@ -43,6 +43,17 @@ pub enum WeightMethod {
     Harmonic,
 }
 
+named_enum!(
+    WeightMethod,
+    "weight method",
+    [
+        (WeightMethod::Monotone, "monotone"),
+        (WeightMethod::Bounded, "bounded"),
+        (WeightMethod::Unconstrained, "unconstrained"),
+        (WeightMethod::Harmonic, "harmonic"),
+    ]
+);
+
 /// Settings of a weights run.
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]
 pub struct WeightSettings {
@@ -375,7 +386,7 @@ pub fn weights_prescribed<D: Smoothable + Sync>(
     let t = Instant::now();
     let count = prescribed.len();
     let functions: Vec<WeightFunction> = if settings.method == WeightMethod::Bounded {
-        bounded(domain, prescribed, &ops, settings)?
+        crate::progress::settle(bounded(domain, prescribed, &ops, settings))?
     } else {
         let next = AtomicUsize::new(0);
         let done = AtomicUsize::new(0);
@@ -383,26 +394,38 @@ pub fn weights_prescribed<D: Smoothable + Sync>(
         let threads = settings.threads.clamp(1, count);
         let inner = (crate::parallel::threads() / threads).max(1);
         let mut results: Vec<Option<Result<WeightFunction>>> = (0..count).map(|_| None).collect();
+        let token = crate::progress::token();
         std::thread::scope(|s| {
             let workers: Vec<_> = (0..threads)
                 .map(|_| {
+                    let token = token.clone();
                     s.spawn(|| {
-                        // the cap shared among the workers (the same results for any split: the
-                        // plans do not depend on the thread count); the normal matrix's
-                        // analysis is shared by this thread's functions
-                        crate::parallel::with_threads(inner, || {
-                            let mut analyses = Analyses::new();
-                            let mut mine = Vec::new();
-                            loop {
-                                let h = next.fetch_add(1, Ordering::Relaxed);
-                                if h >= count {
-                                    break;
+                        crate::progress::with_token(token, || {
+                            // the cap shared among the workers (the same results for any split: the
+                            // plans do not depend on the thread count); the normal matrix's
+                            // analysis is shared by this thread's functions
+                            crate::parallel::with_threads(inner, || {
+                                let mut analyses = Analyses::new();
+                                let mut mine = Vec::new();
+                                loop {
+                                    let h = next.fetch_add(1, Ordering::Relaxed);
+                                    if h >= count {
+                                        break;
+                                    }
+                                    if let Err(e) = crate::progress::checkpoint() {
+                                        mine.push((h, Err(e)));
+                                        continue;
+                                    }
+                                    mine.push((
+                                        h,
+                                        one_function(domain, &prescribed[h], h, &ops, settings, &mut analyses),
+                                    ));
+                                    let d = done.fetch_add(1, Ordering::Relaxed) + 1;
+                                    stage.update(|| format!("{d} of {count} functions"));
+                                    stage.fraction(d as f64 / count as f64);
                                 }
-                                mine.push((h, one_function(domain, &prescribed[h], h, &ops, settings, &mut analyses)));
-                                let d = done.fetch_add(1, Ordering::Relaxed) + 1;
-                                stage.update(|| format!("{d} of {count} functions"));
-                            }
-                            mine
+                                mine
+                            })
                         })
                     })
                 })
@@ -413,7 +436,8 @@ pub fn weights_prescribed<D: Smoothable + Sync>(
                 }
             }
         });
-        let functions = results.into_iter().map(|r| r.expect("every handle was computed")).collect::<Result<_>>()?;
+        let functions = results.into_iter().map(|r| r.expect("every handle was computed")).collect::<Result<_>>();
+        let functions = crate::progress::settle(functions)?;
         stage.end(|| format!("{count} functions on {threads} threads"));
         functions
     };

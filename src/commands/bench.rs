@@ -307,7 +307,7 @@ fn run_single(case: BenchCase, args: &BenchArgs) -> Result<String> {
         }
         BenchCase::Mesh(file, levels) => {
             let path = std::path::Path::new(file);
-            let (mut mesh, _) = super::input::read_trimesh(path)?;
+            let (mut mesh, _) = crate::io::import::read_trimesh(path)?;
             for _ in 0..*levels {
                 mesh = mesh.subdivide().map_err(|e| e.in_file(path))?;
             }
@@ -460,7 +460,7 @@ pub fn bench_weights(cases: &[String], orders: &[u8], handles: usize) -> Result<
             }
             None => (case.as_str(), 0),
         };
-        let (mut mesh, _) = super::input::read_trimesh(std::path::Path::new(file))?;
+        let (mut mesh, _) = crate::io::import::read_trimesh(std::path::Path::new(file))?;
         for _ in 0..levels {
             mesh = mesh.subdivide()?;
         }

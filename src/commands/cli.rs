@@ -4,15 +4,14 @@
 
 use crate::apps::skinning::Skinning;
 use crate::apps::weights::WeightMethod;
-use crate::commands::input::{Derive, DomainKind, GridOptions, MaskRule};
+use crate::commands::settings_args::{SelectionArgs, SettingsArgs};
 use crate::commands::{self, BenchArgs, ExtremaArgs, SmoothArgs, VerifyArgs};
 use crate::constraints::EdgeSet;
-use crate::domain::{MAX_SPACING, MIN_SPACING};
-use crate::io::series_csv::SeriesCsvOptions;
+use crate::io::import::{Derive, DomainKind, MaskRule, ReadOptions};
 use crate::operators::Energy;
-use crate::pipeline::{RepresentativeChoice, SmoothSettings};
+use crate::pipeline::RepresentativeChoice;
 use crate::plot::MeshView;
-use crate::solve::{Formulation, Method, QpSettings};
+use crate::solve::Method;
 use crate::topology::Selection;
 use crate::{Error, Result};
 use clap::{Args, Parser, Subcommand};
@@ -52,9 +51,9 @@ enum Command {
         /// `Persistence` in ParaView to select pairs.
         #[arg(long, value_name = "VTU")]
         diagram: Option<PathBuf>,
-        /// Mark the extrema kept at this persistence: `5%` of the range or an absolute value.
-        #[arg(long, default_value = "5%")]
-        persistence: String,
+        /// Which extrema are marked kept (the rules of `smooth`).
+        #[command(flatten)]
+        selection: SelectionArgs,
     },
     /// Smooth a series keeping exactly the selected extrema; certify the output.
     Smooth(Box<SmoothCli>),
@@ -252,30 +251,13 @@ struct GridCli {
 }
 
 impl GridCli {
-    fn options(&self) -> Result<GridOptions> {
-        let spacing = match &self.spacing {
-            None => None,
-            Some(text) => {
-                let bad = || {
-                    Error::Usage(format!(
-                        "--spacing `{text}` must be two numbers dx,dy (grids) or three dx,dy,dz (volumes) with \
-                         {MIN_SPACING:e} ≤ |d| ≤ {MAX_SPACING:e}"
-                    ))
-                };
-                let parts: Vec<f64> = text
-                    .split(',')
-                    .map(|p| p.trim().parse::<f64>())
-                    .collect::<std::result::Result<_, _>>()
-                    .map_err(|_| bad())?;
-                if !(2..=3).contains(&parts.len())
-                    || parts.iter().any(|d| !(MIN_SPACING..=MAX_SPACING).contains(&d.abs()))
-                {
-                    return Err(bad());
-                }
-                Some(parts)
-            }
-        };
-        Ok(GridOptions {
+    /// The input options with `csv`'s columns.
+    fn options(&self, csv: &CsvArgs) -> Result<ReadOptions> {
+        let spacing = self.spacing.as_deref().map(crate::io::import::parse_spacing).transpose()?;
+        Ok(ReadOptions {
+            domain: self.domain,
+            column: csv.column.clone(),
+            x_column: csv.x_column.clone(),
             array: self.array.clone(),
             spacing,
             derive: self.derive,
@@ -285,7 +267,7 @@ impl GridCli {
             mask: match (&self.mask, self.mask_below) {
                 (Some(name), _) => Some(MaskRule::Array(name.clone())),
                 (None, Some(v)) if v.is_finite() => Some(MaskRule::Below(v)),
-                (None, Some(v)) => return Err(Error::setting("mask-below", format!("must be finite, got {v}"))),
+                (None, Some(v)) => return Err(Error::setting("mask_below", format!("must be finite, got {v}"))),
                 (None, None) => None,
             },
         })
@@ -301,12 +283,6 @@ struct CsvArgs {
     /// or is named x, t, time or date).
     #[arg(long = "x", value_name = "COLUMN")]
     x_column: Option<String>,
-}
-
-impl CsvArgs {
-    fn options(&self) -> SeriesCsvOptions {
-        SeriesCsvOptions { column: self.column.clone(), x_column: self.x_column.clone(), ..Default::default() }
-    }
 }
 
 fn parse_view(view: Option<&str>) -> Result<MeshView> {
@@ -404,77 +380,15 @@ struct SmoothCli {
     /// TTK's layout; volumes with TTK's 3D codes).
     #[arg(long, value_name = "VTP")]
     complex: Option<PathBuf>,
-    /// Grids and meshes: representative function. Given, it is built or the run fails (exit 3
-    /// when the data cannot follow its order, 1 when it fails its own check); by default the
-    /// separatrix one, then harmonic, then flooded, each fallback reported.
-    #[arg(long, value_enum)]
-    representative: Option<RepresentativeChoice>,
     /// Mesh plot: camera azimuth and elevation in degrees (y up).
     #[arg(long, value_name = "AZ,EL", allow_hyphen_values = true)]
     view: Option<String>,
     /// Grid plot: number of isolines, 0 to 1000 (0: none; grids only).
     #[arg(long, default_value_t = 0, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(0..=1000))]
     isolines: usize,
-    /// Keep extrema of persistence ≥ T: `5%` of the range or an absolute value. [default: 5%]
-    #[arg(long, value_name = "T", conflicts_with_all = ["pairs", "minima", "keep_min", "keep_max"])]
-    persistence: Option<String>,
-    /// Series: keep the N most persistent (minimum, maximum) pairs besides the global minimum.
-    #[arg(long, value_name = "N", conflicts_with_all = ["minima", "keep_min", "keep_max"])]
-    pairs: Option<usize>,
-    /// Grids and meshes: keep the N most persistent minima (with --maxima).
-    #[arg(long, value_name = "N", requires = "maxima", conflicts_with_all = ["keep_min", "keep_max"])]
-    minima: Option<usize>,
-    /// Grids and meshes: keep the M most persistent maxima (with --minima).
-    #[arg(long, value_name = "M", requires = "minima")]
-    maxima: Option<usize>,
-    /// Surfaces: keep every maximum of persistence > 0 and only the global minimum (geodesic
-    /// distance from a source keeps its maxima).
-    #[arg(long, conflicts_with_all = ["persistence", "pairs", "minima", "keep_min", "keep_max", "keep_all_minima"])]
-    keep_all_maxima: bool,
-    /// Surfaces: keep every minimum of persistence > 0 and only the global maximum.
-    #[arg(long, conflicts_with_all = ["persistence", "pairs", "minima", "keep_min", "keep_max"])]
-    keep_all_minima: bool,
-    /// Keep exactly these minima (vertex indices, comma-separated; grids: row·nx + column);
-    /// needs --keep-max.
-    #[arg(long, value_name = "I,J", requires = "keep_max")]
-    keep_min: Option<String>,
-    /// Keep exactly these maxima (vertex indices); needs --keep-min.
-    #[arg(long, value_name = "K", requires = "keep_min")]
-    keep_max: Option<String>,
-    /// Polyharmonic order 1..4, or a blend like `1:0.2,2:1`.
-    #[arg(long, default_value = "2")]
-    order: String,
-    /// Samples where orders ≥ 2 are not penalised (a spike can stay C0).
-    #[arg(long, value_name = "I,J")]
-    sharp: Option<String>,
-    /// γD: weight of the data term.
-    #[arg(long, default_value_t = 1.0)]
-    data_weight: f64,
-    /// γL for every energy term (default: ℓ^(2k) with ℓ from --smooth-length).
-    #[arg(long, value_name = "W")]
-    smooth_weight: Option<f64>,
-    /// Smoothing length ℓ as a fraction of the domain's diameter (the series' extent); by
-    /// default max(2 mean edge lengths, 1 % of the diameter), on series at most 0.3 × the median
-    /// spacing of the kept extrema (the report gives ℓ and the rule).
-    #[arg(long, value_name = "FRACTION")]
-    smooth_length: Option<f64>,
-    /// Constraint set.
-    #[arg(long, value_enum, default_value_t = EdgeSet::Minimal)]
-    edges: EdgeSet,
-    /// Largest number of solver iterations (at least 1).
-    #[arg(long, default_value_t = 200, value_parser = clap::value_parser!(u32).range(1..))]
-    max_iter: u32,
-    /// QP solver: auto (the active-set iteration on volumes of 1,000 vertices or more, else
-    /// structured), the structured interior-point method (Clarabel takes over if it fails),
-    /// Clarabel alone, or the active-set iteration with conjugate gradients, which factorises
-    /// nothing and hands over to the structured solver when it does not converge.
-    #[arg(long, value_enum, default_value_t = Method::Auto)]
-    solver: Method,
-    /// How the energy enters the solver: assembled (normal equations in double precision),
-    /// factored (FᵀF, the paper's auxiliary variables: double-double normal equations in the
-    /// structured solver), or auto (factored when the condition estimate exceeds 1e9).
-    #[arg(long, value_enum, default_value_t = Formulation::Auto)]
-    formulation: Formulation,
+    /// The run's settings: the selection, the energy, the solver (the library's schema).
+    #[command(flatten)]
+    settings: SettingsArgs,
     /// Figure: series input (grey), output and kept extrema; grids as heat maps side by side.
     #[arg(long, value_name = "PNG")]
     plot: Option<PathBuf>,
@@ -484,38 +398,10 @@ struct SmoothCli {
 }
 
 fn smooth_args(c: SmoothCli) -> Result<SmoothArgs> {
-    let selection = match (&c.persistence, c.pairs, &c.keep_min, &c.keep_max) {
-        _ if c.keep_all_maxima => Selection::AllMaxima,
-        _ if c.keep_all_minima => Selection::AllMinima,
-        (Some(p), _, _, _) => commands::parse_persistence(p)?,
-        (None, Some(n), _, _) => Selection::Pairs(n),
-        (None, None, _, _) if c.minima.is_some() => {
-            Selection::Count { minima: c.minima.unwrap_or(1), maxima: c.maxima.unwrap_or(1) }
-        }
-        (None, None, Some(mn), Some(mx)) => {
-            Selection::Explicit { minima: commands::parse_indices(mn)?, maxima: commands::parse_indices(mx)? }
-        }
-        _ => commands::parse_persistence("5%")?,
-    };
-    let mut energy = Energy::parse(&c.order)?;
-    if let Some(s) = &c.sharp {
-        energy.sharp = commands::parse_indices(s)?;
-    }
-    let settings = SmoothSettings {
-        selection,
-        energy,
-        data_weight: c.data_weight,
-        smooth_weight: c.smooth_weight,
-        smooth_length: c.smooth_length,
-        edges: c.edges,
-        qp: QpSettings { max_iter: c.max_iter, method: c.solver, formulation: c.formulation, ..Default::default() },
-        representative: c.representative,
-    };
+    let settings = c.settings.settings()?;
     Ok(SmoothArgs {
         input: c.input.first().cloned(),
-        kind: c.grid.domain,
-        csv: c.csv.options(),
-        grid: c.grid.options()?,
+        read: c.grid.options(&c.csv)?,
         complex: c.complex,
         isolines: c.isolines,
         view: parse_view(c.view.as_deref())?,
@@ -550,15 +436,13 @@ fn smooth_command(c: SmoothCli) -> Result<String> {
 
 fn run(cli: Cli) -> Result<String> {
     match cli.command {
-        Command::Extrema { input, csv, grid, json, plot, diagram, persistence } => commands::extrema(&ExtremaArgs {
+        Command::Extrema { input, csv, grid, json, plot, diagram, selection } => commands::extrema(&ExtremaArgs {
             input,
-            kind: grid.domain,
-            csv: csv.options(),
-            grid: grid.options()?,
+            read: grid.options(&csv)?,
             json,
             plot,
             diagram,
-            selection: commands::parse_persistence(&persistence)?,
+            selection: selection.selection()?,
         }),
         Command::Smooth(c) => smooth_command(*c),
         Command::Geodesic { input, source, output, report } => commands::geodesic(&commands::GeodesicArgs {
@@ -612,7 +496,7 @@ fn run(cli: Cli) -> Result<String> {
             commands::mesh_outline(&commands::MeshOutlineArgs { input, output, max_area, min_angle, plot })
         }
         Command::Verify { file, input, csv, grid } => {
-            commands::verify(&VerifyArgs { file, input, csv: csv.options(), grid: grid.options()? })
+            commands::verify(&VerifyArgs { file, input, read: grid.options(&csv)? })
         }
         Command::Bench { weights, weight_orders, .. } if !weights.is_empty() => {
             commands::bench_weights(&weights, &weight_orders, 4)
@@ -642,12 +526,14 @@ fn run(cli: Cli) -> Result<String> {
 /// exit status (SPEC.md), after printing the result or the error.
 pub fn main(args: impl IntoIterator<Item = std::ffi::OsString>) -> i32 {
     commands::install_panic_hook();
-    commands::install_interrupt_handler();
+    let interrupted = commands::install_interrupt_handler();
     let cli = Cli::parse_from(args);
     // a benchmark's table is its progress
     let quiet = cli.quiet || matches!(cli.command, Command::Bench { .. });
     let mode = commands::progress::ProgressMode::detect(quiet);
-    commands::finish(commands::progress::with_progress(mode, || commands::catch_panics(|| run(cli))))
+    commands::finish(commands::progress::with_progress(mode, || {
+        crate::progress::cancellable(interrupted, || commands::catch_panics(|| run(cli)))
+    }))
 }
 
 /// Runs one command in this process without progress, signal handlers or a panic hook (for
@@ -660,5 +546,152 @@ pub fn main(args: impl IntoIterator<Item = std::ffi::OsString>) -> i32 {
 pub fn run_args(args: &[String]) -> Result<String> {
     let argv = std::iter::once("toposmooth".to_string()).chain(args.iter().cloned());
     let cli = Cli::try_parse_from(argv).map_err(|e| Error::Usage(e.render().to_string().trim_end().to_string()))?;
-    run(cli)
+    // a command that fails, panics or is cancelled before writing leaves no reserved temporary
+    struct Discard;
+    impl Drop for Discard {
+        fn drop(&mut self) {
+            crate::io::staging::discard_reserved();
+        }
+    }
+    let _discard = Discard;
+    crate::progress::settle(run(cli))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::pipeline::schema::{Kind, SETTINGS};
+    use crate::pipeline::SmoothSettings;
+    use clap::CommandFactory;
+
+    /// The flags of `smooth` that are neither settings of the run nor input options: what to
+    /// write and how to draw it.
+    const OUTPUTS: &[&str] = &[
+        "quiet",
+        "help",
+        "version",
+        "input",
+        "output",
+        "out-dir",
+        "out-format",
+        "output-array",
+        "diagram",
+        "complex",
+        "view",
+        "isolines",
+        "plot",
+        "report",
+    ];
+
+    fn input_flags() -> Vec<String> {
+        crate::io::import::INPUT_OPTIONS.iter().map(|o| o.flag()).collect()
+    }
+
+    fn subcommand(name: &str) -> clap::Command {
+        Cli::command().find_subcommand(name).expect("the subcommand").clone()
+    }
+
+    #[test]
+    fn smooth_has_exactly_the_schema_s_settings_as_flags() {
+        let smooth = subcommand("smooth");
+        let mut seen = Vec::new();
+        for arg in smooth.get_arguments() {
+            let id = arg.get_id().as_str();
+            let flag = arg.get_long().unwrap_or(id).to_string();
+            match SETTINGS.iter().find(|s| s.flag() == flag) {
+                None => assert!(
+                    OUTPUTS.contains(&flag.as_str()) || input_flags().contains(&flag),
+                    "`smooth --{flag}` is neither a setting of pipeline::schema, an input option of \
+                     io::import::INPUT_OPTIONS nor an output: add it to the schema (the flag is made from it)"
+                ),
+                Some(s) => {
+                    seen.push(s.name);
+                    assert_eq!(id, s.name, "--{flag}");
+                    assert!(arg.get_default_values().is_empty(), "--{flag}: the default is the schema's");
+                    let help = arg.get_help().map(|h| h.to_string()).unwrap_or_default();
+                    assert!(help.starts_with(s.help), "--{flag}: the help is the schema's");
+                    if let (Some(d), false) = (s.default, s.kind == Kind::Switch) {
+                        assert!(help.ends_with(&format!("[default: {d}]")), "--{flag}: {help}");
+                    }
+                    let choices: Vec<String> =
+                        arg.get_possible_values().iter().map(|v| v.get_name().to_string()).collect();
+                    match s.kind {
+                        Kind::Choice(names) => assert_eq!(choices, names, "--{flag}"),
+                        _ => assert!(choices.is_empty(), "--{flag}"),
+                    }
+                }
+            }
+        }
+        let names: Vec<&str> = SETTINGS.iter().map(|s| s.name).collect();
+        assert_eq!(seen, names, "every setting of the schema is a flag of smooth, in the schema's order");
+        let extrema = subcommand("extrema");
+        let selection: Vec<&str> = extrema
+            .get_arguments()
+            .filter_map(|a| SETTINGS.iter().find(|s| a.get_long() == Some(&s.flag())))
+            .map(|s| s.name)
+            .collect();
+        assert_eq!(selection, crate::topology::selection::SELECTION_SETTINGS);
+    }
+
+    #[test]
+    fn the_commands_that_read_a_field_take_every_input_option_of_the_library() {
+        let mut options = input_flags();
+        options.sort();
+        for name in ["smooth", "extrema", "verify"] {
+            let mut flags: Vec<String> = subcommand(name)
+                .get_arguments()
+                .filter_map(|a| a.get_long())
+                .map(String::from)
+                .filter(|f| options.contains(f))
+                .collect();
+            flags.sort();
+            assert_eq!(flags, options, "{name}");
+        }
+    }
+
+    /// clap's names of the library's enums are their own (`named_enum!`): one spelling.
+    #[test]
+    fn every_enum_the_command_line_takes_is_spelt_as_the_library_spells_it() {
+        fn names<T: clap::ValueEnum>() -> Vec<String> {
+            T::value_variants().iter().filter_map(|v| v.to_possible_value()).map(|p| p.get_name().to_string()).collect()
+        }
+        use crate::apps::{skinning::Skinning, weights::WeightMethod};
+        assert_eq!(names::<EdgeSet>(), EdgeSet::NAMES);
+        assert_eq!(names::<Method>(), Method::NAMES);
+        assert_eq!(names::<crate::solve::Formulation>(), crate::solve::Formulation::NAMES);
+        assert_eq!(names::<RepresentativeChoice>(), RepresentativeChoice::NAMES);
+        assert_eq!(names::<DomainKind>(), DomainKind::NAMES);
+        assert_eq!(names::<Derive>(), Derive::NAMES);
+        assert_eq!(names::<WeightMethod>(), WeightMethod::NAMES);
+        assert_eq!(names::<Skinning>(), Skinning::NAMES);
+        for name in Derive::NAMES {
+            assert_eq!(name.parse::<Derive>().unwrap().to_string(), *name);
+        }
+    }
+
+    fn settings_of(args: &[&str]) -> Result<SmoothSettings> {
+        let argv = ["toposmooth", "smooth", "in.csv", "-o", "out.csv"].iter().chain(args).copied();
+        let cli = Cli::try_parse_from(argv).map_err(|e| Error::Usage(e.to_string()))?;
+        match cli.command {
+            Command::Smooth(c) => smooth_args(*c).map(|a| a.settings),
+            _ => unreachable!(),
+        }
+    }
+
+    #[test]
+    fn flags_give_the_settings_the_library_reads_from_their_text() {
+        assert_eq!(settings_of(&[]).unwrap(), SmoothSettings::default());
+        let s =
+            settings_of(&["--minima", "9", "--maxima", "4", "--order", "3", "--data-weight", "0.5", "--threads", "1"])
+                .unwrap();
+        let texts = [("minima", "9"), ("maxima", "4"), ("order", "3"), ("data_weight", "0.5"), ("threads", "1")];
+        assert_eq!(s, SmoothSettings::from_texts(texts).unwrap());
+        assert!(settings_of(&["--keep-all-maxima"]).unwrap().selection == crate::topology::Selection::AllMaxima);
+        // clap refuses two rules and half a pair; the library a value out of range, with its flag
+        for bad in [&["--persistence", "5%", "--pairs", "2"][..], &["--minima", "2"], &["--edges", "some"]] {
+            assert_eq!(settings_of(bad).unwrap_err().kind(), crate::ErrorKind::Usage, "{bad:?}");
+        }
+        let e = settings_of(&["--data-weight", "-1"]).unwrap_err();
+        assert_eq!(commands::cli_message(&e), "usage: --data-weight: must be finite and ≥ 0, got -1");
+    }
 }

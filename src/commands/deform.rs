@@ -1,11 +1,11 @@
 //! `toposmooth deform MESH --weights weights.vtu --transforms pose.json -o posed.obj`: linear
 //! blend or dual-quaternion skinning with the weights `weights` wrote.
 
-use super::input::read_trimesh;
 use super::sig6;
 use crate::apps::skinning::{check_transforms, parse_pose, skin_named, Skinning, Transform};
 use crate::domain::TriMesh;
 use crate::error::{Error, Result};
+use crate::io::import::read_trimesh;
 use crate::io::Staged;
 use crate::plot::{plot_mesh_fields, GridPanel, MeshView};
 use std::path::PathBuf;

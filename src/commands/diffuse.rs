@@ -1,7 +1,6 @@
 //! `toposmooth diffuse IMAGE_OR_MESH --colors colors.json -o out.png`: colour diffusion from
 //! coloured points with monotone weights (a convex blend: no pixel leaves the colours' box).
 
-use super::input::read_trimesh;
 use super::sig6;
 use super::weights::stage_weights;
 use crate::apps::diffuse::{
@@ -11,6 +10,7 @@ use crate::apps::handles::{resolve, Handle, HandleShape};
 use crate::apps::weights::{weights, WeightMethod, WeightSettings};
 use crate::domain::{Domain, TriMesh};
 use crate::error::{Error, Result};
+use crate::io::import::read_trimesh;
 use crate::io::{stage_with, Staged};
 use crate::plot::{plot_mesh_colours, MeshView};
 use std::path::{Path, PathBuf};

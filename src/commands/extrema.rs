@@ -1,10 +1,10 @@
 //! `toposmooth extrema`: list the extrema with persistence and strictness; draw the diagram.
 
-use super::input::{read_field, DomainKind, Field, GridOptions};
 use super::{check_distinct, check_png_name, sig6, stage_plot};
 use crate::domain::{AnyDomain, Domain};
 use crate::error::{Error, Result};
-use crate::io::series_csv::{SeriesCsvOptions, XSource};
+use crate::io::import::{read_field, Field, ReadOptions};
+use crate::io::series_csv::XSource;
 use crate::plot::{plot_persistence_diagram, DiagramPoint};
 use crate::topology::{extrema_table, select, ExtremumKind, KeptSet, Role, Selection};
 use std::path::{Path, PathBuf};
@@ -14,12 +14,8 @@ use std::path::{Path, PathBuf};
 pub struct ExtremaArgs {
     /// Input file (none when a grid comes from `--u`/`--v`).
     pub input: Option<PathBuf>,
-    /// Series or grid.
-    pub kind: DomainKind,
-    /// Column choice (series).
-    pub csv: SeriesCsvOptions,
-    /// Grid options.
-    pub grid: GridOptions,
+    /// How to read it.
+    pub read: ReadOptions,
     /// Print JSON instead of a table.
     pub json: bool,
     /// Persistence diagram PNG.
@@ -102,7 +98,7 @@ pub fn extrema(args: &ExtremaArgs) -> Result<String> {
         crate::io::ttk::check_diagram_output(d)?;
     }
     let path = args.input.clone().unwrap_or_default();
-    let field = read_field(args.input.as_deref(), args.kind, &args.csv, &args.grid)?.into_field(&path)?;
+    let field = read_field(args.input.as_deref(), &args.read)?.into_field(&path)?;
     let text = crate::with_domain!(&field.domain, d => list(args, &field, d)?);
     if args.json {
         return Ok(text);

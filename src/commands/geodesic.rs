@@ -1,11 +1,11 @@
 //! `toposmooth geodesic`: geodesic distance from source vertices by the heat method.
 
 use super::check_distinct;
-use super::input::read_trimesh;
 use crate::apps::geodesic::{heat_geodesic, GeodesicSeconds};
 use crate::domain::Domain;
 use crate::error::{Error, Result};
 use crate::io::export::stage_mesh;
+use crate::io::import::read_trimesh;
 use std::path::PathBuf;
 use std::time::Instant;
 

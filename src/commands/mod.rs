@@ -7,9 +7,9 @@ mod deform;
 mod diffuse;
 mod extrema;
 mod geodesic;
-pub mod input;
 mod mesh_outline;
 pub mod progress;
+pub mod settings_args;
 mod smooth;
 mod smooth_args;
 mod smooth_many;
@@ -35,18 +35,11 @@ use crate::topology::Selection;
 use std::path::Path;
 
 /// Parses `--persistence`: `5%` (relative to the value range) or `0.3` (absolute).
+///
+/// # Errors
+/// As [`crate::topology::selection::parse_threshold`].
 pub fn parse_persistence(s: &str) -> Result<Selection> {
-    let t = s.trim();
-    let (num, relative) = match t.strip_suffix('%') {
-        Some(p) => (p.trim(), true),
-        None => (t, false),
-    };
-    let v: f64 =
-        num.parse().map_err(|_| Error::Usage(format!("--persistence `{s}` is not a number or a percentage")))?;
-    if !(v.is_finite() && v > 0.0) {
-        return Err(Error::Usage(format!("--persistence must be > 0, got `{s}`")));
-    }
-    Ok(if relative { Selection::Relative(v / 100.0) } else { Selection::Absolute(v) })
+    crate::topology::selection::parse_threshold(s)
 }
 
 /// The marker of the message the tool prints when it panics outside a reader (a bug: exit 1).
@@ -64,23 +57,43 @@ pub fn install_panic_hook() {
     }));
 }
 
-/// On SIGINT, SIGTERM or SIGHUP the tool removes its temporaries (waiting for outputs being
-/// renamed into place, so a command's outputs are never left half old, half new) and ends as
-/// the signal would have ended it.
-pub fn install_interrupt_handler() {
+/// How long the run has after SIGINT to stop at its next check before it is ended as SIGTERM
+/// ends it (a factorisation in progress is not interrupted).
+pub const INTERRUPT_GRACE: std::time::Duration = std::time::Duration::from_secs(5);
+
+/// The first SIGINT cancels the run (the returned token, which the command runs under): it
+/// stops at its next check, removes its temporaries and exits with 130 ([`Error::Cancelled`]).
+/// A second SIGINT, [`INTERRUPT_GRACE`] without the run stopping, SIGTERM or SIGHUP remove the
+/// temporaries at once (waiting for outputs being renamed into place, so a command's outputs
+/// are never left half old, half new) and end the tool as the signal would have ended it.
+pub fn install_interrupt_handler() -> crate::progress::CancelToken {
+    let token = crate::progress::CancelToken::new();
     #[cfg(unix)]
     {
         use signal_hook::consts::{SIGHUP, SIGINT, SIGTERM};
+        let end = |signal: i32| -> ! {
+            crate::io::staging::remove_temporaries();
+            let _ = signal_hook::low_level::emulate_default_handler(signal);
+            std::process::exit(128 + signal);
+        };
         if let Ok(mut signals) = signal_hook::iterator::Signals::new([SIGINT, SIGTERM, SIGHUP]) {
+            let token = token.clone();
             std::thread::spawn(move || {
-                if let Some(signal) = signals.forever().next() {
-                    crate::io::staging::remove_temporaries();
-                    let _ = signal_hook::low_level::emulate_default_handler(signal);
-                    std::process::exit(128 + signal);
+                for signal in signals.forever() {
+                    if signal == SIGINT && !token.is_cancelled() {
+                        token.cancel();
+                        std::thread::spawn(move || {
+                            std::thread::sleep(INTERRUPT_GRACE);
+                            end(SIGINT)
+                        });
+                        continue;
+                    }
+                    end(signal)
                 }
             });
         }
     }
+    token
 }
 
 /// The exit status of a process ended by SIGPIPE, which the tool returns when its standard
@@ -143,6 +156,7 @@ pub fn catch_panics(run: impl FnOnce() -> Result<String>) -> Result<String> {
 pub fn cli_message(e: &Error) -> String {
     match e {
         Error::Setting { setting, message } => format!("usage: {}: {message}", flag(setting)),
+        Error::Cancelled => "cancelled (interrupted); no partial output or temporary file is left".into(),
         e => e.to_string(),
     }
 }

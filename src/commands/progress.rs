@@ -1,13 +1,26 @@
 //! The tool's progress on standard error: on a terminal, a spinner for the stage in progress
-//! (what it does now: the round, the iteration and its gap) above which each finished stage
-//! stays as one line; elsewhere (a log, a pipe) one line per finished stage. `--quiet`
-//! silences both.
+//! (how far it is, where known, and what it does now: the round, the iteration and its gap)
+//! above which each finished stage stays as one line; elsewhere (a log, a pipe) one line per
+//! finished stage and, once a stage has run for [`LINES_AFTER`], a line each time it passes a
+//! further tenth of its work. `--quiet` silences both.
 
 use crate::progress::Observer;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use std::collections::HashMap;
 use std::io::{IsTerminal, Write};
 use std::sync::{Arc, Mutex, OnceLock};
-use std::time::Duration;
+use std::time::{Duration, Instant};
+
+/// How long a stage runs before a log gets lines of its progress.
+pub const LINES_AFTER: Duration = Duration::from_secs(1);
+
+/// A stage in progress as the log lines follow it: when it began, what it last said, the
+/// tenth of its work last printed.
+struct Running {
+    since: Instant,
+    message: String,
+    tenth: i64,
+}
 
 /// How progress is shown.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -38,12 +51,14 @@ pub struct Stderr {
     mode: ProgressMode,
     /// The spinner and the stages open (nested: the complex inside the representative).
     state: Mutex<(Option<ProgressBar>, Vec<String>)>,
+    /// The stages open, for the log's lines and the spinner's percentage.
+    running: Mutex<HashMap<String, Running>>,
 }
 
 impl Stderr {
     /// An observer showing progress in `mode`.
     pub fn new(mode: ProgressMode) -> Arc<Self> {
-        Arc::new(Stderr { mode, state: Mutex::new((None, Vec::new())) })
+        Arc::new(Stderr { mode, state: Mutex::new((None, Vec::new())), running: Mutex::new(HashMap::new()) })
     }
 
     /// Prints `text` as a line of its own (the input's summary), above the spinner if any.
@@ -72,6 +87,10 @@ impl Stderr {
 
 impl Observer for Stderr {
     fn begin(&self, stage: &str) {
+        if self.mode != ProgressMode::Quiet {
+            let mut running = self.running.lock().unwrap_or_else(|e| e.into_inner());
+            running.insert(stage.to_string(), Running { since: Instant::now(), message: String::new(), tenth: -1 });
+        }
         if self.mode != ProgressMode::Bar {
             return;
         }
@@ -91,9 +110,23 @@ impl Observer for Stderr {
     }
 
     fn update(&self, stage: &str, message: &str) {
+        if self.mode == ProgressMode::Quiet {
+            return;
+        }
+        let tenth = {
+            let mut running = self.running.lock().unwrap_or_else(|e| e.into_inner());
+            running.get_mut(stage).map(|r| {
+                r.message = message.to_string();
+                r.tenth
+            })
+        };
         if self.mode != ProgressMode::Bar {
             return;
         }
+        let message = match tenth {
+            Some(t) if t >= 0 => format!("{} % · {message}", (t * 10).min(100)),
+            _ => message.to_string(),
+        };
         let state = self.state.lock().unwrap_or_else(|e| e.into_inner());
         if let Some(bar) = &state.0 {
             bar.set_prefix(stage.to_string());
@@ -101,7 +134,33 @@ impl Observer for Stderr {
         }
     }
 
+    fn fraction(&self, stage: &str, done: f64) {
+        if self.mode == ProgressMode::Quiet {
+            return;
+        }
+        let tenth = (done.clamp(0.0, 1.0) * 10.0).floor() as i64;
+        let line = {
+            let mut running = self.running.lock().unwrap_or_else(|e| e.into_inner());
+            let Some(r) = running.get_mut(stage) else { return };
+            // the log prints each tenth once, the furthest reached; the spinner shows the fraction
+            // now (it may go back: a solver handing over to another)
+            let passed = tenth > r.tenth;
+            r.tenth = if passed || self.mode == ProgressMode::Bar { tenth } else { r.tenth };
+            (self.mode == ProgressMode::Lines && passed && r.since.elapsed() >= LINES_AFTER).then(|| {
+                let elapsed = seconds_text(r.since.elapsed().as_secs_f64());
+                match r.message.is_empty() {
+                    true => format!("{stage}: {} % after {elapsed}", tenth * 10),
+                    false => format!("{stage}: {} % after {elapsed} ({})", tenth * 10, r.message),
+                }
+            })
+        };
+        if let Some(line) = line {
+            let _ = writeln!(std::io::stderr(), "{line}");
+        }
+    }
+
     fn end(&self, stage: &str, seconds: f64, summary: &str) {
+        self.running.lock().unwrap_or_else(|e| e.into_inner()).remove(stage);
         let text = if summary.is_empty() {
             format!("{stage}: {}", seconds_text(seconds))
         } else {
@@ -136,6 +195,7 @@ impl Observer for Stderr {
     }
 
     fn abandon(&self, stage: &str) {
+        self.running.lock().unwrap_or_else(|e| e.into_inner()).remove(stage);
         let mut state = self.state.lock().unwrap_or_else(|e| e.into_inner());
         if let Some(i) = state.1.iter().rposition(|s| s == stage) {
             state.1.remove(i);

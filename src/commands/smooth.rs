@@ -1,12 +1,12 @@
 //! `toposmooth smooth`: the whole pipeline on a file of any domain, with the output, the
 //! complex, the figure and the report.
 
-use super::input::{read_field, Field};
 use super::smooth_args::{fit_and_solver_lines, seconds_line, SmoothArgs};
 use super::{check_distinct, check_png_name, sig6, stage_plot, x_axis};
 use crate::domain::{AnyDomain, Domain};
 use crate::error::{Error, Result};
 use crate::io::export::{check_complex_output, check_output, check_written, stage_complex, stage_results, Results};
+use crate::io::import::{read_field, Field};
 use crate::io::Staged;
 use crate::pipeline::{smooth_any, Report, Smoothed};
 use crate::plot::{plot_grid_fields, plot_mesh_fields, plot_series, GridMarker, GridPanel, GridPlotOptions, Marker};
@@ -103,12 +103,12 @@ fn same_domain(a: &AnyDomain, b: &AnyDomain) -> bool {
 /// [`smooth`], reusing `shared`'s smoother when given (inputs of `smooth_many`).
 pub(super) fn smooth_shared(args: &SmoothArgs, shared: Option<&mut Option<Shared>>) -> Result<String> {
     check_png_name(args.plot.as_deref())?;
-    let input_path = args.input.clone().or_else(|| args.grid.uv.as_ref().map(|(u, _)| u.clone())).unwrap_or_default();
+    let input_path = args.input.clone().or_else(|| args.read.uv.as_ref().map(|(u, _)| u.clone())).unwrap_or_default();
     let mut inputs: Vec<&Path> = args.input.iter().map(PathBuf::as_path).collect();
-    if let Some((u, v)) = &args.grid.uv {
+    if let Some((u, v)) = &args.read.uv {
         inputs.extend([u.as_path(), v.as_path()]);
     }
-    if let Some(values) = &args.grid.values {
+    if let Some(values) = &args.read.values {
         inputs.push(values.as_path());
     }
     check_distinct(
@@ -125,7 +125,7 @@ pub(super) fn smooth_shared(args: &SmoothArgs, shared: Option<&mut Option<Shared
         crate::io::ttk::check_diagram_output(d)?;
     }
     // the pairs and critical points would be the whole grid's, background included
-    if args.grid.mask.is_some() {
+    if args.read.mask.is_some() {
         if let Some(flag) = [("--complex", args.complex.is_some()), ("--diagram", args.diagram.is_some())]
             .into_iter()
             .find_map(|(flag, given)| given.then_some(flag))
@@ -136,7 +136,7 @@ pub(super) fn smooth_shared(args: &SmoothArgs, shared: Option<&mut Option<Shared
         }
     }
     let start = Instant::now();
-    let mut field = read_field(args.input.as_deref(), args.kind, &args.csv, &args.grid)?.into_field(&input_path)?;
+    let mut field = read_field(args.input.as_deref(), &args.read)?.into_field(&input_path)?;
     if let Some(c) = &args.complex {
         check_complex_output(c, &field.domain)?;
     }
@@ -151,7 +151,7 @@ pub(super) fn smooth_shared(args: &SmoothArgs, shared: Option<&mut Option<Shared
             field.path.display()
         )));
     }
-    if args.grid.mask.is_some() && !matches!(field.domain, AnyDomain::Grid(_) | AnyDomain::Volume(_)) {
+    if args.read.mask.is_some() && !matches!(field.domain, AnyDomain::Grid(_) | AnyDomain::Volume(_)) {
         return Err(Error::Usage(format!(
             "{}: --mask and --mask-below restrict grids and volumes; this input is {}",
             field.path.display(),

@@ -1,9 +1,8 @@
 //! The options of `smooth` and the shared lines of its summary.
 
-use super::input::{DomainKind, GridOptions};
 use super::sig6;
 use crate::domain::AnyDomain;
-use crate::io::series_csv::SeriesCsvOptions;
+use crate::io::import::ReadOptions;
 use crate::pipeline::{Report, SmoothSettings, StageSeconds};
 use std::path::PathBuf;
 
@@ -12,12 +11,8 @@ use std::path::PathBuf;
 pub struct SmoothArgs {
     /// Input file (none when a grid comes from `--u`/`--v`).
     pub input: Option<PathBuf>,
-    /// Series or grid.
-    pub kind: DomainKind,
-    /// Column choice (series).
-    pub csv: SeriesCsvOptions,
-    /// Array, spacing, derivation and NaN policy (grids).
-    pub grid: GridOptions,
+    /// How to read it: the domain, the column or array, spacing, derivation, mask, NaN policy.
+    pub read: ReadOptions,
     /// Critical points (and separatrices on surfaces) as VTK PolyData.
     pub complex: Option<PathBuf>,
     /// Isolines in the grid plot.

@@ -57,8 +57,8 @@ pub fn smooth_many(args: &SmoothArgs, inputs: &[PathBuf], dir: &Path, format: Op
         ("--complex", args.complex.is_some()),
         ("--diagram", args.diagram.is_some()),
         ("--report", args.report.is_some()),
-        ("--u/--v", args.grid.uv.is_some()),
-        ("--values", args.grid.values.is_some()),
+        ("--u/--v", args.read.uv.is_some()),
+        ("--values", args.read.values.is_some()),
     ];
     if let Some((flag, _)) = single.iter().find(|(_, given)| *given) {
         return Err(Error::Usage(format!(

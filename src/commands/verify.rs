@@ -1,10 +1,9 @@
 //! `toposmooth verify`: re-check an output file from what it carries, independently of `smooth`.
 
-use super::input::{read_field, DomainKind, GridOptions};
 use crate::domain::{AnyDomain, Domain};
 use crate::error::{Error, Result};
 use crate::io::export::{read_results, results_on_mesh, Stored, MESH_OUTPUTS};
-use crate::io::series_csv::SeriesCsvOptions;
+use crate::io::import::{read_field, DomainKind, ReadOptions};
 use crate::topology::Role;
 use crate::verify::certify_any;
 use std::path::{Path, PathBuf};
@@ -16,10 +15,8 @@ pub struct VerifyArgs {
     pub file: PathBuf,
     /// The original input, to compare with the file's input column.
     pub input: Option<PathBuf>,
-    /// Column choice for the original input.
-    pub csv: SeriesCsvOptions,
-    /// How to read the original input when it is a grid.
-    pub grid: GridOptions,
+    /// How to read the original input (its domain is the file's).
+    pub read: ReadOptions,
 }
 
 /// Runs `verify`: `Ok(text)` when the file is certified, [`Error::Uncertified`] (exit 1) when not.
@@ -179,7 +176,7 @@ fn certify_masked<D: crate::domain::Domain>(
 /// carries the spacing the input was read with (the harmonic fill and derived quantities
 /// depend on it), so a grid original is read with it unless `--spacing` says otherwise.
 fn compare_input(args: &VerifyArgs, orig: &Path, out: &Stored) -> Result<Option<String>> {
-    let mut opts = args.grid.clone();
+    let mut opts = args.read.clone();
     let kind = match &out.domain {
         AnyDomain::Series(_) => {
             // the file says which samples were filled: the original is read with them filled
@@ -202,7 +199,8 @@ fn compare_input(args: &VerifyArgs, orig: &Path, out: &Stored) -> Result<Option<
         }
         AnyDomain::Mesh(_) | AnyDomain::Tets(_) => DomainKind::Mesh,
     };
-    let original = read_field(Some(orig), kind, &args.csv, &opts)?.into_field(orig)?;
+    opts.domain = kind;
+    let original = read_field(Some(orig), &opts)?.into_field(orig)?;
     let (file, o) = (args.file.display(), orig.display());
     let same = match (&original.domain, &out.domain) {
         (AnyDomain::Series(a), AnyDomain::Series(b)) => a.n_vertices() == b.n_vertices(),

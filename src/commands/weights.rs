@@ -2,12 +2,12 @@
 //! handle, certified (monotone), normalised, written with u and roles; `--compare` adds the
 //! spurious-extremum counts of the other three methods.
 
-use super::input::read_trimesh;
 use super::sig6;
 use crate::apps::handles::{parse_handles, resolve, HandleFile};
 use crate::apps::weights::{weights as compute, WeightMethod, WeightSettings, Weights};
 use crate::domain::{Domain, TriMesh};
 use crate::error::{Error, Result};
+use crate::io::import::read_trimesh;
 use crate::io::Staged;
 use crate::plot::{plot_mesh_fields, GridMarker, GridPanel, MeshView};
 use std::path::{Path, PathBuf};

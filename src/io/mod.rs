@@ -1,11 +1,15 @@
-//! Reading and writing files. Every output is written to a locked temporary file and put in
-//! place only when complete ([`staging`]), so a failed run never leaves a half-written file.
+//! Reading and writing files: [`import`] reads any supported file into a domain and a field,
+//! [`export`] writes any domain's results. Every output is written to a locked temporary file
+//! and put in place only when complete ([`staging`]), so a failed run never leaves a
+//! half-written file.
 
 pub mod content;
 pub mod csv_dialect;
 #[cfg(all(feature = "io-vtk", feature = "io-npz"))]
 pub mod export;
 pub mod grid;
+#[cfg(all(feature = "io-vtk", feature = "io-npz", feature = "image"))]
+pub mod import;
 #[cfg(feature = "io-vtk")]
 pub mod mesh;
 #[cfg(feature = "io-nifti")]

@@ -415,6 +415,17 @@ pub fn remove_temporaries() {
     std::mem::forget(live);
 }
 
+/// Removes the temporaries of outputs reserved and not staged (a command that failed or was
+/// cancelled before writing them): for a process that goes on after a command, as the Python
+/// package's in-process commands do ([`remove_temporaries`] is for a process about to end).
+pub fn discard_reserved() {
+    let reserved: Vec<Reservation> = lock(&RESERVED).drain(..).collect();
+    for r in reserved {
+        let _ = std::fs::remove_file(&r.temp.path);
+        unregister(&r.temp.path);
+    }
+}
+
 /// Stages `path`: `fill` writes the complete content into its temporary (reserved by
 /// [`reserve`], or created now), which is then flushed and synced. A replaced regular file's
 /// permissions are kept.

@@ -7,7 +7,7 @@ use faer::sparse::Triplet;
 /// A smoothness energy: a weighted sum of polyharmonic orders (Botsch & Kobbelt 2004) and
 /// the vertices where orders ≥ 2 are not penalised.
 #[derive(Clone, Debug, PartialEq)]
-#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Energy {
     /// `(order k, weight)` pairs, k in 1..=4, weight ≥ 0.
     pub terms: Vec<(u8, f64)>,
@@ -59,9 +59,27 @@ impl Energy {
         Ok(())
     }
 
+    /// The orders as [`Energy::parse`] reads them: `2`, or `1:0.2,2:1` (sharp vertices are a
+    /// setting of their own).
+    pub fn orders_text(&self) -> String {
+        match self.terms.as_slice() {
+            [(k, w)] if *w == 1.0 => k.to_string(),
+            terms => terms.iter().map(|(k, w)| format!("{k}:{w}")).collect::<Vec<_>>().join(","),
+        }
+    }
+
     /// Highest order with a positive weight.
     pub fn max_order(&self) -> u8 {
         self.terms.iter().filter(|t| t.1 > 0.0).map(|t| t.0).max().unwrap_or(1)
+    }
+}
+
+impl std::str::FromStr for Energy {
+    type Err = Error;
+
+    /// [`Energy::parse`].
+    fn from_str(spec: &str) -> Result<Self> {
+        Energy::parse(spec)
     }
 }
 

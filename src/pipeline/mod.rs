@@ -12,6 +12,7 @@
 //! ```
 
 mod report;
+pub mod schema;
 mod settings;
 mod smoothable;
 mod stages;
@@ -213,8 +214,30 @@ fn structured_again<D: Smoothable + Sync>(
 }
 
 /// The pipeline on a domain whose operators are built; `keep_analyses`: the fills' analysis
-/// stays in `analyses` through the solve (else it is dropped first, for memory).
+/// stays in `analyses` through the solve (else it is dropped first, for memory). Runs under
+/// the settings' thread cap; a run cancelled ([`crate::progress::cancelled`]) ends with
+/// [`Error::Cancelled`] whatever stage noticed it.
 pub(crate) fn smooth_on<D: Smoothable + Sync>(
+    domain: &D,
+    ops: &mut DomainOperators,
+    h: &[f64],
+    settings: &SmoothSettings,
+    analyses: &mut Analyses,
+    keep_analyses: bool,
+) -> Result<Smoothed> {
+    let mut run = || {
+        crate::progress::checkpoint()?;
+        smooth_stages(domain, ops, h, settings, analyses, keep_analyses)
+    };
+    let out = match settings.threads {
+        Some(n) => crate::parallel::with_threads(n, run),
+        None => run(),
+    };
+    crate::progress::settle(out)
+}
+
+/// The stages of [`smooth_on`].
+fn smooth_stages<D: Smoothable + Sync>(
     domain: &D,
     ops: &mut DomainOperators,
     h: &[f64],
@@ -244,6 +267,7 @@ pub(crate) fn smooth_on<D: Smoothable + Sync>(
 
     let stage = Stage::begin("selection");
     let kept = select(domain, h, &settings.selection)?;
+    crate::progress::checkpoint()?;
     let extrema = count_sos_extrema(domain, h);
     seconds.persistence = stage.end(|| {
         format!(
@@ -286,6 +310,7 @@ pub(crate) fn smooth_on<D: Smoothable + Sync>(
     );
     let ordered = ordered?;
     let operators = operators?;
+    crate::progress::checkpoint()?;
     seconds.operators = operators_seconds;
     // the fills' Laplacian analysis is not needed again: free it before the solver runs, whose
     // factor storage was made beside the representative (the two together set the peak)
@@ -303,6 +328,7 @@ pub(crate) fn smooth_on<D: Smoothable + Sync>(
     let (f, margin_repair, strictness_repair) = output_of(&sol.x, &problem, &ordered);
     seconds.repair = t.elapsed().as_secs_f64();
 
+    crate::progress::checkpoint()?;
     let stage = Stage::begin("certificate");
     let certificate = certify(domain, &f, &kept.roles, Some(h));
     seconds.verify = stage.end(|| if certificate.passed { "passed".into() } else { "FAILED".into() });

@@ -9,8 +9,11 @@ use crate::topology::{KeptSet, Selection};
 
 use super::smoothable::RepresentativeChoice;
 
-/// Settings of a smoothing run. Defaults follow SPEC.md.
+/// Settings of a smoothing run. Defaults follow SPEC.md; every field is a setting of
+/// [`super::schema::SETTINGS`], which the front ends are made from (the selection is several).
 #[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(default))]
 pub struct SmoothSettings {
     /// Which extrema survive. {persistence ≥ 5 % of the range}
     pub selection: Selection,
@@ -30,6 +33,9 @@ pub struct SmoothSettings {
     /// Representative function on surfaces; `None` chooses automatically (separatrix, then
     /// harmonic, then flooded, each fallback reported). {None}
     pub representative: Option<RepresentativeChoice>,
+    /// At most this many threads for the run; `None` keeps the caller's cap
+    /// ([`crate::parallel::with_threads`], 2 by default). Results do not depend on it. {None}
+    pub threads: Option<usize>,
 }
 
 impl Default for SmoothSettings {
@@ -43,6 +49,7 @@ impl Default for SmoothSettings {
             edges: EdgeSet::Minimal,
             qp: QpSettings::default(),
             representative: None,
+            threads: None,
         }
     }
 }
@@ -58,6 +65,9 @@ impl SmoothSettings {
             if !(w.is_finite() && w > 0.0) {
                 return Err(Error::setting("smooth_weight", format!("must be finite and > 0, got {w}")));
             }
+        }
+        if self.threads == Some(0) {
+            return Err(Error::setting("threads", "must be at least 1, got 0"));
         }
         if let Some(l) = self.smooth_length {
             if !(l.is_finite() && l > 0.0) {

@@ -16,7 +16,7 @@ use crate::verify::certify;
 
 /// Which representative function to build on surfaces (series always use the linear one).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[cfg_attr(feature = "serde", serde(rename_all = "lowercase"))]
 #[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 pub enum RepresentativeChoice {
@@ -29,6 +29,16 @@ pub enum RepresentativeChoice {
     /// Pascucci 2012; NOTES.md 9), plateaus made strict in flood order.
     Flooded,
 }
+
+named_enum!(
+    RepresentativeChoice,
+    "representative",
+    [
+        (RepresentativeChoice::Separatrix, "separatrix"),
+        (RepresentativeChoice::Harmonic, "harmonic"),
+        (RepresentativeChoice::Flooded, "flooded"),
+    ]
+);
 
 /// The construction a representative function came from.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -285,6 +295,9 @@ fn surface_representative<D: Domain>(
         // the failure of the last attempt (the most mended one) is the one reported
         let mut last_failure = None;
         for (ms, move_kept) in attempts {
+            if crate::progress::cancelled() {
+                return None;
+            }
             match separatrix_representative(domain, &untied, kept, ms, k, move_kept, &mut analyses.borrow_mut()) {
                 Ok((u, r)) => {
                     let c = certify(domain, &u, &kept.roles, None);
@@ -350,6 +363,7 @@ fn surface_representative<D: Domain>(
         _ => kind.name().to_string(),
     };
     for kind in order {
+        crate::progress::checkpoint()?;
         if skip(kind) {
             continue;
         }

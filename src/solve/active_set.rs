@@ -379,6 +379,9 @@ fn solve_clustered(obj: &Objective<'_>, cl: &Clusters, x: &mut [f64], tolerance:
     let mut hd = vec![0.0; nu];
     let mut it = 0;
     while it < MAX_CG && measure(&r) > tolerance {
+        if it % 32 == 31 && crate::progress::cancelled() {
+            break;
+        }
         cl.expand_unknowns(&dir, &mut xs);
         obj.p.apply(&xs, &mut px);
         cl.gather(&px, &mut hd);
@@ -748,7 +751,11 @@ pub(super) fn solve(
     // how often a row joined two anchored clusters (an anchor left for it): twice at most,
     // once per anchor, as the next cut tends to undo it
     let mut tabu = vec![0u8; rows.len()];
+    let mut first_gap = None;
     while outer < MAX_OUTER {
+        if crate::progress::cancelled() {
+            return Err("cancelled".into());
+        }
         outer += 1;
         let t0 = std::time::Instant::now();
         let cl = Clusters::new(n, &rows, &in_set);
@@ -906,6 +913,17 @@ pub(super) fn solve(
         }
         let gap = gap_bound(&rows, &x, &z, &g, &r.d);
         let t5 = std::time::Instant::now();
+        crate::progress::update("solve", || {
+            format!(
+                "active set {outer}: {} rows in, {} violated (worst {worst:.1e}), gap {:.1e} of the data (target {:.0e})",
+                in_set.iter().filter(|&&s| s).count(),
+                violated.len(),
+                gap / data,
+                settings.gap_tolerance
+            )
+        });
+        let first = *first_gap.get_or_insert(gap / data);
+        crate::progress::fraction("solve", crate::progress::log_fraction(first, gap / data, settings.gap_tolerance));
         if std::env::var_os("TOPOSMOOTH_TRACE_ACTIVE").is_some() {
             eprintln!(
                 "active set {outer}: {} rows in, {changed} changed ({swaps} swaps, {drops} cut), {} violated (worst {worst:.1e}, stuck {stuck:?} above {stuck_above:.1e}), gap/data {:.1e}, cg {cg_iterations}; ms clusters {} cg {} multipliers {} flow {} join {}",

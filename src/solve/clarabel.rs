@@ -114,19 +114,24 @@ pub(super) fn run(
         .map_err(|e| Error::NoSolution { path: None, status: format!("bad solver settings: {e:?}") })?;
     let mut solver = DefaultSolver::new(p, q, a, b, cones, solver_settings)
         .map_err(|e| Error::NoSolution { path: None, status: format!("solver setup failed: {e}") })?;
-    if let Some(observer) = crate::progress::current() {
+    let observer = crate::progress::current();
+    if observer.is_some() || crate::progress::token().is_some() {
+        // called on this thread between iterations: true stops the solver (cancelled)
         solver.set_termination_callback(move |info: &clarabel::solver::DefaultInfo<f64>| {
-            observer.update(
-                "solve",
-                &format!(
-                    "Clarabel iteration {}: relative gap {:.1e}, primal residual {:.1e}",
-                    info.iterations, info.gap_rel, info.res_primal
-                ),
-            );
-            false
+            if let Some(observer) = &observer {
+                observer.update(
+                    "solve",
+                    &format!(
+                        "Clarabel iteration {}: relative gap {:.1e}, primal residual {:.1e}",
+                        info.iterations, info.gap_rel, info.res_primal
+                    ),
+                );
+            }
+            crate::progress::cancelled()
         });
     }
     solver.solve();
+    crate::progress::checkpoint()?;
     let sol = &solver.solution;
     let status = match sol.status {
         SolverStatus::Solved => SolveStatus::Solved,

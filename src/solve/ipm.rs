@@ -238,6 +238,18 @@ impl<T> Copy for At<'_, T> {}
 struct Progress {
     best_gap: f64,
     best_at: u32,
+    /// The first gap (relative to its target's base): where the reported fraction starts.
+    first: Option<f64>,
+}
+
+impl Progress {
+    /// Tells the observer how far the relative gap `gap` is from the first towards `target`.
+    fn tell(&mut self, gap: f64, target: f64) {
+        if gap.is_finite() {
+            let first = *self.first.get_or_insert(gap);
+            crate::progress::fraction("solve", crate::progress::log_fraction(first, gap, target));
+        }
+    }
 }
 
 /// The constants of the stopping tests.
@@ -315,8 +327,11 @@ fn run<T: Real, O: Objective<T>>(
     let mut newton = Newton::new(n, m);
     let mut last = (f64::INFINITY, f64::INFINITY, f64::INFINITY);
     let mut last_step = f64::INFINITY;
-    let mut progress = Progress { best_gap: f64::INFINITY, best_at: 0 };
+    let mut progress = Progress { best_gap: f64::INFINITY, best_at: 0, first: None };
     for it in 0..settings.max_iter {
+        if crate::progress::cancelled() {
+            return Err(crate::error::NumericalError(format!("cancelled at iteration {it}")));
+        }
         residuals(r, rows, objective, &point, &b, (bnorm, qnorm), &mut res, &mut tmp_n);
         last = (res.pres, res.dres, res.mu);
         if !(res.pres.is_finite() && res.dres.is_finite() && res.mu.is_finite()) {
@@ -429,6 +444,7 @@ fn verdict_with_data<T: Real>(
         gap
     };
     let target = t.gap_tolerance * data;
+    progress.tell(gap / data, t.gap_tolerance);
     crate::progress::update("solve", || {
         format!(
             "iteration {iteration}: gap {:.1e} of the data (target {:.0e}), primal residual {pres:.1e}",
@@ -476,6 +492,9 @@ fn verdict_without_data<T: Real, O: Objective<T>>(
         .flatten()
         .map(|dual| res.slack.iter().zip(&it.z).map(|(s, z)| (max(*s, zero) * *z).to_f64()).sum::<f64>() + dual);
     let target = t.gap_tolerance * energy.abs().max(1e-300);
+    if let Some(gap) = gap {
+        progress.tell(gap / energy.abs().max(1e-300), t.gap_tolerance);
+    }
     crate::progress::update("solve", || match gap {
         Some(gap) => format!(
             "iteration {iteration}: gap {:.1e} of the energy (target {:.0e}), primal residual {pres:.1e}",

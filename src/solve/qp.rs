@@ -94,6 +94,7 @@ pub fn solve_monotone_qp_with(
                     Some(a.outcome)
                 }
                 Ok(a) => {
+                    crate::progress::checkpoint()?;
                     fallback = Some(format!(
                         "the active-set iteration ended {:?} after {} outer and {} conjugate-gradient iterations",
                         a.outcome.status, a.outcome.iterations, a.cg_iterations
@@ -101,6 +102,7 @@ pub fn solve_monotone_qp_with(
                     None
                 }
                 Err(why) => {
+                    crate::progress::checkpoint()?;
                     fallback = Some(why.to_string());
                     None
                 }
@@ -119,6 +121,7 @@ pub fn solve_monotone_qp_with(
                 Ok(out) => (out, Method::Structured),
                 // the assembled normal matrix lost its definiteness (an energy without a data
                 // term, ill-conditioned on its own): the factored form in double-double next
+                Err(_) if crate::progress::cancelled() => return Err(crate::Error::Cancelled),
                 Err(_)
                     if formulation == Formulation::Assembled
                         && settings.formulation == Formulation::Auto
@@ -129,12 +132,14 @@ pub fn solve_monotone_qp_with(
                     match super::ipm::solve(&reduced, hint.as_deref(), settings, analyses, None) {
                         Ok(out) => (out, Method::Structured),
                         Err(why) => {
+                            crate::progress::checkpoint()?;
                             fallback = Some(why.to_string());
                             (clarabel(&reduced)?, Method::Clarabel)
                         }
                     }
                 }
                 Err(why) => {
+                    crate::progress::checkpoint()?;
                     fallback = Some(why.to_string());
                     (clarabel(&reduced)?, Method::Clarabel)
                 }

@@ -2,7 +2,7 @@
 
 /// Which interior-point solver runs.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[cfg_attr(feature = "serde", serde(rename_all = "lowercase"))]
 #[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 pub enum Method {
@@ -26,9 +26,21 @@ pub enum Method {
     ActiveSet,
 }
 
+named_enum!(
+    Method,
+    "solver",
+    [
+        (Method::Auto, "auto"),
+        (Method::Structured, "structured"),
+        (Method::Clarabel, "clarabel"),
+        (Method::ClarabelAuxiliary, "clarabel-auxiliary"),
+        (Method::ActiveSet, "active-set"),
+    ]
+);
+
 /// How the objective enters the solver.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[cfg_attr(feature = "serde", serde(rename_all = "lowercase"))]
 #[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 pub enum Formulation {
@@ -44,6 +56,12 @@ pub enum Formulation {
     Factored,
 }
 
+named_enum!(
+    Formulation,
+    "formulation",
+    [(Formulation::Auto, "auto"), (Formulation::Assembled, "assembled"), (Formulation::Factored, "factored")]
+);
+
 /// Condition estimate of `diag(d)^{-½} P diag(d)^{-½}` above which [`Formulation::Auto`]
 /// chooses the factored form. An assembled P carries rounding errors of about `10⁻¹⁶ κ`
 /// relative to its smallest eigenvalues, and the gap bound squares the gradient's: at κ = 10⁹
@@ -58,7 +76,8 @@ pub const ACTIVE_SET_FROM: usize = 1_000;
 
 /// Solver settings.
 #[derive(Clone, Debug, PartialEq)]
-#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(default))]
 pub struct QpSettings {
     /// Largest number of interior-point iterations. {200}
     pub max_iter: u32,

@@ -47,12 +47,19 @@ impl MorseSmale {
         let mut down = DiscreteGradient::on(complex.clone(), values, Direction::Descending);
         let mut up = DiscreteGradient::on(complex, values, Direction::Ascending);
         let built = t.elapsed().as_secs_f64();
+        let stop = || crate::error::ConstructionError::Unfit("cancelled".into());
+        if crate::progress::cancelled() {
+            return Err(stop());
+        }
         let t = std::time::Instant::now();
         let keep_min: Vec<bool> = kept.roles.iter().map(|&r| r == Role::Min).collect();
         let (low_pairs, high_pairs) = (sublevel_pairs(domain, values), superlevel_pairs(domain, values));
         down.simplify(&low_pairs, &keep_min)?;
         let keep_max: Vec<bool> = kept.roles.iter().map(|&r| r == Role::Max).collect();
         up.simplify(&high_pairs, &keep_max)?;
+        if crate::progress::cancelled() {
+            return Err(stop());
+        }
         let (ds, us) = (down.saddles(), up.saddles());
         let in_down: std::collections::HashSet<usize> = ds.iter().map(|s| s.vertex).collect();
         let in_up: std::collections::HashSet<usize> = us.iter().map(|s| s.vertex).collect();

@@ -1,6 +1,10 @@
 //! Which extrema survive: selection by persistence threshold, by count, or by explicit list,
 //! and the role of every vertex in the output (SPEC.md, "Persistence" and "Formats").
 
+mod rules;
+
+pub use rules::{parse_indices, parse_threshold, DEFAULT_SELECTION, SELECTION_SETTINGS};
+
 use super::persistence::{sublevel_pairs, superlevel_pairs, Pair};
 use crate::domain::{sos_greater, sos_less, Domain, PairingRule};
 use crate::error::{Error, Result};
@@ -63,6 +67,33 @@ impl serde::Serialize for Selection {
             Selection::Explicit { minima, maxima } => Record::Explicit { minima, maxima },
         };
         record.serialize(serializer)
+    }
+}
+
+/// Reads what [`Selection`]'s `Serialize` writes.
+#[cfg(feature = "serde")]
+impl<'de> serde::Deserialize<'de> for Selection {
+    fn deserialize<D: serde::Deserializer<'de>>(deserializer: D) -> std::result::Result<Self, D::Error> {
+        #[derive(serde::Deserialize)]
+        #[serde(tag = "rule", rename_all = "snake_case", deny_unknown_fields)]
+        enum Record {
+            Absolute { persistence: f64 },
+            Relative { fraction_of_range: f64 },
+            Count { minima: usize, maxima: usize },
+            Pairs { pairs: usize },
+            AllMaxima,
+            AllMinima,
+            Explicit { minima: Vec<usize>, maxima: Vec<usize> },
+        }
+        Ok(match Record::deserialize(deserializer)? {
+            Record::Absolute { persistence } => Selection::Absolute(persistence),
+            Record::Relative { fraction_of_range } => Selection::Relative(fraction_of_range),
+            Record::Count { minima, maxima } => Selection::Count { minima, maxima },
+            Record::Pairs { pairs } => Selection::Pairs(pairs),
+            Record::AllMaxima => Selection::AllMaxima,
+            Record::AllMinima => Selection::AllMinima,
+            Record::Explicit { minima, maxima } => Selection::Explicit { minima, maxima },
+        })
     }
 }
 

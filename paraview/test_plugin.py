@@ -73,16 +73,16 @@ for proxy, algorithm in ((TopologyControlledSmoothing(Input=speed), "smoothing")
     fresh = type(proxy.GetClientSideObject())().settings()
     assert defaults == fresh, (algorithm, "the properties' defaults are the algorithm's", defaults, fresh)
     for name in proxy.ListProperties():
-        if name in ("Input", "Scalars"):
+        if name in ("Input", "Scalars", "ReloadPythonModule"):  # the last: ParaView's own button
             continue
         before = proxy.GetClientSideObject().settings()
-        value = getattr(proxy, name)
-        if isinstance(value, str):
-            other = [v for v in proxy.GetProperty(name).Available if v != value][0]
-        elif isinstance(value, int):
-            other = value + 1
+        prop = proxy.GetProperty(name)
+        if hasattr(prop, "Available"):  # an enumeration: its entries' texts
+            value = prop.GetData()
+            other = [v for v in prop.Available if v != value][0]
         else:
-            other = value / 2 + 0.01
+            value = prop.GetData()
+            other = value + 1 if isinstance(value, int) else value / 2 + 0.01
         setattr(proxy, name, other)
         proxy.UpdateVTKObjects()
         after = proxy.GetClientSideObject().settings()
@@ -90,4 +90,4 @@ for proxy, algorithm in ((TopologyControlledSmoothing(Input=speed), "smoothing")
         assert changed and changed <= set(schema), (algorithm, name, "changes no setting of the schema", changed)
         setattr(proxy, name, value)
         proxy.UpdateVTKObjects()
-    print(f"ok {algorithm}: {len(proxy.ListProperties()) - 2} properties, each a setting of toposmooth.SETTINGS")
+    print(f"ok {algorithm}: {len(proxy.ListProperties()) - 3} properties, each a setting of toposmooth.SETTINGS")

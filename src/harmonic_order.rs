@@ -122,6 +122,9 @@ pub fn ordered_harmonic<D: Domain>(
     let mut scale = vec![spread; n];
     let mut levels = 0;
     loop {
+        if crate::progress::cancelled() {
+            return Err(ConstructionError::Unfit("cancelled".into()));
+        }
         let bad = irregular(domain, &phi, fixed);
         if bad.is_empty() {
             break;

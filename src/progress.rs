@@ -274,4 +274,26 @@ mod tests {
             ]
         );
     }
+
+    #[test]
+    fn a_token_is_seen_on_its_thread_and_the_threads_a_run_splits_into_and_restored_after() {
+        let token = CancelToken::new();
+        assert!(checkpoint().is_ok(), "no token: never cancelled");
+        let seen = cancellable(token.clone(), || {
+            assert!(checkpoint().is_ok());
+            token.cancel();
+            let (here, there) = crate::parallel::with_threads(2, || crate::parallel::join(cancelled, cancelled));
+            let elsewhere = std::thread::spawn(cancelled).join().unwrap();
+            (here, there, elsewhere, checkpoint())
+        });
+        assert_eq!((seen.0, seen.1, seen.2), (true, true, false), "join's threads see it, a bare thread does not");
+        assert!(matches!(seen.3, Err(Error::Cancelled)));
+        assert!(!cancelled() && checkpoint().is_ok(), "restored after the run");
+        assert!(matches!(settle::<()>(Err(Error::internal("x"))), Err(Error::Internal { .. })), "not cancelled");
+        let r = cancellable(token, || settle::<()>(Err(Error::internal("stopped"))));
+        assert!(matches!(r, Err(Error::Cancelled)), "a cancelled run's own error is Cancelled");
+        assert_eq!(log_fraction(1e4, 1e4, 1e-6), 0.0);
+        assert!((log_fraction(1e4, 1e-1, 1e-6) - 0.5).abs() < 1e-12);
+        assert_eq!(log_fraction(1e4, 1e-9, 1e-6), 1.0);
+    }
 }

@@ -496,4 +496,25 @@ mod tests {
             assert_eq!(name.parse::<Method>().unwrap().name(), *name);
         }
     }
+
+    #[cfg(feature = "serde")]
+    #[test]
+    fn settings_go_through_json_and_back() {
+        let s = SmoothSettings::from_texts([
+            ("keep_min", "3,1"),
+            ("keep_max", "7"),
+            ("order", "1:0.5,3:2"),
+            ("solver", "clarabel-auxiliary"),
+            ("representative", "harmonic"),
+            ("threads", "4"),
+        ])
+        .unwrap();
+        let json = serde_json::to_string(&s).unwrap();
+        assert!(json.contains(r#""rule":"explicit""#) && json.contains(r#""method":"clarabel-auxiliary""#), "{json}");
+        assert_eq!(serde_json::from_str::<SmoothSettings>(&json).unwrap(), s);
+        // what is not given keeps its default
+        let partial: SmoothSettings = serde_json::from_str(r#"{"data_weight": 0.5, "edges": "all"}"#).unwrap();
+        assert_eq!(partial, SmoothSettings::from_texts([("data_weight", "0.5"), ("edges", "all")]).unwrap());
+        assert!(serde_json::from_str::<SmoothSettings>(r#"{"selection": {"rule": "loudest"}}"#).is_err());
+    }
 }

@@ -518,3 +518,22 @@ fn a_long_solve_prints_its_fraction_in_a_log() {
     assert!(percents.windows(2).all(|w| w[0] < w[1]), "each line a further tenth: {percents:?}");
     assert!(stderr.lines().any(|l| l.starts_with("solve: ") && l.contains(" s (")), "the stage's own line: {stderr}");
 }
+
+/// Off a terminal a running stage is never silent for long: a line at least every 10 s
+/// (`TOPOSMOOTH_LOG_EVERY` shortens it here) with how long it has run and what it last said.
+#[test]
+fn a_log_gets_a_line_from_a_running_stage_at_least_every_period() {
+    let dir = scratch("heartbeat");
+    let input = long_grid(&dir);
+    let out = dir.join("smoothed.npz");
+    let o = Command::new(bin())
+        .env("TOPOSMOOTH_LOG_EVERY", "0.3")
+        .args(["smooth", input.to_str().unwrap(), "-o", out.to_str().unwrap(), "--persistence", "1%"])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", text(&o));
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    let beats: Vec<&str> = stderr.lines().filter(|l| l.starts_with("solve: running for ")).collect();
+    assert!(beats.len() >= 2, "{stderr}");
+    assert!(beats.iter().any(|l| l.contains("iteration")), "what the solver last said: {beats:?}");
+}

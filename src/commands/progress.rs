@@ -2,7 +2,8 @@
 //! (how far it is, where known, and what it does now: the round, the iteration and its gap)
 //! above which each finished stage stays as one line; elsewhere (a log, a pipe) one line per
 //! finished stage and, once a stage has run for [`LINES_AFTER`], a line each time it passes a
-//! further tenth of its work. `--quiet` silences both.
+//! further tenth of its work, and a line at least every [`LINES_EVERY`] while it runs (what it
+//! last said, how far it is: a log of a long run is never silent). `--quiet` silences both.
 
 use crate::progress::Observer;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
@@ -14,12 +15,26 @@ use std::time::{Duration, Instant};
 /// How long a stage runs before a log gets lines of its progress.
 pub const LINES_AFTER: Duration = Duration::from_secs(1);
 
+/// The longest a log goes without a line while a stage runs (`TOPOSMOOTH_LOG_EVERY` seconds
+/// overrides it, for tests).
+pub const LINES_EVERY: Duration = Duration::from_secs(10);
+
+fn lines_every() -> Duration {
+    std::env::var("TOPOSMOOTH_LOG_EVERY")
+        .ok()
+        .and_then(|s| s.parse::<f64>().ok())
+        .filter(|s| s.is_finite() && *s > 0.0)
+        .map_or(LINES_EVERY, Duration::from_secs_f64)
+}
+
 /// A stage in progress as the log lines follow it: when it began, what it last said, the
-/// tenth of its work last printed.
+/// tenth of its work last printed (and the fraction itself), when its last line was printed.
 struct Running {
     since: Instant,
     message: String,
     tenth: i64,
+    fraction: Option<f64>,
+    last_line: Instant,
 }
 
 /// How progress is shown.
@@ -75,6 +90,29 @@ impl Stderr {
         }
     }
 
+    /// The lines of the stages that have printed nothing for `every` (a log's heartbeat): the
+    /// stage, how long it has run, how far it is and what it last said.
+    fn stale(&self, every: Duration) -> Vec<String> {
+        let mut running = self.running.lock().unwrap_or_else(|e| e.into_inner());
+        let mut lines: Vec<(Instant, String)> = running
+            .iter_mut()
+            .filter(|(_, r)| r.last_line.elapsed() >= every)
+            .map(|(stage, r)| {
+                r.last_line = Instant::now();
+                let mut line = format!("{stage}: running for {}", seconds_text(r.since.elapsed().as_secs_f64()));
+                if let Some(f) = r.fraction {
+                    line.push_str(&format!(", {:.0} %", 100.0 * f));
+                }
+                if !r.message.is_empty() {
+                    line.push_str(&format!(" ({})", r.message));
+                }
+                (r.since, line)
+            })
+            .collect();
+        lines.sort();
+        lines.into_iter().map(|(_, l)| l).collect()
+    }
+
     /// Removes the spinner (before an error or the summary is printed).
     pub fn clear(&self) {
         let mut state = self.state.lock().unwrap_or_else(|e| e.into_inner());
@@ -89,7 +127,9 @@ impl Observer for Stderr {
     fn begin(&self, stage: &str) {
         if self.mode != ProgressMode::Quiet {
             let mut running = self.running.lock().unwrap_or_else(|e| e.into_inner());
-            running.insert(stage.to_string(), Running { since: Instant::now(), message: String::new(), tenth: -1 });
+            let now = Instant::now();
+            let r = Running { since: now, message: String::new(), tenth: -1, fraction: None, last_line: now };
+            running.insert(stage.to_string(), r);
         }
         if self.mode != ProgressMode::Bar {
             return;
@@ -142,11 +182,13 @@ impl Observer for Stderr {
         let line = {
             let mut running = self.running.lock().unwrap_or_else(|e| e.into_inner());
             let Some(r) = running.get_mut(stage) else { return };
+            r.fraction = Some(done);
             // the log prints each tenth once, the furthest reached; the spinner shows the fraction
             // now (it may go back: a solver handing over to another)
             let passed = tenth > r.tenth;
             r.tenth = if passed || self.mode == ProgressMode::Bar { tenth } else { r.tenth };
             (self.mode == ProgressMode::Lines && passed && r.since.elapsed() >= LINES_AFTER).then(|| {
+                r.last_line = Instant::now();
                 let elapsed = seconds_text(r.since.elapsed().as_secs_f64());
                 match r.message.is_empty() {
                     true => format!("{stage}: {} % after {elapsed}", tenth * 10),
@@ -213,7 +255,29 @@ static INSTALLED: OnceLock<Arc<Stderr>> = OnceLock::new();
 /// Runs `work` with progress shown in `mode` (the tool's commands: once per process).
 pub fn with_progress<R>(mode: ProgressMode, work: impl FnOnce() -> R) -> R {
     let observer = INSTALLED.get_or_init(|| Stderr::new(mode)).clone();
+    // a log's heartbeat: a thread that prints the stages silent for `lines_every`
+    let done = Arc::new((Mutex::new(false), std::sync::Condvar::new()));
+    let heartbeat = (mode == ProgressMode::Lines).then(|| {
+        let (observer, done, every) = (observer.clone(), done.clone(), lines_every());
+        let tick = (every / 4).clamp(Duration::from_millis(20), Duration::from_secs(1));
+        std::thread::spawn(move || loop {
+            let stop = done.0.lock().unwrap_or_else(|e| e.into_inner());
+            let (stop, _) = done.1.wait_timeout_while(stop, tick, |d| !*d).unwrap_or_else(|e| e.into_inner());
+            if *stop {
+                break;
+            }
+            drop(stop);
+            for line in observer.stale(every) {
+                let _ = writeln!(std::io::stderr(), "{line}");
+            }
+        })
+    });
     let out = crate::progress::observe(observer.clone(), work);
+    *done.0.lock().unwrap_or_else(|e| e.into_inner()) = true;
+    done.1.notify_all();
+    if let Some(h) = heartbeat {
+        let _ = h.join();
+    }
     observer.clear();
     out
 }

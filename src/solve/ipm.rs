@@ -444,7 +444,6 @@ fn verdict_with_data<T: Real>(
         gap
     };
     let target = t.gap_tolerance * data;
-    progress.tell(gap / data, t.gap_tolerance);
     crate::progress::update("solve", || {
         format!(
             "iteration {iteration}: gap {:.1e} of the data (target {:.0e}), primal residual {pres:.1e}",
@@ -452,6 +451,7 @@ fn verdict_with_data<T: Real>(
             t.gap_tolerance
         )
     });
+    progress.tell(gap / data, t.gap_tolerance);
     if pres <= t.tol && small_step && gap <= target {
         return (Verdict::Stop(SolveStatus::Solved), Some(polished));
     }
@@ -492,9 +492,6 @@ fn verdict_without_data<T: Real, O: Objective<T>>(
         .flatten()
         .map(|dual| res.slack.iter().zip(&it.z).map(|(s, z)| (max(*s, zero) * *z).to_f64()).sum::<f64>() + dual);
     let target = t.gap_tolerance * energy.abs().max(1e-300);
-    if let Some(gap) = gap {
-        progress.tell(gap / energy.abs().max(1e-300), t.gap_tolerance);
-    }
     crate::progress::update("solve", || match gap {
         Some(gap) => format!(
             "iteration {iteration}: gap {:.1e} of the energy (target {:.0e}), primal residual {pres:.1e}",
@@ -503,6 +500,9 @@ fn verdict_without_data<T: Real, O: Objective<T>>(
         ),
         None => format!("iteration {iteration}: primal residual {pres:.1e}, complementarity {mu:.1e}"),
     });
+    if let Some(gap) = gap {
+        progress.tell(gap / energy.abs().max(1e-300), t.gap_tolerance);
+    }
     let converged = match gap {
         Some(gap) => pres <= t.tol && small_step && gap <= target,
         None => pres <= t.tol && dres <= t.tol && mu <= t.tol_mu,

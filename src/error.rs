@@ -80,6 +80,18 @@ pub enum Error {
         /// Solver status as text.
         status: String,
     },
+    /// A route whose predicted peak passes the memory budget, refused before its work (exit 3).
+    #[error("{}not enough memory: {message}", prefix(path))]
+    Memory {
+        /// File the input came from, if any.
+        path: Option<PathBuf>,
+        /// What would need how much, and the budget.
+        message: String,
+        /// The predicted peak, bytes.
+        predicted: u64,
+        /// The budget, bytes.
+        budget: u64,
+    },
     /// The run was cancelled: the caller's [`crate::progress::CancelToken`], or SIGINT in the
     /// command-line tool (exit 130). Nothing is left behind.
     #[error("cancelled")]
@@ -171,6 +183,8 @@ pub enum ErrorKind {
     NoSolution,
     /// The run was cancelled (exit 130, as a shell reports SIGINT).
     Cancelled,
+    /// A run predicted past the memory budget, refused before the work (exit 3).
+    Memory,
 }
 
 impl ErrorKind {
@@ -179,7 +193,7 @@ impl ErrorKind {
         match self {
             ErrorKind::Uncertified | ErrorKind::Internal => 1,
             ErrorKind::Usage => 2,
-            ErrorKind::Input | ErrorKind::Infeasible | ErrorKind::Io => 3,
+            ErrorKind::Input | ErrorKind::Infeasible | ErrorKind::Io | ErrorKind::Memory => 3,
             ErrorKind::NoSolution => 4,
             ErrorKind::Cancelled => 130,
         }
@@ -251,6 +265,9 @@ impl Error {
             Error::Usage(m) => Error::Usage(text(m)),
             Error::Setting { setting, message } => Error::Setting { setting, message: text(message) },
             Error::Cancelled => Error::Cancelled,
+            Error::Memory { path, message, predicted, budget } => {
+                Error::Memory { path: file(path), message: text(message), predicted, budget }
+            }
             Error::Io { path, source } => {
                 Error::Io { path: if path == from { to.to_path_buf() } else { path }, source }
             }
@@ -265,6 +282,7 @@ impl Error {
             | Error::Representative { path, .. }
             | Error::Internal { path, .. }
             | Error::Uncertified { path, .. }
+            | Error::Memory { path, .. }
             | Error::NoSolution { path, .. } => {
                 if path.is_none() {
                     *path = Some(file.into());
@@ -286,6 +304,7 @@ impl Error {
             Error::Representative { .. } | Error::Internal { .. } => ErrorKind::Internal,
             Error::NoSolution { .. } => ErrorKind::NoSolution,
             Error::Cancelled => ErrorKind::Cancelled,
+            Error::Memory { .. } => ErrorKind::Memory,
         }
     }
 
@@ -297,6 +316,7 @@ impl Error {
             | Error::Representative { path, .. }
             | Error::Internal { path, .. }
             | Error::Uncertified { path, .. }
+            | Error::Memory { path, .. }
             | Error::NoSolution { path, .. } => path.as_deref(),
             Error::Io { path, .. } => Some(path),
             Error::Usage(_) | Error::Setting { .. } | Error::Cancelled => None,
@@ -337,6 +357,7 @@ mod tests {
             (Error::Representative { path: None, message: "r".into() }, ErrorKind::Internal, 1),
             (Error::NoSolution { path: None, status: "s".into() }, ErrorKind::NoSolution, 4),
             (Error::Cancelled, ErrorKind::Cancelled, 130),
+            (Error::Memory { path: None, message: "m".into(), predicted: 2, budget: 1 }, ErrorKind::Memory, 3),
         ];
         for (e, kind, code) in cases {
             assert_eq!((e.kind(), e.exit_code()), (kind, code), "{e}");

@@ -67,6 +67,7 @@ pub mod derive;
 pub(crate) mod harmonic_order;
 pub mod io;
 pub(crate) mod linalg;
+pub mod memory;
 pub mod parallel;
 pub mod pipeline;
 #[cfg(feature = "plot")]

@@ -509,19 +509,18 @@ fn flood<D: crate::domain::Domain>(domain: &D, g: &mut [f64], kept: &KeptSet, ro
         }
     };
     let n = g.len();
-    let mut seen = vec![false; n];
-    let mut heap = BinaryHeap::new();
+    // a vertex's value changes only when it is popped, so its key is the same whoever pushes
+    // it: each vertex is pushed once (the order is that of pushing it from every neighbour)
+    let mut queued = vec![false; n];
+    let mut heap = BinaryHeap::with_capacity(n);
     for (v, &gv) in g.iter().enumerate() {
         if kept.roles[v] == role {
             heap.push(Reverse((key(gv), 0u8, v)));
+            queued[v] = true;
         }
     }
     let mut last: Option<f64> = None;
     while let Some(Reverse((_, _, v))) = heap.pop() {
-        if seen[v] {
-            continue;
-        }
-        seen[v] = true;
         if kept.roles[v] != role {
             if let Some(l) = last {
                 g[v] = if up { g[v].max(l.next_up()) } else { g[v].min(l.next_down()) };
@@ -529,7 +528,8 @@ fn flood<D: crate::domain::Domain>(domain: &D, g: &mut [f64], kept: &KeptSet, ro
         }
         last = Some(g[v]);
         for w in domain.neighbors(v) {
-            if !seen[w] {
+            if !queued[w] {
+                queued[w] = true;
                 heap.push(Reverse((key(g[w]), 1u8, w)));
             }
         }

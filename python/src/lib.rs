@@ -31,6 +31,7 @@ fn to_py(py: Python<'_>, e: Error) -> PyErr {
         ErrorKind::Internal => "InternalError",
         ErrorKind::NoSolution => "SolverError",
         ErrorKind::Cancelled => "Cancelled",
+        ErrorKind::Memory => "MemoryLimitError",
     };
     let raised = (|| -> PyResult<PyErr> {
         let ty = py.import("toposmooth.errors")?.getattr(class)?.cast_into::<PyType>()?;
@@ -410,6 +411,8 @@ fn setting_text(py: Python<'_>, spec: &Setting, v: &Bound<'_, PyAny>) -> PyResul
         Kind::Threshold if is_text => text("a number or a percentage")?,
         Kind::Threshold => number().map_err(|_| wrong("a number or a percentage such as \"5%\""))?,
         Kind::Choice(names) => text(&format!("one of {}", names.join(", ")))?,
+        Kind::Size if is_text => text("a size")?,
+        Kind::Size => whole("a size such as \"6G\" or a number of bytes")?,
         Kind::Orders if is_text => text("an order")?,
         Kind::Orders => whole("an order 1..4 or a blend such as \"1:0.2,2:1\"")?,
         Kind::Indices => {
@@ -492,6 +495,7 @@ fn settings_schema(py: Python<'_>) -> PyResult<Vec<Bound<'_, PyDict>>> {
                     "choice"
                 }
                 Kind::Indices => "indices",
+                Kind::Size => "size",
                 Kind::Orders => {
                     d.set_item("min", 1)?;
                     d.set_item("max", 4)?;

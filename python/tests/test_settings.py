@@ -55,7 +55,7 @@ def test_extrema_takes_the_selection_and_smoother_every_setting():
     for name in SCHEMA:
         # each setting is accepted by the Smoother (the keywords go through **settings)
         value = {"threshold": "5%", "count": 3, "real": 0.5, "switch": True, "indices": [0],
-                 "orders": 2}.get(SCHEMA[name]["kind"], (SCHEMA[name].get("choices") or [None])[0])
+                 "orders": 2, "size": "1G"}.get(SCHEMA[name]["kind"], (SCHEMA[name].get("choices") or [None])[0])
         settings = {name: value}
         if SCHEMA[name]["partner"]:
             settings[SCHEMA[name]["partner"]] = value
@@ -117,3 +117,13 @@ def test_read_takes_exactly_the_input_options_of_the_cli():
         if name != "path":
             switch = next(o["switch"] for o in toposmooth.INPUT_OPTIONS if o["name"] == name)
             assert p.default == (False if switch else None), name
+
+
+def test_a_run_predicted_past_its_memory_limit_raises_memory_limit_error(datasets):
+    h = np.genfromtxt(datasets / "soapfilm_piv_vorticity_63x63.csv", delimiter=",")
+    with pytest.raises(toposmooth.MemoryLimitError) as e:
+        toposmooth.smooth(h, fill_missing=True, memory_limit="4M")
+    assert isinstance(e.value, MemoryError) and e.value.exit_code == 3
+    assert "over the memory budget of 4 MiB" in str(e.value)
+    r = toposmooth.smooth(h, fill_missing=True, memory_limit=2 << 30)
+    assert r.report["memory"]["budget"] == 2 << 30 and r.report["memory"]["predicted_peak"] > 0

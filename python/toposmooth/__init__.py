@@ -52,6 +52,7 @@ from .errors import (
     InputError,
     InternalError,
     IoError,
+    MemoryLimitError,
     SolverError,
     UsageError,
 )
@@ -76,6 +77,7 @@ __all__ = [
     "SolverError",
     "InternalError",
     "Cancelled",
+    "MemoryLimitError",
     "CancelToken",
     "SETTINGS",
     "INPUT_OPTIONS",
@@ -372,6 +374,7 @@ def smooth(
     solver: str = "auto",
     formulation: str = "auto",
     threads: Optional[int] = None,
+    memory_limit: Union[str, int, None] = None,
     sharp: Optional[Sequence[int]] = None,
     progress: Any = None,
     cancel: Any = None,
@@ -438,6 +441,10 @@ def smooth(
     threads : int, optional
         At most this many threads for the call (default 2). Results are bit-identical for
         every thread count; 1 suits one process per core (Dask workers, pvbatch ranks).
+    memory_limit : str or int, optional
+        The memory the run may use: ``"6G"``, ``"512M"`` or bytes (default: the lowest of the
+        cgroup's limit, ``ulimit -v`` and the machine's memory). A solver route predicted past
+        it is refused before its work with :class:`MemoryLimitError` (a ``MemoryError``).
     sharp : sequence of int, optional
         Vertices where orders >= 2 are not penalised (a spike can stay C0).
     progress : callable, optional
@@ -507,6 +514,7 @@ def smooth(
             solver=solver,
             formulation=formulation,
             threads=threads,
+            memory_limit=memory_limit,
             sharp=sharp,
         )
     )

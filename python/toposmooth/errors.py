@@ -25,6 +25,7 @@ __all__ = [
     "SolverError",
     "InternalError",
     "Cancelled",
+    "MemoryLimitError",
 ]
 
 
@@ -82,3 +83,10 @@ class Cancelled(Error):
     """The run was stopped by its ``cancel=`` token (exit 130); nothing was written."""
 
     kind, exit_code = "cancelled", 130
+
+
+class MemoryLimitError(Error, MemoryError):
+    """A run whose predicted peak passes the memory budget (``memory_limit=``, else the
+    machine's), refused before its work (exit 3)."""
+
+    kind, exit_code = "memory", 3

@@ -1,6 +1,7 @@
 //! The command-line tool's commands: reading files, running the pipeline, printing, writing.
 //! `main.rs` only parses arguments into these option structs and maps errors to exit codes.
 
+pub mod alloc;
 mod bench;
 pub mod cli;
 mod deform;

@@ -54,6 +54,10 @@ struct Reservation {
 
 /// The temporaries this process holds (paths), for [`remove_temporaries`].
 static LIVE: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
+/// The same paths as C strings, made when each temporary is, so that they can be removed
+/// where nothing may be allocated ([`remove_temporaries_unallocated`]).
+#[cfg(unix)]
+static LIVE_C: Mutex<Vec<std::ffi::CString>> = Mutex::new(Vec::new());
 /// Outputs reserved by [`reserve`] and not yet staged.
 static RESERVED: Mutex<Vec<Reservation>> = Mutex::new(Vec::new());
 /// Held while a command's outputs are renamed into place, and by [`remove_temporaries`].
@@ -246,6 +250,13 @@ fn new_temp(dir: &Path, target: &Path) -> std::io::Result<Temp> {
         let mut live = lock(&LIVE);
         if let Some(t) = create_locked(dir, &name)? {
             live.push(t.path.clone());
+            #[cfg(unix)]
+            {
+                use std::os::unix::ffi::OsStrExt;
+                if let Ok(c) = std::ffi::CString::new(t.path.as_os_str().as_bytes()) {
+                    lock(&LIVE_C).push(c);
+                }
+            }
             return Ok(t);
         }
     }
@@ -373,6 +384,24 @@ fn copy_into(temp: &Temp, target: &Path) -> std::io::Result<()> {
 
 fn unregister(path: &Path) {
     lock(&LIVE).retain(|p| p != path);
+    #[cfg(unix)]
+    {
+        use std::os::unix::ffi::OsStrExt;
+        lock(&LIVE_C).retain(|c| c.as_bytes() != path.as_os_str().as_bytes());
+    }
+}
+
+/// Removes the temporaries this process holds without allocating (for a failed allocation:
+/// the tool's allocator calls it before it exits); a list locked by the failing thread itself
+/// is left.
+pub fn remove_temporaries_unallocated() {
+    #[cfg(unix)]
+    if let Ok(list) = LIVE_C.try_lock() {
+        for c in list.iter() {
+            // SAFETY: a NUL-terminated path kept alive by the list
+            unsafe { libc::unlink(c.as_ptr()) };
+        }
+    }
 }
 
 impl Drop for Staged {

@@ -129,6 +129,25 @@ pub(crate) enum Analysis {
     TwoWay(Box<two_way::Symbolic>),
 }
 
+impl Analysis {
+    /// The bytes a factorisation of this analysis allocates ([`SpdFactor::new`]): the factor's
+    /// values and faer's scratch (the two-way plan: both halves, their coupling blocks and the
+    /// separator's dense factor), known before any of it is allocated.
+    pub(crate) fn numeric_bytes(&self) -> u64 {
+        let f64s = |n: usize| 8 * n as u64;
+        match self {
+            Analysis::Single { symbolic, par } => {
+                let scratch = StackReq::any_of(&[
+                    symbolic.factorize_numeric_llt_scratch::<f64>(*par, Spec::default()),
+                    symbolic.solve_in_place_scratch::<f64>(1, *par),
+                ]);
+                f64s(symbolic.len_val()) + scratch.size_bytes() as u64
+            }
+            Analysis::TwoWay(s) => s.numeric_bytes(),
+        }
+    }
+}
+
 /// Speed-up of faer's parallel kernels on this machine's two cores, for factors above
 /// [`PARALLEL_MIN_FLOPS`] (measured on the largest bench mesh: docs/performance.md).
 const PARALLEL_SPEEDUP: f64 = 1.33;

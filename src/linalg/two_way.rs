@@ -156,6 +156,35 @@ struct HalfNumeric {
     work: Vec<f64>,
 }
 
+impl Symbolic {
+    /// The bytes [`TwoWay::new`] allocates for this analysis.
+    pub fn numeric_bytes(&self) -> u64 {
+        let ls = self.sep.len();
+        let f64s = |n: usize| 8 * n as u64;
+        let halves: u64 = self
+            .halves
+            .iter()
+            .map(|h| {
+                let req = StackReq::any_of(&[
+                    h.symbolic.factorize_numeric_llt_scratch::<f64>(Par::Seq, Spec::default()),
+                    supernodal(h).solve_in_place_scratch::<f64>(1, Par::Seq),
+                ]);
+                f64s(h.src.len())
+                    + f64s(h.symbolic.len_val())
+                    + req.size_bytes() as u64
+                    + f64s(ls * ls)
+                    + f64s(h.pattern.ncols())
+            })
+            .sum();
+        let sigma = faer::linalg::cholesky::llt::factor::cholesky_in_place_scratch::<f64>(
+            ls,
+            crate::parallel::faer_par(),
+            Spec::default(),
+        );
+        halves + 2 * f64s(ls * ls) + sigma.size_bytes() as u64
+    }
+}
+
 /// A two-way factorisation: numeric values for a [`Symbolic`].
 pub struct TwoWay {
     halves: [HalfNumeric; 2],

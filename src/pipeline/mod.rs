@@ -26,7 +26,7 @@ use crate::solve::{solve_monotone_qp_with, Bound, Method, MonotoneQp, ACTIVE_SET
 use crate::topology::morse_smale::MorseSmale;
 use crate::topology::{count_sos_extrema, select, Role};
 use crate::verify::certify;
-pub use report::{EnergyReport, FitReport, Report, RunSettings, StageSeconds, ACTIVE_WARNING};
+pub use report::{EnergyReport, FitReport, MemoryReport, Report, RunSettings, StageSeconds, ACTIVE_WARNING};
 pub use settings::{
     default_smooth_length, SmoothSettings, SMOOTH_LENGTH_EDGES, SMOOTH_LENGTH_FRACTION, SMOOTH_LENGTH_KEPT_SPACING,
 };
@@ -302,7 +302,9 @@ fn smooth_stages<D: Smoothable + Sync>(
             let seconds = t.elapsed().as_secs_f64();
             let prepared = match (&built, settings.qp.method) {
                 // a failed analysis is redone (and reported) by the solver itself
-                (Ok(o), Method::Structured) if o.factor.is_none() => crate::solve::prepare(&o.p, &problem.fixed).ok(),
+                (Ok(o), Method::Structured) if o.factor.is_none() => {
+                    crate::solve::prepare(&o.p, &problem.fixed, settings.qp.memory_limit).ok()
+                }
                 _ => None,
             };
             (built, seconds, prepared)
@@ -323,6 +325,7 @@ fn smooth_stages<D: Smoothable + Sync>(
     let stage = Stage::begin("solve");
     let sol = solve_qp(&problem, &ordered, &operators, settings, analyses, prepared)?;
     seconds.solve = stage.end(|| format!("{:?} after {} iterations", sol.status, sol.iterations));
+    let peak_after_solve = crate::memory::peak_resident();
 
     let t = Instant::now();
     let (f, margin_repair, strictness_repair) = output_of(&sol.x, &problem, &ordered);
@@ -369,6 +372,8 @@ fn smooth_stages<D: Smoothable + Sync>(
         length,
         repairs: (margin_repair, strictness_repair),
         diameter: domain.diameter(),
+        budget: crate::memory::Budget::of(settings.qp.memory_limit),
+        peak_after_solve,
     };
     let report = run.report(seconds, certificate);
     // the active-set point is checked as written, after the margin repair: one further from

@@ -135,6 +135,23 @@ pub struct Report {
     pub representative_certificate: Certificate,
     /// Certificate of the output (items 1–4).
     pub certificate: Certificate,
+    /// The memory budget and what the run used of it.
+    pub memory: MemoryReport,
+}
+
+/// The memory budget and the process's memory around the solve.
+#[derive(Clone, Debug, Default, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+pub struct MemoryReport {
+    /// The budget, bytes.
+    pub budget: u64,
+    /// Where the budget comes from (the limit given, the cgroup's, ulimit -v, the machine's).
+    pub budget_source: String,
+    /// The interior-point route's predicted peak (resident memory then plus what it
+    /// allocates), bytes, when it ran.
+    pub predicted_peak: Option<u64>,
+    /// The process's peak resident memory when the solve ended, bytes (0 where unknown).
+    pub peak_after_solve: u64,
 }
 
 /// How close the output is to the optimum of the QP it solves (SPEC.md, end of "Exit status"),

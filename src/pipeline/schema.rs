@@ -66,6 +66,8 @@ pub enum Kind {
     Indices,
     /// A polyharmonic order 1..4, or a blend such as `1:0.2,2:1`.
     Orders,
+    /// A size in bytes: `6G`, `512M`, `2.5GiB` (binary units) or a number of bytes.
+    Size,
 }
 
 /// One setting.
@@ -272,6 +274,14 @@ pub const SETTINGS: &[Setting] = &[
         "How the energy enters the solver: assembled (normal equations in double precision), factored (FᵀF, the paper's auxiliary variables: double-double normal equations in the structured solver), or auto (factored when the condition estimate exceeds 1e9).",
     ),
     setting(
+        "memory_limit",
+        "SIZE",
+        Kind::Size,
+        None,
+        Group::Run,
+        "The memory the run may use (6G, 512M): a route predicted past it is refused before its work (exit 3) instead of being killed; by default the lowest of the cgroup's limit, ulimit -v and the machine's memory.",
+    ),
+    setting(
         "threads",
         "N",
         Kind::Count { min: 1, max: 1024 },
@@ -320,6 +330,7 @@ impl Kind {
             },
             Kind::Indices => parse_indices(setting, t).map(drop),
             Kind::Orders => Energy::parse(t).map(drop),
+            Kind::Size => crate::memory::parse_size(t).map(drop),
         }
     }
 }
@@ -377,6 +388,7 @@ impl SmoothSettings {
             "solver" => self.qp.method = text.parse()?,
             "formulation" => self.qp.formulation = text.parse()?,
             "threads" => self.threads = Some(usize::try_from(whole()?).unwrap_or(usize::MAX)),
+            "memory_limit" => self.qp.memory_limit = Some(crate::memory::parse_size(text)?),
             _ => return Err(Error::internal(format!("the setting `{name}` has no field"))),
         }
         Ok(())
@@ -407,6 +419,7 @@ impl SmoothSettings {
             "solver" => self.qp.method.to_string(),
             "formulation" => self.qp.formulation.to_string(),
             "threads" => self.threads?.to_string(),
+            "memory_limit" => self.qp.memory_limit?.to_string(),
             _ => return None,
         })
     }
@@ -432,6 +445,7 @@ mod tests {
             ("solver", "active-set"),
             ("formulation", "factored"),
             ("threads", "3"),
+            ("memory_limit", "1.5G"),
         ];
         let s = SmoothSettings::from_texts(given).unwrap();
         assert_eq!(s.selection, Selection::Explicit { minima: vec![3, 1], maxima: vec![7] });
@@ -439,7 +453,7 @@ mod tests {
         assert_eq!((s.data_weight, s.smooth_weight, s.smooth_length), (0.25, Some(1e-6), Some(0.02)));
         assert_eq!((s.edges, s.representative), (EdgeSet::All, Some(RepresentativeChoice::Flooded)));
         assert_eq!((s.qp.max_iter, s.qp.method, s.qp.formulation), (17, Method::ActiveSet, Formulation::Factored));
-        assert_eq!(s.threads, Some(3));
+        assert_eq!((s.threads, s.qp.memory_limit), (Some(3), Some(3 << 29)));
         // the texts of every setting give the same settings back
         let texts: Vec<(&str, String)> = SETTINGS.iter().filter_map(|d| Some((d.name, s.text(d.name)?))).collect();
         let again = SmoothSettings::from_texts(texts.iter().map(|(n, t)| (*n, t.as_str()))).unwrap();

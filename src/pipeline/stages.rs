@@ -3,7 +3,9 @@
 //! an output, and the report of a certified run. The QP is solved on values scaled to the
 //! input's range ([`Scale`]); everything here maps between the two once.
 
-use super::report::{fit_report, EnergyReport, FitInputs, Report, RunSettings, StageSeconds, ACTIVE_WARNING};
+use super::report::{
+    fit_report, EnergyReport, FitInputs, MemoryReport, Report, RunSettings, StageSeconds, ACTIVE_WARNING,
+};
 use super::settings::SmoothSettings;
 use super::smoothable::{RepresentativeKind, Smoothable};
 use crate::constraints::{activity, choose_margin, constraint_edges, margin_cap, max_margin_or_conflict};
@@ -279,6 +281,10 @@ pub(super) struct Run<'a> {
     pub(super) length: (f64, String),
     pub(super) repairs: (MarginSummary, RepairSummary),
     pub(super) diameter: f64,
+    /// The memory budget of the run.
+    pub(super) budget: crate::memory::Budget,
+    /// The process's peak resident memory when the solve ended.
+    pub(super) peak_after_solve: u64,
 }
 
 impl Run<'_> {
@@ -362,6 +368,12 @@ impl Run<'_> {
             representative_fallbacks: o.fallbacks.clone(),
             representative_certificate: o.certificate.clone(),
             certificate,
+            memory: MemoryReport {
+                budget: self.budget.bytes,
+                budget_source: self.budget.source,
+                predicted_peak: self.sol.predicted_peak,
+                peak_after_solve: self.peak_after_solve,
+            },
         }
     }
 }

@@ -156,6 +156,33 @@ pub(super) fn solve(
     }
 }
 
+/// The bytes the structured solver allocates for `r` (the assembled form) beyond what the
+/// caller holds, known before it allocates them: the normal matrix's factor and faer's
+/// scratch (from its analysis, made here and kept in `analyses`, where [`solve`] takes it),
+/// the normal matrix's values and pattern, the rows, and the iterate's vectors. `None` for
+/// the factored form, whose double-double storage is not predicted yet.
+///
+/// # Errors
+/// A message if the analysis fails.
+pub(super) fn predicted_bytes(
+    r: &ReducedQp,
+    analyses: &mut ordering::Analyses,
+) -> std::result::Result<Option<u64>, crate::error::NumericalError> {
+    if r.factor.is_some() {
+        return Ok(None);
+    }
+    let rows = Rows::new(r)?;
+    let normal = Normal::new(r, &rows.cols, &rows.len);
+    let analysis = analyses.of(normal.symbolic.as_ref())?;
+    let (n, m, nnz) = (r.n as u64, r.m() as u64, normal.symbolic.row_idx().len() as u64);
+    // values and row indices of the normal matrix, its position tables; the rows (two
+    // columns, two values, a length); about 14 vectors of n and 18 of m in the iteration
+    let normal_bytes = 16 * nnz + 8 * (n + 1) + 8 * (r.p.len() as u64 + 4 * m + n);
+    let row_bytes = 33 * m;
+    let vectors = 8 * (14 * n + 18 * m);
+    Ok(Some(analysis.numeric_bytes() + normal_bytes + row_bytes + vectors))
+}
+
 /// The primal–dual iterate: `x`, the slacks `s = b − Ax` and the multipliers `z`.
 struct Iterate<T> {
     x: Vec<T>,

@@ -84,10 +84,12 @@ impl Prepared {
     ///
     /// # Errors
     /// A message if the analysis fails.
+    /// The storage is made only if `fits` its size in bytes.
     pub fn new(
         p: SymbolicSparseColMatRef<'_, usize>,
         slot: &[usize],
         n: usize,
+        fits: impl FnOnce(u64) -> bool,
     ) -> std::result::Result<Prepared, crate::error::NumericalError> {
         let (cp, ri) = (p.col_ptr(), p.row_idx());
         let pairs = (0..p.ncols()).flat_map(|j| {
@@ -99,8 +101,9 @@ impl Prepared {
         let (col_ptr, row_idx) = upper_pattern(n, pairs);
         let pattern = SymbolicSparseColMat::new_checked(n, n, col_ptr, None, row_idx);
         let analysis = ordering::analyse(pattern.as_ref())?;
-        // without it (faer's scratch could not be allocated) the solver makes the storage
-        let workspace = ordering::Workspace::new(&analysis).ok();
+        // without it (faer's scratch could not be allocated, or it would not fit the budget) the
+        // solver makes the storage, or refuses to
+        let workspace = if fits(analysis.numeric_bytes()) { ordering::Workspace::new(&analysis).ok() } else { None };
         Ok(Prepared { pattern, analysis, workspace })
     }
 

@@ -49,6 +49,7 @@ pub fn solve_monotone_qp_with(
             formulation: Formulation::Assembled,
             condition: None,
             fallback: None,
+            predicted_peak: None,
         });
     }
     let mut reduced = reduce(qp, &free);
@@ -114,9 +115,24 @@ pub fn solve_monotone_qp_with(
         }
         _ => None,
     };
+    let mut predicted_peak = None;
     let (out, method) = match (attempt, settings.method) {
         (Some(out), _) => (out, Method::ActiveSet),
         (None, Method::Auto | Method::Structured | Method::ActiveSet) => {
+            // the interior-point route's peak, predicted from its analysis before it allocates
+            // (the analysis is kept for the solve); past the budget it is refused, not started
+            if let Some(extra) = super::ipm::predicted_bytes(&reduced, analyses).ok().flatten() {
+                let budget = crate::memory::Budget::of(settings.memory_limit);
+                let peak = budget.in_use() + extra + budget.kernel_reserve();
+                if peak > budget.bytes {
+                    let what = match &fallback {
+                        Some(why) => format!("{why}; the interior-point route that would take over"),
+                        None => "the interior-point route".into(),
+                    };
+                    return Err(crate::memory::over_budget(&what, peak, &budget));
+                }
+                predicted_peak = Some(peak);
+            }
             match super::ipm::solve(&reduced, hint.as_deref(), settings, analyses, prepared.take()) {
                 Ok(out) => (out, Method::Structured),
                 // the assembled normal matrix lost its definiteness (an energy without a data
@@ -164,6 +180,7 @@ pub fn solve_monotone_qp_with(
         formulation,
         condition,
         fallback,
+        predicted_peak,
     })
 }
 
@@ -173,9 +190,17 @@ pub fn solve_monotone_qp_with(
 /// the normal matrix has this pattern (constrained pairs inside `p`'s pattern, as for every
 /// energy built on the domain's Laplacian).
 ///
+/// The factor's storage is made (and its pages mapped) only where it fits the memory budget
+/// `memory_limit` (`None`: the machine's) beside what the process holds now: past it the
+/// solver's own prediction refuses the route.
+///
 /// # Errors
 /// A message if the analysis fails.
-pub fn prepare(p: &Sparse, fixed: &[Option<f64>]) -> std::result::Result<Prepared, crate::error::NumericalError> {
+pub fn prepare(
+    p: &Sparse,
+    fixed: &[Option<f64>],
+    memory_limit: Option<u64>,
+) -> std::result::Result<Prepared, crate::error::NumericalError> {
     let mut slot = vec![usize::MAX; fixed.len()];
     let mut n = 0;
     for (i, f) in fixed.iter().enumerate() {
@@ -184,7 +209,8 @@ pub fn prepare(p: &Sparse, fixed: &[Option<f64>]) -> std::result::Result<Prepare
             n += 1;
         }
     }
-    Prepared::new(p.symbolic(), &slot, n)
+    let budget = crate::memory::Budget::of(memory_limit);
+    Prepared::new(p.symbolic(), &slot, n, |bytes| budget.in_use().saturating_add(bytes) <= budget.bytes)
 }
 
 #[cfg(test)]
@@ -237,7 +263,7 @@ mod tests {
         };
         let free: Vec<usize> = (0..n).filter(|&i| fixed[i].is_none()).collect();
         let reduced = reduce(&qp, &free);
-        let prepared = prepare(&p, &fixed).unwrap();
+        let prepared = prepare(&p, &fixed, None).unwrap();
         let normal = super::super::ipm::normal_pattern(&reduced);
         let same = |a: faer::sparse::SymbolicSparseColMatRef<'_, usize>| {
             a.col_ptr() == normal.col_ptr() && a.row_idx() == normal.row_idx()
@@ -250,7 +276,8 @@ mod tests {
         let settings = QpSettings::default();
         let plain = solve_monotone_qp(&qp, &settings).unwrap();
         let mut analyses = Analyses::default();
-        let with = solve_monotone_qp_with(&qp, &settings, &mut analyses, Some(prepare(&p, &fixed).unwrap())).unwrap();
+        let with =
+            solve_monotone_qp_with(&qp, &settings, &mut analyses, Some(prepare(&p, &fixed, None).unwrap())).unwrap();
         assert_eq!(plain.iterations, with.iterations);
         // kept for the next solve on the pattern: the same result again
         let again = solve_monotone_qp_with(&qp, &settings, &mut analyses, None).unwrap();

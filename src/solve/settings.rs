@@ -91,6 +91,9 @@ pub struct QpSettings {
     pub method: Method,
     /// Formulation. {auto}
     pub formulation: Formulation,
+    /// The memory budget in bytes; `None`: the machine's ([`crate::memory::machine_budget`]).
+    /// A route predicted past it is refused before its work. {None}
+    pub memory_limit: Option<u64>,
 }
 
 impl Default for QpSettings {
@@ -101,6 +104,7 @@ impl Default for QpSettings {
             gap_tolerance: 3e-7,
             method: Method::Auto,
             formulation: Formulation::Auto,
+            memory_limit: None,
         }
     }
 }

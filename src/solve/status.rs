@@ -45,6 +45,9 @@ pub struct QpSolution {
     pub condition: Option<f64>,
     /// Why the structured solver handed over to Clarabel, if it did.
     pub fallback: Option<String>,
+    /// The interior-point route's predicted peak (the process's resident memory when it was
+    /// predicted plus what the route allocates), when it ran.
+    pub predicted_peak: Option<u64>,
 }
 
 /// What a solver returns on a [`ReducedQp`].

@@ -6,24 +6,33 @@
 //! chosen from the problem alone, so results are bit-identical for every thread count.
 //!
 //! ```
-//! use toposmooth::parallel::{join, threads, with_threads};
-//! assert_eq!(threads(), toposmooth::parallel::DEFAULT_THREADS);
+//! use toposmooth::parallel::{default_threads, join, threads, with_threads};
+//! assert_eq!(threads(), default_threads());
 //! let (a, b) = with_threads(1, || join(threads, threads));
 //! assert_eq!((a, b), (1, 1));
 //! ```
 
 use std::cell::Cell;
 
-/// The cap when no caller set one: the two cores the library is tuned for.
-pub const DEFAULT_THREADS: usize = 2;
+/// The cap when no caller set one: every core of the machine
+/// (`std::thread::available_parallelism`, which honours the process's CPU affinity and
+/// cgroup quota), 2 where it is unknown.
+pub fn default_threads() -> usize {
+    static DEFAULT: std::sync::OnceLock<usize> = std::sync::OnceLock::new();
+    *DEFAULT.get_or_init(|| std::thread::available_parallelism().map_or(2, std::num::NonZeroUsize::get))
+}
 
 thread_local! {
-    static LIMIT: Cell<usize> = const { Cell::new(DEFAULT_THREADS) };
+    /// 0: no cap set on this thread (the default applies).
+    static LIMIT: Cell<usize> = const { Cell::new(0) };
 }
 
 /// The number of threads the current thread's computations may use (at least 1).
 pub fn threads() -> usize {
-    LIMIT.with(Cell::get)
+    match LIMIT.with(Cell::get) {
+        0 => default_threads(),
+        n => n,
+    }
 }
 
 /// Runs `f` with at most `n` threads (`n` = 0 is taken as 1), restoring the previous cap after.
@@ -36,6 +45,14 @@ pub fn with_threads<R>(n: usize, f: impl FnOnce() -> R) -> R {
     }
     let _restore = Restore(LIMIT.with(|l| l.replace(n.max(1))));
     f()
+}
+
+/// Factorisations of at least `flops` use faer's parallel kernels (0: every one; the default is
+/// the measured break-even): for tests that check that the parallel kernels give the same bits
+/// for every thread count.
+#[doc(hidden)]
+pub fn set_parallel_factor_flops(flops: f64) {
+    crate::linalg::set_parallel_factor_flops(flops);
 }
 
 /// faer's parallelism for a dense or supernodal kernel under the cap: sequential for one
@@ -71,17 +88,17 @@ mod tests {
 
     #[test]
     fn the_cap_is_split_and_restored() {
-        assert_eq!(threads(), DEFAULT_THREADS);
+        assert_eq!(threads(), default_threads());
         let main = std::thread::current().id();
         let (a, b) = with_threads(4, || join(|| (threads(), std::thread::current().id()), threads));
         assert_eq!((a.0, b), (2, 2));
         assert_eq!(a.1, main, "a runs on the calling thread");
         let ids = with_threads(1, || join(|| std::thread::current().id(), || std::thread::current().id()));
         assert_eq!(ids, (main, main), "one thread: both parts here");
-        assert_eq!(threads(), DEFAULT_THREADS);
+        assert_eq!(threads(), default_threads());
         let r = std::panic::catch_unwind(|| with_threads(3, || -> usize { panic!("inside") }));
         assert!(r.is_err());
-        assert_eq!(threads(), DEFAULT_THREADS, "restored after a panic");
+        assert_eq!(threads(), default_threads(), "restored after a panic");
         // faer's kernels follow the cap: one thread is sequential
         assert_eq!(with_threads(1, faer_par), faer::Par::Seq);
     }

@@ -90,6 +90,25 @@ fn a_smoother_can_move_to_another_thread() {
 /// factorisation) one after the other, with the plans chosen from the problem alone. The
 /// 120 × 90 grid (10,800 unknowns) is past the size where nested dissection and the two-way
 /// plan are considered; weights run their functions on 1 and 2 workers.
+/// Every thread count gives the same bits, faer's parallel kernels included: every
+/// factorisation is made parallel here and faer's pool allowed four threads, on two cores.
+#[test]
+fn results_are_bit_identical_for_1_2_3_and_4_threads_with_parallel_kernels() {
+    use toposmooth::parallel::{set_parallel_factor_flops, with_threads};
+    faer::set_global_parallelism(faer::Par::rayon(4));
+    set_parallel_factor_flops(0.0);
+    let grid = Grid2d::new(100, 80).unwrap();
+    let settings = SmoothSettings { selection: Selection::Relative(0.1), ..Default::default() };
+    let h = &fields(&grid, 5)[0];
+    let runs: Vec<_> = (1..=4).map(|t| with_threads(t, || smooth(&grid, h, &settings).unwrap())).collect();
+    set_parallel_factor_flops(2e10);
+    for (t, r) in runs.iter().enumerate().skip(1) {
+        assert!(r.report.certificate.passed);
+        assert_eq!(runs[0].output, r.output, "1 and {} threads give different outputs", t + 1);
+        assert_eq!(runs[0].u, r.u);
+    }
+}
+
 #[test]
 fn results_are_bit_identical_for_one_and_two_threads() {
     use toposmooth::parallel::with_threads;

@@ -868,7 +868,7 @@ fn run<'py>(
     cancel: Option<PyRef<'py, PyCancelToken>>,
 ) -> PyResult<String> {
     let watch = Watch::new(progress, cancel);
-    let cap = threads.unwrap_or(toposmooth::parallel::DEFAULT_THREADS).max(1);
+    let cap = threads.unwrap_or_else(toposmooth::parallel::default_threads).max(1);
     watched(py, &watch, || {
         toposmooth::parallel::with_threads(cap, || {
             toposmooth::commands::catch_panics(|| toposmooth::commands::cli::run_args(&args))

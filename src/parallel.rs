@@ -47,12 +47,24 @@ pub fn with_threads<R>(n: usize, f: impl FnOnce() -> R) -> R {
     f()
 }
 
+/// Factor flops from which a numeric factorisation uses faer's parallel kernels (on 2 cores
+/// rayon only paid off for the largest factors measured).
+pub const PARALLEL_FACTOR_FLOPS: f64 = 2e10;
+
+static PARALLEL_FLOPS: std::sync::atomic::AtomicU64 =
+    std::sync::atomic::AtomicU64::new(PARALLEL_FACTOR_FLOPS.to_bits());
+
+/// The factor flops from which factorisations use faer's parallel kernels now.
+pub fn parallel_factor_flops() -> f64 {
+    f64::from_bits(PARALLEL_FLOPS.load(std::sync::atomic::Ordering::Relaxed))
+}
+
 /// Factorisations of at least `flops` use faer's parallel kernels (0: every one; the default is
-/// the measured break-even): for tests that check that the parallel kernels give the same bits
-/// for every thread count.
+/// [`PARALLEL_FACTOR_FLOPS`]): for tests that check that the parallel kernels give the same
+/// bits for every thread count.
 #[doc(hidden)]
 pub fn set_parallel_factor_flops(flops: f64) {
-    crate::linalg::set_parallel_factor_flops(flops);
+    PARALLEL_FLOPS.store(flops.to_bits(), std::sync::atomic::Ordering::Relaxed);
 }
 
 /// faer's parallelism for a dense or supernodal kernel under the cap: sequential for one

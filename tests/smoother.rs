@@ -101,7 +101,7 @@ fn results_are_bit_identical_for_1_2_3_and_4_threads_with_parallel_kernels() {
     let settings = SmoothSettings { selection: Selection::Relative(0.1), ..Default::default() };
     let h = &fields(&grid, 5)[0];
     let runs: Vec<_> = (1..=4).map(|t| with_threads(t, || smooth(&grid, h, &settings).unwrap())).collect();
-    set_parallel_factor_flops(2e10);
+    set_parallel_factor_flops(toposmooth::parallel::PARALLEL_FACTOR_FLOPS);
     for (t, r) in runs.iter().enumerate().skip(1) {
         assert!(r.report.certificate.passed);
         assert_eq!(runs[0].output, r.output, "1 and {} threads give different outputs", t + 1);

@@ -856,7 +856,7 @@ fn fill_missing<'py>(py: Python<'py>, domain: &Domain, h: PyReadonlyArray1<'py, 
 /// Runs one CLI command in this process (`args` without the program's name, e.g.
 /// `["smooth", "a.vti", "-o", "b.vti"]`) and returns what the tool prints on standard output;
 /// errors are raised as the package's exceptions with the CLI's message.
-/// `threads` caps the threads the command uses (default 2); `progress` and `cancel` as for
+/// `threads` caps the threads the command uses (default: every core); `progress` and `cancel` as for
 /// [`Smoother::smooth`] (a cancelled command leaves no output or temporary behind).
 #[pyfunction]
 #[pyo3(signature = (args, threads=None, progress=None, cancel=None))]

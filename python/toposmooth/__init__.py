@@ -439,7 +439,7 @@ def smooth(
         structured interior-point method.
     formulation : {"auto", "assembled", "factored"}
     threads : int, optional
-        At most this many threads for the call (default 2). Results are bit-identical for
+        At most this many threads for the call (default: every core). Results are bit-identical for
         every thread count; 1 suits one process per core (Dask workers, pvbatch ranks).
     memory_limit : str or int, optional
         The memory the run may use: ``"6G"``, ``"512M"`` or bytes (default: the lowest of the

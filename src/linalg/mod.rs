@@ -58,24 +58,10 @@ const ND_ONLY_N: usize = 200_000;
 /// Parts at most this large are ordered by AMD inside the dissection.
 const ND_LEAF: usize = 128;
 
-/// Factor flops from which a numeric factorisation uses faer's parallel kernels (on 2 cores
-/// rayon only paid off for the largest factors measured).
-const PARALLEL_FACTOR_FLOPS: f64 = 2e10;
-
-/// Another threshold than [`PARALLEL_FACTOR_FLOPS`] for the factorisations analysed after it
-/// is set (0: every one parallel), for tests that check the parallel kernels give the same
-/// bits ([`crate::parallel::set_parallel_factor_flops`]).
-pub(crate) fn set_parallel_factor_flops(flops: f64) {
-    PARALLEL_FLOPS.store(flops.to_bits(), std::sync::atomic::Ordering::Relaxed);
-}
-
-static PARALLEL_FLOPS: std::sync::atomic::AtomicU64 =
-    std::sync::atomic::AtomicU64::new(PARALLEL_FACTOR_FLOPS.to_bits());
-
-/// Parallelism for a numeric factorisation: sequential below [`PARALLEL_FACTOR_FLOPS`], else
-/// faer's global setting under the caller's cap.
+/// Parallelism for a numeric factorisation: sequential below
+/// [`crate::parallel::parallel_factor_flops`], else faer's global setting under the caller's cap.
 pub(crate) fn parallelism_for(s: &SymbolicCholesky<usize>) -> Par {
-    if factor_flops(s) < f64::from_bits(PARALLEL_FLOPS.load(std::sync::atomic::Ordering::Relaxed)) {
+    if factor_flops(s) < crate::parallel::parallel_factor_flops() {
         Par::Seq
     } else {
         crate::parallel::faer_par()

@@ -287,7 +287,7 @@ pub const SETTINGS: &[Setting] = &[
         Kind::Count { min: 1, max: 1024 },
         None,
         Group::Run,
-        "At most N threads (default: the caller's cap, 2); results are bit-identical for every count.",
+        "At most N threads (default: every core, or the caller's cap); results are bit-identical for every count.",
     ),
 ];
 

@@ -34,7 +34,7 @@ pub struct SmoothSettings {
     /// harmonic, then flooded, each fallback reported). {None}
     pub representative: Option<RepresentativeChoice>,
     /// At most this many threads for the run; `None` keeps the caller's cap
-    /// ([`crate::parallel::with_threads`], 2 by default). Results do not depend on it. {None}
+    /// ([`crate::parallel::with_threads`], every core by default). Results do not depend on it. {None}
     pub threads: Option<usize>,
 }
 

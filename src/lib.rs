@@ -63,8 +63,6 @@ pub use verify::{certify, certify_any, Certificate};
 pub mod commands;
 pub mod constraints;
 pub mod derive;
-#[cfg(feature = "serde")]
-pub(crate) mod harmonic_order;
 pub mod io;
 pub(crate) mod linalg;
 pub mod memory;

@@ -262,7 +262,7 @@ def test_the_readme_example_runs(datasets, capsys, monkeypatch):
     monkeypatch.chdir(ROOT)
     exec(compile(blocks[0], "README.md", "exec"), {})
     lines = capsys.readouterr().out.split("\n")
-    assert lines[0] == "9 4 True" and lines[1].startswith("0.02348"), lines
+    assert lines[0] == "9 4 True" and lines[1].startswith("0.02023"), lines
 
 
 def test_results_do_not_depend_on_the_thread_count(datasets):

@@ -423,8 +423,9 @@ def smooth(
     edges : {"minimal", "all"}
         Constraint set: one lower and one higher neighbour per vertex, or every edge.
     representative : {"separatrix", "harmonic", "flooded"}, optional
-        Representative function on grids and meshes (default: separatrix, falling back in
-        that order, each fallback reported).
+        Representative function on grids and meshes (default: flooded, the data with its
+        cancelled basins flooded, falling back to separatrix, then harmonic, each fallback
+        reported).
     fill_missing : bool
         Fill NaN samples first (linearly on series, harmonically on grids and meshes), as
         the CLI's ``--fill-missing``; otherwise NaN is an :class:`InputError`.

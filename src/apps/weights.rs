@@ -18,10 +18,10 @@
 use crate::constraints::{choose_margin, constraint_edges, margin_cap, max_margin, EdgeSet};
 use crate::domain::sos_sort;
 use crate::error::{Error, Result};
-use crate::harmonic_order::ordered_harmonic;
 use crate::linalg::Analyses;
 use crate::operators::{dirichlet_solve, polyharmonic, Energy, Sparse};
 use crate::pipeline::Smoothable;
+use crate::representative::harmonic_order::ordered_harmonic;
 use crate::solve::{repair, solve_bounded_partition, solve_monotone_qp_with, MonotoneQp, QpSettings, SolveStatus};
 use crate::verify::{certify_no_data, spurious_components, Certificate, RegionKind};
 use std::sync::atomic::{AtomicUsize, Ordering};

@@ -231,16 +231,18 @@ pub(super) fn smooth_shared(args: &SmoothArgs, shared: Option<&mut Option<Shared
     let output = stage_results(&args.output, &field.domain, x_axis, &results)?;
     check_written(&output, &field.domain, &results).map_err(|e| e.in_file(&field.path))?;
     let mut staged = vec![output];
+    // surfaces write the kept complex's separatrices (built here when the representative did
+    // not need it); volumes only the critical points
+    let built = match (&args.complex, &result.complex) {
+        (Some(_), None) if field.domain.dimension() == 2 => Some(
+            crate::pipeline::complex_of(&field.domain, &field.values, &args.settings.selection)
+                .map_err(|e| e.in_file(&field.path))?,
+        ),
+        _ => None,
+    };
+    let complex = result.complex.as_ref().or(built.as_ref());
     if let Some(path) = &args.complex {
-        // surfaces write the kept complex's separatrices; volumes only the critical points
-        let ms = result.complex.as_ref();
-        if ms.is_none() && field.domain.dimension() == 2 {
-            return Err(Error::Internal {
-                path: Some(field.path.clone()),
-                message: format!("no Morse-Smale complex to write ({})", result.report.representative),
-            });
-        }
-        staged.push(stage_complex(path, &field.domain, &field.values, &result.roles, ms)?);
+        staged.push(stage_complex(path, &field.domain, &field.values, &result.roles, complex)?);
     }
     if let Some(path) = &args.diagram {
         let pairs = crate::io::ttk::diagram_of(&field.domain, &field.values);
@@ -269,8 +271,8 @@ pub(super) fn smooth_shared(args: &SmoothArgs, shared: Option<&mut Option<Shared
             read_seconds,
             write_seconds,
             total_seconds: start.elapsed().as_secs_f64(),
-            saddles: result.complex.as_ref().map(|c| c.saddles.len()),
-            separatrices: result.complex.as_ref().map(|c| c.descending.len() + c.ascending.len()),
+            saddles: complex.map(|c| c.saddles.len()),
+            separatrices: complex.map(|c| c.descending.len() + c.ascending.len()),
             report: &result.report,
         };
         staged.push(super::stage_report(path, &run)?);

@@ -89,6 +89,26 @@ pub fn smooth_any(domain: &crate::domain::AnyDomain, h: &[f64], settings: &Smoot
     crate::with_domain!(domain, d => smooth(d, h, settings))
 }
 
+/// The simplified Morse–Smale complex of `h` for the kept set of `selection`, as the separatrix
+/// representative builds it: for `--complex` when another representative was used (grids and
+/// triangle meshes).
+///
+/// # Errors
+/// As the selection, and an internal error if the complex cannot be built.
+pub fn complex_of(
+    domain: &crate::domain::AnyDomain,
+    h: &[f64],
+    selection: &crate::topology::Selection,
+) -> Result<MorseSmale> {
+    crate::with_domain!(domain, d => {
+        let kept = select(d, h, selection)?;
+        let stage = Stage::begin("complex");
+        let ms = MorseSmale::new(d, h, &kept).map_err(|e| Error::internal(format!("Morse-Smale complex: {e}")))?;
+        stage.end(|| format!("{} saddles, {} separatrices", ms.saddles.len(), ms.descending.len() + ms.ascending.len()));
+        Ok(ms)
+    })
+}
+
 /// The fit's target (Ĝ ≤ 10⁻⁶ × the data term) that an active-set output must meet as
 /// written, else the structured solver runs instead.
 const ACTIVE_SET_FIT: f64 = 1e-6;

@@ -247,7 +247,7 @@ pub const SETTINGS: &[Setting] = &[
         Kind::Choice(RepresentativeChoice::NAMES),
         None,
         Group::Solver,
-        "Grids and meshes: the representative function. Given, it is built or the run fails (exit 3 when the data cannot follow its order, 1 when it fails its own check); by default the separatrix one, then harmonic, then flooded, each fallback reported.",
+        "Grids and meshes: the representative function. Given, it is built or the run fails (exit 3 when the data cannot follow its order, 1 when it fails its own check); by default the flooded one (the data with its cancelled basins flooded: closest to the data), then on surfaces the separatrix one, then harmonic, each fallback reported.",
     ),
     setting(
         "max_iter",

@@ -222,12 +222,13 @@ enum Cells {
     Tetrahedra,
 }
 
-/// The representative on a triangulated surface (the complex is built either way, for
-/// `--complex`) or a volume. A construction the user chose is built or refused (its check
-/// failing is an error naming the vertices); the automatic choice tries, on surfaces, the
-/// separatrix one, then the harmonic one, then the flooded one (NOTES.md 9), on volumes the
-/// flooded one, then the harmonic one, and records why each one before was not used. `k` is
-/// the Laplacian of the harmonic fills (non-negative weights).
+/// The representative on a triangulated surface or a volume. A construction the user chose is
+/// built or refused (its check failing is an error naming the vertices); the automatic choice
+/// tries the flooded one first (NOTES.md 9: closer to the data on every bundled grid,
+/// docs/grids.md section 5), then on surfaces the separatrix one, then the harmonic one, and
+/// records why each one before was not used. The Morse-Smale complex is built only for the
+/// separatrix one (`--complex` builds it for the others). `k` is the Laplacian of the
+/// harmonic fills (non-negative weights).
 #[allow(clippy::too_many_arguments)]
 fn surface_representative<D: Domain>(
     domain: &D,
@@ -249,32 +250,32 @@ fn surface_representative<D: Domain>(
     let analyses = std::cell::RefCell::new(analyses);
     let mut why: Vec<String> = excluded.iter().map(|(kind, e)| format!("{kind} representative: {e}")).collect();
     let skip = |kind: RepresentativeKind| excluded.iter().any(|(x, _)| *x == kind);
-    let stage = crate::progress::Stage::begin("complex");
-    let built = match cells {
-        Cells::Triangles => MorseSmale::new(domain, h, kept).map(Some),
-        Cells::Tetrahedra => Ok(None),
-    };
-    let complex = match built {
-        Ok(None) => {
-            stage.end(|| "not built on volumes".into());
-            None
-        }
-        Ok(Some(ms)) => {
-            stage.end(|| {
-                format!(
-                    "{} saddles, {} descending and {} ascending separatrices",
-                    ms.saddles.len(),
-                    ms.descending.len(),
-                    ms.ascending.len()
-                )
-            });
-            Some(ms)
-        }
-        Err(e) => {
-            stage.end(|| format!("not built ({e})"));
-            why.push(format!("Morse-Smale complex: {e}"));
-            None
-        }
+    // the complex, built when the separatrix representative is tried (surfaces only)
+    let built: std::cell::OnceCell<Option<MorseSmale>> = std::cell::OnceCell::new();
+    let complex_for = |why: &mut Vec<String>| -> Option<&MorseSmale> {
+        built
+            .get_or_init(|| {
+                let stage = crate::progress::Stage::begin("complex");
+                match MorseSmale::new(domain, h, kept) {
+                    Ok(ms) => {
+                        stage.end(|| {
+                            format!(
+                                "{} saddles, {} descending and {} ascending separatrices",
+                                ms.saddles.len(),
+                                ms.descending.len(),
+                                ms.ascending.len()
+                            )
+                        });
+                        Some(ms)
+                    }
+                    Err(e) => {
+                        stage.end(|| format!("not built ({e})"));
+                        why.push(format!("Morse-Smale complex: {e}"));
+                        None
+                    }
+                }
+            })
+            .as_ref()
     };
     let repairs = std::cell::Cell::new(Repairs::default());
     let one_sided_saddles = std::cell::Cell::new(0);
@@ -287,7 +288,7 @@ fn surface_representative<D: Domain>(
     // ties broken as the complex broke them (SoS): a saddle and an extremum of equal input
     // value no longer give a flat separatrix.
     let separatrix = |why: &mut Vec<String>| -> Option<Vec<f64>> {
-        let matched = complex.as_ref()?;
+        let matched = complex_for(why)?;
         let merged = matched.with_one_sided();
         let untied = crate::domain::sos_untied(h);
         let complexes: Vec<&MorseSmale> = std::iter::once(matched).chain(merged.as_ref()).collect();
@@ -342,7 +343,7 @@ fn surface_representative<D: Domain>(
     };
     use RepresentativeKind::{Flooded, Harmonic, Separatrix};
     let automatic = match cells {
-        Cells::Triangles => vec![Separatrix, Harmonic, Flooded],
+        Cells::Triangles => vec![Flooded, Separatrix, Harmonic],
         Cells::Tetrahedra => vec![Flooded, Harmonic],
     };
     let order: Vec<RepresentativeKind> = match choice {
@@ -350,7 +351,6 @@ fn surface_representative<D: Domain>(
         Some(c) => vec![c.into()],
     };
     if choice.is_some() {
-        // the complex is only for --complex when the user chose the construction
         why.clear();
     }
     let build = |kind: RepresentativeKind, why: &mut Vec<String>| match kind {
@@ -362,16 +362,23 @@ fn surface_representative<D: Domain>(
         Separatrix => separatrix_name(one_sided_saddles.get(), repairs.get()),
         _ => kind.name().to_string(),
     };
+    let mut found = None;
     for kind in order {
         crate::progress::checkpoint()?;
         if skip(kind) {
             continue;
         }
         if let Some(u) = build(kind, &mut why) {
-            // --complex writes the separatrices u was built from
-            let complex = if kind == Separatrix { merged_used.take().or(complex) } else { complex };
-            return Ok(Representative { u, kind, name: named(kind), fallbacks: why, complex });
+            found = Some((kind, u));
+            break;
         }
+    }
+    // the constructions' borrows of the complex end here: it moves into the result
+    if let Some((kind, u)) = found {
+        // --complex writes the separatrices u was built from
+        let complex = built.into_inner().flatten();
+        let complex = if kind == Separatrix { merged_used.take().or(complex) } else { complex };
+        return Ok(Representative { u, kind, name: named(kind), fallbacks: why, complex });
     }
     let message = match choice {
         Some(_) => format!("{} (requested explicitly: not replaced by another construction)", why.join("; ")),

@@ -138,6 +138,45 @@ fn peak_rss_mib() -> f64 {
         .unwrap_or(f64::NAN)
 }
 
+/// A tie-heavy volume as a scanner writes one: a head-like ellipsoid of tissue (160, with a
+/// smooth variation of ±15) holding two dark ventricles (40) and three bright spots (220),
+/// on a dark background (2), plus noise (standard deviation 8 inside, 2 outside), rounded and
+/// clamped to the 256 levels of uint8: a fifth of the voxels tie at 0 to 4, every level holds
+/// hundreds (the brain crops that the active set once handed over on).
+pub fn quantised_phantom3(nx: usize, ny: usize, nz: usize, seed: u64) -> Vec<f64> {
+    let mut next = uniform(seed);
+    let unit = |i: usize, n: usize| if n > 1 { i as f64 / (n - 1) as f64 } else { 0.5 };
+    // (centre, semi-axes) in unit coordinates
+    let inside =
+        |p: [f64; 3], c: [f64; 3], r: [f64; 3]| (0..3).map(|a| ((p[a] - c[a]) / r[a]).powi(2)).sum::<f64>() <= 1.0;
+    let ventricles = [([0.42, 0.5, 0.55], [0.06, 0.16, 0.09]), ([0.58, 0.5, 0.55], [0.06, 0.16, 0.09])];
+    let spots = [
+        ([0.3, 0.3, 0.4], [0.05, 0.05, 0.05]),
+        ([0.7, 0.65, 0.35], [0.06, 0.04, 0.05]),
+        ([0.5, 0.75, 0.7], [0.04, 0.06, 0.05]),
+    ];
+    (0..nx * ny * nz)
+        .map(|v| {
+            let p = [unit(v % nx, nx), unit((v / nx) % ny, ny), unit(v / (nx * ny), nz)];
+            // about Gaussian: the sum of four uniforms, variance 1/3
+            let noise = ((0..4).map(|_| next()).sum::<f64>() - 2.0) * 3f64.sqrt();
+            let value = if inside(p, [0.5, 0.5, 0.5], [0.42, 0.36, 0.4]) {
+                let base = if ventricles.iter().any(|&(c, r)| inside(p, c, r)) {
+                    40.0
+                } else if spots.iter().any(|&(c, r)| inside(p, c, r)) {
+                    220.0
+                } else {
+                    160.0 + 15.0 * (5.0 * p[0]).sin() * (4.0 * p[1]).cos() * (3.0 * p[2] + 1.0).sin()
+                };
+                base + 8.0 * noise
+            } else {
+                2.0 + 2.0 * noise
+            };
+            value.round().clamp(0.0, 255.0)
+        })
+        .collect()
+}
+
 /// One benchmark case: a series of n samples, an nx × ny grid, or a mesh file.
 #[derive(Clone, Debug, PartialEq)]
 pub enum BenchCase {
@@ -147,6 +186,9 @@ pub enum BenchCase {
     Grid(usize, usize),
     /// Noisy bumps in a volume (nx, ny, nz).
     Volume(usize, usize, usize),
+    /// A tie-heavy uint8 volume ([`quantised_phantom3`]), written `NXxNYxNZq`, smoothed at a
+    /// persistence of 5 % of the range (as the brain crop was; `--persistence` is not used).
+    Quantised(usize, usize, usize),
     /// A mesh file, midpoint-subdivided this many times: geodesic distance from vertex 0,
     /// then smoothing with every maximum kept (the paper's figure 13).
     Mesh(String, usize),
@@ -179,14 +221,19 @@ impl BenchCase {
         }
         let bad = || {
             Error::Usage(format!(
-                "bench size `{s}` is not N (series), NXxNY (grid), NXxNYxNZ (volume) or a mesh file[@levels]"
+                "bench size `{s}` is not N (series), NXxNY (grid), NXxNYxNZ (volume), NXxNYxNZq (quantised volume) or a mesh file[@levels]"
             ))
+        };
+        let (s, quantised) = match s.strip_suffix('q') {
+            Some(rest) => (rest, true),
+            None => (s, false),
         };
         let parts: Vec<usize> =
             s.split(['x', 'X', '×']).map(|p| p.trim().parse().map_err(|_| bad())).collect::<Result<_>>()?;
         let case = match parts[..] {
             [n] => BenchCase::Series(n),
             [a, b] => BenchCase::Grid(a, b),
+            [a, b, c] if quantised => BenchCase::Quantised(a, b, c),
             [a, b, c] => BenchCase::Volume(a, b, c),
             _ => return Err(bad()),
         };
@@ -197,14 +244,14 @@ impl BenchCase {
             BenchCase::Grid(a, b) if a.checked_mul(b).is_none_or(|n| n > MAX_BENCH_VERTICES) => Err(Error::Usage(
                 format!("bench grid {a} × {b}: at most {MAX_BENCH_VERTICES} vertices (a run of that size takes hours)"),
             )),
-            BenchCase::Volume(a, b, c)
+            BenchCase::Volume(a, b, c) | BenchCase::Quantised(a, b, c)
                 if a.checked_mul(b).and_then(|ab| ab.checked_mul(c)).is_none_or(|n| n > MAX_BENCH_VERTICES) =>
             {
                 Err(Error::Usage(format!(
                     "bench volume {a} × {b} × {c}: at most {MAX_BENCH_VERTICES} vertices (a run of that size takes hours)"
                 )))
             }
-            BenchCase::Volume(a, b, c) if a < 2 || b < 2 || c < 2 => {
+            BenchCase::Volume(a, b, c) | BenchCase::Quantised(a, b, c) if a < 2 || b < 2 || c < 2 => {
                 Err(Error::Usage(format!("bench volumes need at least 2 × 2 × 2 vertices, got {a} × {b} × {c}")))
             }
             BenchCase::Series(n) if n < 2 => {
@@ -222,6 +269,7 @@ impl BenchCase {
             BenchCase::Series(n) => n.to_string(),
             BenchCase::Grid(a, b) => format!("{a}x{b}"),
             BenchCase::Volume(a, b, c) => format!("{a}x{b}x{c}"),
+            BenchCase::Quantised(a, b, c) => format!("{a}x{b}x{c}q"),
             BenchCase::Mesh(f, 0) => f.clone(),
             BenchCase::Mesh(f, l) => format!("{f}@{l}"),
         }
@@ -298,6 +346,17 @@ fn run_single(case: BenchCase, args: &BenchArgs) -> Result<String> {
             settings.selection = Selection::Count { minima: 7, maxima: 6 };
             let grid = Grid3d::new(*nx, *ny, *nz)?;
             let h = noisy_bumps3(*nx, *ny, *nz, args.seed);
+            let n = nx * ny * nz;
+            if many {
+                (through_smoother(grid, &h, &settings, args.fields)?, n)
+            } else {
+                (vec![(smooth(&grid, &h, &settings)?, f64::NAN)], n)
+            }
+        }
+        BenchCase::Quantised(nx, ny, nz) => {
+            settings.selection = Selection::Relative(0.05);
+            let grid = Grid3d::new(*nx, *ny, *nz)?;
+            let h = quantised_phantom3(*nx, *ny, *nz, args.seed);
             let n = nx * ny * nz;
             if many {
                 (through_smoother(grid, &h, &settings, args.fields)?, n)

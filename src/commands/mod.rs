@@ -17,7 +17,7 @@ mod smooth_many;
 mod verify;
 mod weights;
 
-pub use bench::{bench, bench_weights, BenchArgs, BenchCase};
+pub use bench::{bench, bench_weights, quantised_phantom3, BenchArgs, BenchCase};
 pub use deform::{deform, DeformArgs};
 pub use diffuse::{diffuse, DiffuseArgs};
 pub use extrema::{extrema, ExtremaArgs};

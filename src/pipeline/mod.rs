@@ -22,7 +22,7 @@ use crate::error::{Error, Result};
 use crate::linalg::Analyses;
 use crate::operators::Sparse;
 use crate::progress::Stage;
-use crate::solve::{solve_monotone_qp_with, Bound, Method, MonotoneQp, ACTIVE_SET_FROM};
+use crate::solve::{policy, solve_monotone_qp_with, Bound, Method, MonotoneQp};
 use crate::topology::morse_smale::MorseSmale;
 use crate::topology::{count_sos_extrema, select, Role};
 use crate::verify::certify;
@@ -108,10 +108,6 @@ pub fn complex_of(
         Ok(ms)
     })
 }
-
-/// The fit's target (Ĝ ≤ 10⁻⁶ × the data term) that an active-set output must meet as
-/// written, else the structured solver runs instead.
-const ACTIVE_SET_FIT: f64 = 1e-6;
 
 /// [`smooth`] on a volume restricted to a mask: the pipeline runs on the
 /// [`MaskedVolume`]'s tetrahedra and its outputs come back on the whole grid, the outside
@@ -224,6 +220,7 @@ fn structured_again<D: Smoothable + Sync>(
         qp: crate::solve::QpSettings { method: Method::Structured, ..settings.qp.clone() },
         ..settings.clone()
     };
+    policy::announce_hand_over(&format!("{why}; the interior-point method takes over"));
     ops.own_fill = domain.own_fill_stiffness();
     let mut again = smooth_on(domain, ops, h, &structured, analyses, keep_analyses)?;
     again.report.solver_fallback = Some(match again.report.solver_fallback.take() {
@@ -276,7 +273,7 @@ fn smooth_stages<D: Smoothable + Sync>(
     let chosen;
     let settings = match settings.qp.method {
         Method::Auto => {
-            let method = if domain.solid() && n >= ACTIVE_SET_FROM { Method::ActiveSet } else { Method::Structured };
+            let method = policy::route(Method::Auto, n, domain.solid());
             chosen =
                 SmoothSettings { qp: crate::solve::QpSettings { method, ..settings.qp.clone() }, ..settings.clone() };
             &chosen
@@ -398,7 +395,7 @@ fn smooth_stages<D: Smoothable + Sync>(
     let report = run.report(seconds, certificate);
     // the active-set point is checked as written, after the margin repair: one further from
     // the optimum than the fit's target is solved again by the interior-point method
-    if sol.method == Method::ActiveSet && report.fit.gap_over_data.is_some_and(|g| g > ACTIVE_SET_FIT) {
+    if sol.method == Method::ActiveSet && report.fit.gap_over_data.is_some_and(|g| g > policy::ACTIVE_SET_FIT) {
         let why = format!(
             "the active-set output ({:?} after {} outer iterations), after the margin repair moved {} vertices by up to {:.1e}, was {:.1e} × the data term from the optimum",
             sol.status,

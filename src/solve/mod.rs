@@ -13,6 +13,7 @@ mod flow;
 mod ipm;
 mod newton;
 mod optimality;
+pub mod policy;
 mod problem;
 mod qp;
 mod repair;

@@ -115,6 +115,9 @@ pub fn solve_monotone_qp_with(
         }
         _ => None,
     };
+    if let (None, Some(why)) = (&attempt, &fallback) {
+        super::policy::announce_hand_over(&format!("{why}; the interior-point method takes over"));
+    }
     let mut predicted_peak = None;
     let (out, method) = match (attempt, settings.method) {
         (Some(out), _) => (out, Method::ActiveSet),
@@ -150,6 +153,7 @@ pub fn solve_monotone_qp_with(
                         Err(why) => {
                             crate::progress::checkpoint()?;
                             fallback = Some(why.to_string());
+                            super::policy::announce_hand_over(&format!("{why}; Clarabel takes over"));
                             (clarabel(&reduced)?, Method::Clarabel)
                         }
                     }
@@ -157,6 +161,7 @@ pub fn solve_monotone_qp_with(
                 Err(why) => {
                     crate::progress::checkpoint()?;
                     fallback = Some(why.to_string());
+                    super::policy::announce_hand_over(&format!("{why}; Clarabel takes over"));
                     (clarabel(&reduced)?, Method::Clarabel)
                 }
             }
@@ -318,6 +323,49 @@ mod tests {
                 assert_eq!((sol.x[0], sol.x[3]), (0.0, 3.0));
             }
         }
+    }
+
+    #[test]
+    fn a_hand_over_says_why_in_the_solution_and_to_the_progress_observer() {
+        use crate::progress::{observe, Observer};
+        use std::sync::{Arc, Mutex};
+        #[derive(Default)]
+        struct Ends(Mutex<Vec<(String, String)>>);
+        impl Observer for Ends {
+            fn begin(&self, _: &str) {}
+            fn update(&self, _: &str, _: &str) {}
+            fn end(&self, stage: &str, _: f64, summary: &str) {
+                self.0.lock().unwrap().push((stage.to_string(), summary.to_string()));
+            }
+        }
+        // no data term: the active-set iteration cannot bound its gap and hands over
+        let p =
+            Sparse::try_new_from_triplets(4, 4, &(0..4).map(|i| Triplet::new(i, i, 1.0)).collect::<Vec<_>>()).unwrap();
+        let (q, fixed, edges) = ([0.0, -2.0, -1.0, -3.0], [Some(0.0), None, None, Some(3.0)], [(0, 1), (1, 2), (2, 3)]);
+        let qp = MonotoneQp {
+            p: &p,
+            q: &q,
+            fixed: &fixed,
+            edges: &edges,
+            margin: 1e-6,
+            hint: None,
+            bounds: &[],
+            data: None,
+            factor: None,
+            condition: None,
+        };
+        let ends = Arc::new(Ends::default());
+        let sol = observe(ends.clone(), || {
+            solve_monotone_qp(&qp, &QpSettings { method: Method::ActiveSet, ..Default::default() })
+        })
+        .unwrap();
+        assert_eq!(sol.method, Method::Structured);
+        let why = sol.fallback.expect("the reason is in the solution");
+        assert!(why.contains("data term"), "{why}");
+        let ends = ends.0.lock().unwrap();
+        assert_eq!(ends.len(), 1, "{ends:?}");
+        assert_eq!(ends[0].0, "hand-over");
+        assert!(ends[0].1.starts_with(&why) && ends[0].1.ends_with("the interior-point method takes over"), "{ends:?}");
     }
 
     #[test]

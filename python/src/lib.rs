@@ -190,14 +190,16 @@ fn watched<T: Send>(py: Python<'_>, watch: &Watch, work: impl FnOnce() -> toposm
                     }
                 }
             }
-            if done {
-                break;
-            }
+            // checked before the end too: the last batch's callable may have been the one that
+            // saw Ctrl-C come (a loaded machine can hold this thread back for the whole run)
             if raised.is_none() {
                 if let Err(e) = py.check_signals() {
                     token.cancel();
                     raised = Some(e);
                 }
+            }
+            if done {
+                break;
             }
         }
         worker.join().unwrap_or_else(|payload| std::panic::resume_unwind(payload))

@@ -1,0 +1,167 @@
+//! The join step of an outer iteration: violated rows enter the working set, the most
+//! violated first and those within [`JOIN_SHARE`] of the worst, merging distinct clusters
+//! (never closing a cycle among them), swapping out a tree row where a row closes a cycle
+//! inside one cluster, or a bound where two anchored clusters are pulled together.
+
+use super::clusters::{find, Clusters};
+use super::multipliers::Forest;
+use super::rows::Row;
+use super::{ADD_ABOVE, JOIN_SHARE};
+
+/// What the join step did.
+pub(super) struct Joined {
+    /// Working-set changes this iteration, those before the join step included.
+    pub(super) changed: usize,
+    /// Swaps: a row in, a tree row or a bound out.
+    pub(super) swaps: usize,
+    /// Violated rows that could not join, by reason: a cycle row whose path crosses a row
+    /// another swap took out, a cycle row with no rising tree row on its path, a row inside a
+    /// cluster merged this iteration, a row between two anchored clusters, a bound on an
+    /// anchored cluster.
+    pub(super) stuck: [usize; 5],
+    /// The largest violation (0 when none).
+    pub(super) worst: f64,
+    /// Rows violated by more than [`ADD_ABOVE`].
+    pub(super) violated: usize,
+}
+
+/// The join step on the working set `in_set` (multipliers `z`, the trees `forest` walked) at
+/// the point `x`; `changed` counts the changes made before it this iteration, and `tabu` how
+/// often each row joined two anchored clusters.
+pub(super) fn join(
+    rows: &[Row],
+    in_set: &mut [bool],
+    z: &mut [f64],
+    x: &[f64],
+    forest: &Forest,
+    tabu: &mut [u8],
+    mut changed: usize,
+) -> Joined {
+    let n = x.len();
+    let cl = Clusters::new(n, rows, in_set);
+    let mut violated: Vec<(f64, usize)> = rows
+        .iter()
+        .enumerate()
+        .filter(|(k, _)| !in_set[*k])
+        .map(|(k, row)| (row.violation(x), k))
+        .filter(|&(v, _)| v > ADD_ABOVE)
+        .collect();
+    violated.sort_by(|a, b| b.0.total_cmp(&a.0));
+    let worst = violated.first().map_or(0.0, |v| v.0);
+    let joining = violated.partition_point(|v| v.0 >= JOIN_SHARE * worst);
+    let nc = cl.anchor.len();
+    let mut parent: Vec<u32> = (0..nc as u32).collect();
+    let mut anchored: Vec<bool> = cl.anchor.iter().map(Option::is_some).collect();
+    let mut anchor_row = vec![usize::MAX; nc];
+    for (k, row) in rows.iter().enumerate().filter(|(k, _)| in_set[*k]) {
+        if let Row::Bound(v, _, _) = *row {
+            anchor_row[cl.label[v] as usize] = k;
+        }
+    }
+    // a cluster's anchor changes by one swap per iteration at most, and not beside a swap
+    // in its tree; the tree rows that swaps took out this iteration
+    let mut swapped = vec![false; nc];
+    let mut reanchored = vec![false; nc];
+    let mut taken_out = vec![false; rows.len()];
+    let mut swaps = 0usize;
+    let mut stuck = [0usize; 5];
+    // the rows within the share of the worst; when none of those could join, the rows
+    // within the share of the worst one that can (rows stuck at the top would otherwise
+    // let one row join per iteration)
+    let mut beyond: Option<f64> = None;
+    for (rank, &(violation, k)) in violated.iter().enumerate() {
+        if rank == joining && changed > 0 {
+            break;
+        }
+        if beyond.is_some_and(|v| violation < JOIN_SHARE * v) {
+            break;
+        }
+        let before = changed;
+        match rows[k] {
+            Row::Pair(i, j, _) if cl.label[i] == cl.label[j] => {
+                // a cycle in one cluster: the row replaces a tree row on its path
+                // several per cluster when their paths share no row a swap took out:
+                // each such path is then the new tree's path too (at 48³ of a quantised
+                // volume, one swap per cluster took 76 iterations for the last 240 rows)
+                let c = cl.label[i] as usize;
+                let mut crosses = reanchored[c];
+                forest.walk_path(rows, i, j, |row, _| crosses |= taken_out[row]);
+                if crosses {
+                    stuck[0] += 1;
+                    continue;
+                }
+                if let Some(out) = forest.rising_row_on_path(rows, z, i, j) {
+                    swapped[c] = true;
+                    taken_out[out] = true;
+                    in_set[out] = false;
+                    in_set[k] = true;
+                    swaps += 1;
+                    changed += 1;
+                } else {
+                    stuck[1] += 1;
+                }
+            }
+            Row::Pair(i, j, _) => {
+                let (ci, cj) = (cl.label[i], cl.label[j]);
+                let (a, b) = (find(&mut parent, ci), find(&mut parent, cj));
+                if a != b && !(anchored[a as usize] && anchored[b as usize]) {
+                    parent[a as usize] = b;
+                    anchored[b as usize] |= anchored[a as usize];
+                    in_set[k] = true;
+                    changed += 1;
+                } else if a != b
+                    && tabu[k] < 2
+                    && (a, b) == (ci, cj)
+                    && !swapped[ci as usize]
+                    && !swapped[cj as usize]
+                    && anchor_row[ci as usize] != usize::MAX
+                    && anchor_row[cj as usize] != usize::MAX
+                {
+                    // two clusters on their bounds that the row pulls together: one
+                    // leaves its bound, the row joins them; the bound holding its cluster
+                    // less leaves first, the other one if the row comes back
+                    let (ri, rj) = (anchor_row[ci as usize], anchor_row[cj as usize]);
+                    let (weaker, stronger) = if z[ri] <= z[rj] { (ri, rj) } else { (rj, ri) };
+                    let out = if tabu[k] == 0 { weaker } else { stronger };
+                    in_set[out] = false;
+                    z[out] = 0.0;
+                    in_set[k] = true;
+                    tabu[k] += 1;
+                    parent[a as usize] = b;
+                    swapped[ci as usize] = true;
+                    swapped[cj as usize] = true;
+                    reanchored[ci as usize] = true;
+                    reanchored[cj as usize] = true;
+                    swaps += 1;
+                    changed += 2;
+                } else {
+                    stuck[if a == b { 2 } else { 3 }] += 1;
+                }
+            }
+            Row::Bound(v, _, _) => {
+                let c = cl.label[v] as usize;
+                let a = find(&mut parent, cl.label[v]);
+                if !anchored[a as usize] {
+                    anchored[a as usize] = true;
+                    in_set[k] = true;
+                    changed += 1;
+                } else if anchor_row[c] != usize::MAX && !swapped[c] {
+                    // a second bound on an anchored cluster, violated (by the offsets
+                    // inside the cluster): it anchors the cluster instead
+                    swapped[c] = true;
+                    reanchored[c] = true;
+                    in_set[anchor_row[c]] = false;
+                    in_set[k] = true;
+                    swaps += 1;
+                    changed += 1;
+                } else {
+                    stuck[4] += 1;
+                }
+            }
+        }
+        if changed > before && rank >= joining && beyond.is_none() {
+            beyond = Some(violation);
+        }
+    }
+    Joined { changed, swaps, stuck, worst, violated: violated.len() }
+}

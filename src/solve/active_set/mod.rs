@@ -1,0 +1,215 @@
+//! An active-set iteration for the monotone QP that never factorises: the route for volumes,
+//! where one Cholesky factorisation of the normal matrix costs more than the whole run may
+//! (NOTES.md 6; docs/volumes.md, "Speed").
+//!
+//! The working set `S` holds rows taken as equalities: a pair row joins two variables into
+//! one cluster (one value), a bound row fixes its variable's cluster at the bound. With `S`
+//! fixed the QP is unconstrained over the cluster values, `min ½ yᵀCᵀPCy + …`, solved by
+//! conjugate gradients preconditioned by the clusters' diagonal (one product with P per
+//! iteration, nothing factorised). The rows of `S` in a cluster form a spanning tree, and the
+//! multipliers follow from stationarity: on the tree each row's is the gradient summed over
+//! the subtree it cuts off. Where that gives a negative one, the cluster's multipliers are
+//! taken instead as a maximum flow over all its tight rows (a cluster's tight rows form
+//! cycles, and a tree's multipliers are one of many): if the flow carries the whole
+//! imbalance the multipliers are non-negative and the cluster stays; if not, the cluster
+//! splits along the minimum cut, the one split the gradient pulls apart. Violated rows
+//! within [`JOIN_SHARE`] of the worst join `S` (merging two clusters, never closing a
+//! cycle), and the iteration stops when nothing joins or leaves and the gap bound of
+//! [`super::optimality`] — `Σ s⁺z + ½ Σ ρ²/d` with the data term's diagonal `d` — is below
+//! the tolerance. Inside a cluster the values step by the margin along the tree's rows; a row
+//! that closes a cycle in a cluster may miss its margin by a few ε, which the caller's margin
+//! repair restores, and the certificate and the gap of the output as written decide.
+
+mod clusters;
+mod join;
+mod multipliers;
+mod objective;
+mod rows;
+
+use super::problem::ReducedQp;
+use super::settings::QpSettings;
+use super::status::{Outcome, SolveStatus};
+use crate::error::NumericalError;
+use clusters::{Clusters, NONE};
+use join::{join, Joined};
+use multipliers::{balanced_gradient, flow_multipliers, gap_bound, tree_multipliers};
+use objective::{solve_clustered, Csr, Objective};
+use rows::{rows_of, Row};
+
+/// Outer iterations at most.
+const MAX_OUTER: u32 = 200;
+/// A row joins the working set when violated by more than this (unit values; the margin
+/// repair closes smaller violations).
+const ADD_ABOVE: f64 = 1e-10;
+/// The iteration ends as stalled when the same working-set size, violated count and number
+/// of changes come back this many times within [`CYCLE_WINDOW`] outer iterations.
+const CYCLE_REPEATS: usize = 4;
+/// See [`CYCLE_REPEATS`].
+const CYCLE_WINDOW: usize = 20;
+/// The iteration ends as stalled, not solved, when rows stay violated by more than this
+/// many margins with nothing left to change. Smaller ones the margin repair closes, moving
+/// vertices by at most the violation, and the pipeline checks the gap of the output as
+/// written (the structured solver runs when it misses the fit's target). At 4 margins a
+/// tie-heavy 48³ volume stalled on one row between two anchored clusters violated by 5.4
+/// margins, its gap 1.7 × 10⁻⁸ of the data term, and was handed over (170 s, 1.8 GiB).
+const STUCK_SHARE: f64 = 16.0;
+/// Violated rows join the working set when violated by at least this share of the worst
+/// violation: the others are mostly relieved by the same solve (joining every violated row
+/// merges clusters the next solve splits again: at 48³ 88 outer and 8,696 conjugate-gradient
+/// iterations with all of them, 35 and 2,412 with a share of 10⁻²).
+const JOIN_SHARE: f64 = 0.03;
+/// The first solve stops at this fraction of the data term.
+const FIRST_TOLERANCE: f64 = 1e-3;
+/// After a change of the working set the next solve stops at this share of the current gap
+/// (relative to the data term), between the final tolerance and [`LOOSEST_TOLERANCE`]: at
+/// 32³ this halves the conjugate-gradient iterations of a fixed tenth-per-iteration schedule
+/// at the same outer count, where 10⁻³ of the gap stalls the iteration.
+const GAP_SHARE: f64 = 1e-2;
+/// The loosest solve after the first.
+const LOOSEST_TOLERANCE: f64 = 1e-4;
+
+/// What the iteration did, beside the point.
+pub(super) struct ActiveSetOutcome {
+    pub(super) outcome: Outcome,
+    /// Conjugate-gradient iterations over all solves.
+    pub(super) cg_iterations: usize,
+}
+
+/// Runs the iteration from `hint` (or the data's target); needs a data term at every
+/// variable (the gap bound and the conjugate gradients' start).
+pub(super) fn solve(
+    r: &ReducedQp,
+    hint: Option<&[f64]>,
+    settings: &QpSettings,
+) -> std::result::Result<ActiveSetOutcome, NumericalError> {
+    if !r.gap_bound || r.factor.is_some() {
+        return Err("the active-set iteration needs the assembled energy with a data term everywhere".into());
+    }
+    if r.n >= NONE as usize {
+        return Err("too many variables for the active-set iteration".into());
+    }
+    let n = r.n;
+    let rows = rows_of(r)?;
+    let obj = Objective { p: Csr::from_upper(n, &r.p), q: &r.q, d: &r.d, q_free: &r.q_free };
+    let mut x: Vec<f64> = match hint {
+        Some(h) => h.to_vec(),
+        None => r.q_free.iter().zip(&r.d).map(|(q, d)| -q / d).collect(),
+    };
+    let mut in_set = vec![false; rows.len()];
+    let mut z = vec![0.0; rows.len()];
+    let mut g = vec![0.0; n];
+    let final_tolerance = 0.1 * settings.gap_tolerance;
+    let mut relative = FIRST_TOLERANCE;
+    let mut cg_iterations = 0;
+    let mut status = SolveStatus::MaxIterations;
+    let mut outer = 0;
+    let mut history: Vec<(usize, usize, usize)> = Vec::new();
+    let margin = rows.iter().map(|r| if let Row::Pair(_, _, b) = *r { -b } else { 0.0 }).fold(0.0, f64::max);
+    let stuck_above = (STUCK_SHARE * margin).max(ADD_ABOVE);
+    // how often a row joined two anchored clusters (an anchor left for it): twice at most,
+    // once per anchor, as the next cut tends to undo it
+    let mut tabu = vec![0u8; rows.len()];
+    let mut first_gap = None;
+    while outer < MAX_OUTER {
+        if crate::progress::cancelled() {
+            return Err("cancelled".into());
+        }
+        outer += 1;
+        let t0 = std::time::Instant::now();
+        let cl = Clusters::new(n, &rows, &in_set);
+        let data = obj.data_term(&x).max(f64::MIN_POSITIVE);
+        let t1 = std::time::Instant::now();
+        cg_iterations += solve_clustered(&obj, &cl, &mut x, relative * data);
+        let t2 = std::time::Instant::now();
+        obj.gradient(&x, &mut g);
+        let balanced = balanced_gradient(&cl, &g, &r.d);
+        let forest = tree_multipliers(&rows, &in_set, &cl, &balanced, &mut z);
+        let data = obj.data_term(&x).max(f64::MIN_POSITIVE);
+        let target = settings.gap_tolerance * data;
+        // leave: an anchor whose multiplier is negative (the whole cluster moves off its
+        // bound); a cluster with a negative tree multiplier gets its multipliers as a flow
+        // over all its tight rows, and splits along the cut where there is none
+        let in_count = in_set.iter().filter(|&&s| s).count().max(1);
+        let significant = final_tolerance * data / in_count as f64;
+        let mut changed = 0usize;
+        let mut marked = vec![false; cl.anchor.len()];
+        let mut unanchored = vec![false; cl.anchor.len()];
+        for (k, row) in rows.iter().enumerate() {
+            if in_set[k] && z[k] < 0.0 {
+                match *row {
+                    Row::Pair(i, j, _) if z[k] * z[k] / r.d[i].min(r.d[j]) > significant => {
+                        marked[cl.label[i] as usize] = true;
+                    }
+                    Row::Bound(v, _, _) if z[k] * z[k] / r.d[v] > significant => {
+                        unanchored[cl.label[v] as usize] = true;
+                        in_set[k] = false;
+                        z[k] = 0.0;
+                        changed += 1;
+                    }
+                    _ => {}
+                }
+            }
+        }
+        marked.iter_mut().zip(&unanchored).for_each(|(m, &u)| *m &= !u);
+        let t3 = std::time::Instant::now();
+        let drops = flow_multipliers(&rows, &mut in_set, &cl, &balanced, &x, &r.d, &marked, significant, &mut z);
+        changed += drops;
+        let t4 = std::time::Instant::now();
+        let Joined { changed, swaps, stuck, worst, violated } =
+            join(&rows, &mut in_set, &mut z, &x, &forest, &mut tabu, changed);
+        let gap = gap_bound(&rows, &x, &z, &g, &r.d);
+        let t5 = std::time::Instant::now();
+        crate::progress::update("solve", || {
+            format!(
+                "active set {outer}: {} rows in, {} violated (worst {worst:.1e}), gap {:.1e} of the data (target {:.0e})",
+                in_set.iter().filter(|&&s| s).count(),
+                violated,
+                gap / data,
+                settings.gap_tolerance
+            )
+        });
+        let first = *first_gap.get_or_insert(gap / data);
+        crate::progress::fraction("solve", crate::progress::log_fraction(first, gap / data, settings.gap_tolerance));
+        if std::env::var_os("TOPOSMOOTH_TRACE_ACTIVE").is_some() {
+            eprintln!(
+                "active set {outer}: {} rows in, {changed} changed ({swaps} swaps, {drops} cut), {} violated (worst {worst:.1e}, stuck {stuck:?} above {stuck_above:.1e}), gap/data {:.1e}, cg {cg_iterations}; ms clusters {} cg {} multipliers {} flow {} join {}",
+                in_set.iter().filter(|&&s| s).count(),
+                violated,
+                gap / data,
+                (t1 - t0).as_millis(),
+                (t2 - t1).as_millis(),
+                (t3 - t2).as_millis(),
+                (t4 - t3).as_millis(),
+                (t5 - t4).as_millis()
+            );
+        }
+        // a working set that keeps coming back (a swap undone by the next cut) is a cycle
+        let state = (in_set.iter().filter(|&&s| s).count(), violated, changed);
+        history.push(state);
+        if history.iter().rev().take(CYCLE_WINDOW).filter(|&&h| h == state).count() >= CYCLE_REPEATS {
+            status = SolveStatus::Stalled;
+            break;
+        }
+        if changed == 0 {
+            // every violated row is stuck where nothing else changed: not a solution
+            if worst > stuck_above {
+                status = SolveStatus::Stalled;
+                break;
+            }
+            if gap <= target {
+                status = SolveStatus::Solved;
+                break;
+            }
+            if relative <= final_tolerance {
+                status = SolveStatus::Stalled;
+                break;
+            }
+            relative = final_tolerance;
+        } else {
+            // the next solve need only be as exact as the current gap deserves
+            relative = (GAP_SHARE * gap / data).clamp(final_tolerance, LOOSEST_TOLERANCE);
+        }
+    }
+    let z = z.iter().map(|v| v.max(0.0)).collect();
+    Ok(ActiveSetOutcome { outcome: Outcome { x, z, y: None, status, iterations: outer }, cg_iterations })
+}

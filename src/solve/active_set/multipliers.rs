@@ -1,0 +1,325 @@
+//! The working set's multipliers: by stationarity on each cluster's tree, as a maximum flow
+//! over a cluster's tight rows where a tree multiplier is negative (splitting the cluster
+//! along the minimum cut where no flow carries its imbalance), and the gap bound they give.
+
+use super::super::flow::Network;
+use super::clusters::{Clusters, NONE};
+use super::rows::Row;
+
+/// The working set's trees as the multipliers walked them: each variable's row to its parent
+/// (`usize::MAX` at a root) and its depth.
+pub(super) struct Forest {
+    pub(super) parent_row: Vec<usize>,
+    pub(super) depth: Vec<u32>,
+}
+
+impl Forest {
+    /// Calls `visit(row, rises)` for each tree row on the path from `i` to `j` (one tree),
+    /// `rises` when `x` rises along it in the direction `i → j`.
+    pub(super) fn walk_path(&self, rows: &[Row], mut i: usize, mut j: usize, mut visit: impl FnMut(usize, bool)) {
+        // Pair(a, b) is x_a − x_b ≤ −ε: x rises from a to b. Walking up from i, a row rises
+        // along i → j when i's side is its a; walking up from j, when j's side is its b.
+        let other = |k: usize, v: usize| match rows[k] {
+            Row::Pair(a, b, _) => (if a == v { b } else { a }, a == v),
+            Row::Bound(..) => unreachable!("tree rows are pairs"),
+        };
+        while i != j {
+            if self.depth[i] >= self.depth[j] {
+                let k = self.parent_row[i];
+                if k == usize::MAX {
+                    return;
+                }
+                let (p, from_a) = other(k, i);
+                visit(k, from_a);
+                i = p;
+            } else {
+                let k = self.parent_row[j];
+                if k == usize::MAX {
+                    return;
+                }
+                let (p, from_a) = other(k, j);
+                visit(k, !from_a);
+                j = p;
+            }
+        }
+    }
+
+    /// The tree row on the path from `i` to `j` that runs the way `i → j` does, `x` rising
+    /// along it, with the smallest multiplier: swapping it for the row `i → j` keeps the
+    /// tree's equalities consistent with every row on the cycle.
+    pub(super) fn rising_row_on_path(&self, rows: &[Row], z: &[f64], i: usize, j: usize) -> Option<usize> {
+        let mut best: Option<usize> = None;
+        self.walk_path(rows, i, j, |k, rises| {
+            if rises && best.is_none_or(|b| z[k] < z[b]) {
+                best = Some(k);
+            }
+        });
+        best
+    }
+}
+
+/// The gradient with each unanchored cluster's sum spread back over it in proportion to the
+/// data diagonal (the conjugate gradients leave a residual of their tolerance): what the
+/// multipliers of a cluster's rows must balance.
+pub(super) fn balanced_gradient(cl: &Clusters, g: &[f64], d: &[f64]) -> Vec<f64> {
+    let nc = cl.anchor.len();
+    let (mut gsum, mut dsum) = (vec![0.0; nc], vec![0.0; nc]);
+    for (v, &c) in cl.label.iter().enumerate() {
+        gsum[c as usize] += g[v];
+        dsum[c as usize] += d[v];
+    }
+    cl.label
+        .iter()
+        .enumerate()
+        .map(|(v, &c)| {
+            let c = c as usize;
+            if cl.anchor[c].is_none() && dsum[c] > 0.0 {
+                g[v] - gsum[c] * d[v] / dsum[c]
+            } else {
+                g[v]
+            }
+        })
+        .collect()
+}
+
+/// The multipliers of the working set's rows by stationarity on each tree (zero elsewhere).
+pub(super) fn tree_multipliers(
+    rows: &[Row],
+    in_set: &[bool],
+    cl: &Clusters,
+    balanced: &[f64],
+    z: &mut [f64],
+) -> Forest {
+    let n = balanced.len();
+    z.iter_mut().for_each(|v| *v = 0.0);
+    // adjacency of the set's pair rows, the anchor row of each anchored cluster
+    let mut deg = vec![0usize; n + 1];
+    let mut anchor_row = vec![usize::MAX; cl.anchor.len()];
+    for (k, row) in rows.iter().enumerate().filter(|(k, _)| in_set[*k]) {
+        match *row {
+            Row::Pair(i, j, _) => {
+                deg[i + 1] += 1;
+                deg[j + 1] += 1;
+            }
+            Row::Bound(v, _, _) => anchor_row[cl.label[v] as usize] = k,
+        }
+    }
+    for v in 0..n {
+        deg[v + 1] += deg[v];
+    }
+    let mut adj = vec![0usize; deg[n]];
+    let mut at = deg.clone();
+    for (k, row) in rows.iter().enumerate().filter(|(k, _)| in_set[*k]) {
+        if let Row::Pair(i, j, _) = *row {
+            adj[at[i]] = k;
+            at[i] += 1;
+            adj[at[j]] = k;
+            at[j] += 1;
+        }
+    }
+    let nc = cl.anchor.len();
+    let mut acc = balanced.to_vec();
+    // breadth-first from each cluster's root (the anchor row's variable when anchored)
+    let mut seen = vec![false; n];
+    let mut order = Vec::with_capacity(n);
+    let mut parent_row = vec![usize::MAX; n];
+    let mut depth = vec![0u32; n];
+    let mut root_of = vec![usize::MAX; nc];
+    for (c, &k) in anchor_row.iter().enumerate() {
+        if k != usize::MAX {
+            if let Row::Bound(v, _, _) = rows[k] {
+                root_of[c] = v;
+            }
+        }
+    }
+    for v in 0..n {
+        let c = cl.label[v] as usize;
+        if root_of[c] == usize::MAX {
+            root_of[c] = v;
+        }
+    }
+    for &root in &root_of {
+        if root == usize::MAX || seen[root] {
+            continue;
+        }
+        seen[root] = true;
+        let start = order.len();
+        order.push(root);
+        let mut head = start;
+        while head < order.len() {
+            let v = order[head];
+            head += 1;
+            for &k in &adj[deg[v]..deg[v + 1]] {
+                let Row::Pair(i, j, _) = rows[k] else { continue };
+                let w = if i == v { j } else { i };
+                if !seen[w] {
+                    seen[w] = true;
+                    parent_row[w] = k;
+                    depth[w] = depth[v] + 1;
+                    order.push(w);
+                }
+            }
+        }
+    }
+    // leaves to roots: a row's multiplier carries its subtree's gradient
+    for &v in order.iter().rev() {
+        let k = parent_row[v];
+        if k == usize::MAX {
+            let c = cl.label[v] as usize;
+            if anchor_row[c] != usize::MAX {
+                if let Row::Bound(_, a, _) = rows[anchor_row[c]] {
+                    z[anchor_row[c]] = -a * acc[v];
+                }
+            }
+            continue;
+        }
+        let Row::Pair(i, j, _) = rows[k] else { unreachable!("tree rows are pairs") };
+        // stationarity at v: acc_v + a_kv z_k = 0, a = +1 at i, −1 at j
+        let (a_v, parent) = if v == i { (1.0, j) } else { (-1.0, i) };
+        z[k] = -a_v * acc[v];
+        acc[parent] += acc[v];
+    }
+    Forest { parent_row, depth }
+}
+
+/// A row is tight (an arc of the multipliers' network) within this of its bound.
+const TIGHT: f64 = 1e-10;
+
+/// Multipliers for the clusters marked in `marked` as a non-negative flow over all their
+/// tight rows, tree rows or not: stationarity `g + Aᵀz = 0` asks each variable to send out
+/// `−g` (balanced) along rows `x_i ≤ x_j − ε` from `i` to `j`, an anchor row taking or giving
+/// the cluster's sum. Where no such flow exists the minimum cut's source side is a set the
+/// objective falls by raising (or its complement, by lowering) with every tight row
+/// respected: the tree rows across it leave the set, splitting the cluster once, for good.
+/// A tree row's negative multiplier alone says nothing of this when tight rows close cycles,
+/// and dropping it there only has the row rejoin (the cycling of 48³ volumes). Returns the
+/// rows dropped.
+#[allow(clippy::too_many_arguments)]
+pub(super) fn flow_multipliers(
+    rows: &[Row],
+    in_set: &mut [bool],
+    cl: &Clusters,
+    balanced: &[f64],
+    x: &[f64],
+    d: &[f64],
+    marked: &[bool],
+    significant: f64,
+    z: &mut [f64],
+) -> usize {
+    let n = x.len();
+    let nc = cl.anchor.len();
+    let mut node = vec![NONE; n];
+    let mut count = 2usize; // 0 the source, 1 the sink
+    let mut scale = 0.0f64;
+    for v in 0..n {
+        if marked[cl.label[v] as usize] {
+            node[v] = count as u32;
+            count += 1;
+            scale = scale.max(balanced[v].abs());
+        }
+    }
+    if count == 2 || scale == 0.0 {
+        return 0;
+    }
+    let eps = 1e-14 * scale;
+    let mut net = Network::new(count);
+    let (source, sink) = (0, 1);
+    // per cluster: the sum to send out, the supply arcs, the smallest data diagonal
+    let mut sum = vec![0.0; nc];
+    let mut dmin = vec![f64::INFINITY; nc];
+    let mut supply: Vec<(u32, usize, f64)> = Vec::new();
+    for v in 0..n {
+        if node[v] == NONE {
+            continue;
+        }
+        let c = cl.label[v] as usize;
+        let out = -balanced[v];
+        sum[c] += out;
+        dmin[c] = dmin[c].min(d[v]);
+        if out > 0.0 {
+            supply.push((c as u32, net.add_arc(source, node[v] as usize, out), out));
+        } else if out < 0.0 {
+            net.add_arc(node[v] as usize, sink, -out);
+        }
+    }
+    let mut arcs: Vec<(usize, usize)> = Vec::new();
+    for (k, row) in rows.iter().enumerate() {
+        match *row {
+            Row::Pair(i, j, _) => {
+                if node[i] == NONE || cl.label[i] != cl.label[j] || !(in_set[k] || row.slack(x).abs() <= TIGHT) {
+                    continue;
+                }
+                arcs.push((k, net.add_arc(node[i] as usize, node[j] as usize, f64::INFINITY)));
+            }
+            Row::Bound(v, a, _) if in_set[k] && node[v] != NONE => {
+                let c = cl.label[v] as usize;
+                let hub = net.add_node();
+                if a > 0.0 {
+                    // x_v ≤ b: the anchor takes what the cluster sends out
+                    arcs.push((k, net.add_arc(node[v] as usize, hub, f64::INFINITY)));
+                    supply_or_demand(&mut net, &mut supply, hub, sink, sum[c].max(0.0), None);
+                } else {
+                    arcs.push((k, net.add_arc(hub, node[v] as usize, f64::INFINITY)));
+                    supply_or_demand(&mut net, &mut supply, source, hub, (-sum[c]).max(0.0), Some(c as u32));
+                }
+            }
+            Row::Bound(..) => {}
+        }
+    }
+    net.max_flow(source, sink, eps);
+    let mut deficit = vec![0.0; nc];
+    for &(c, a, cap) in &supply {
+        deficit[c as usize] += cap - net.flow(a);
+    }
+    let cut: Vec<bool> = (0..nc).map(|c| marked[c] && deficit[c] * deficit[c] / dmin[c] > significant).collect();
+    let side = net.reachable(source, eps);
+    let mut dropped = 0;
+    for &(k, a) in &arcs {
+        z[k] = net.flow(a);
+        if let Row::Pair(i, j, _) = rows[k] {
+            if in_set[k] && cut[cl.label[i] as usize] && side[node[i] as usize] != side[node[j] as usize] {
+                in_set[k] = false;
+                z[k] = 0.0;
+                dropped += 1;
+            }
+        }
+    }
+    dropped
+}
+
+/// An arc `from → to` of capacity `cap`, recorded as supply of cluster `c` when it leaves the
+/// source.
+fn supply_or_demand(
+    net: &mut Network,
+    supply: &mut Vec<(u32, usize, f64)>,
+    from: usize,
+    to: usize,
+    cap: f64,
+    c: Option<u32>,
+) {
+    let a = net.add_arc(from, to, cap);
+    if let Some(c) = c {
+        supply.push((c, a, cap));
+    }
+}
+
+/// `Σ max(s, 0) z⁺ + ½ Σ ρ²/d` with `ρ = g + Aᵀz⁺` (all in the reduced units).
+pub(super) fn gap_bound(rows: &[Row], x: &[f64], z: &[f64], g: &[f64], d: &[f64]) -> f64 {
+    let mut rho = g.to_vec();
+    let mut complementarity = 0.0;
+    for (row, &zk) in rows.iter().zip(z) {
+        let zk = zk.max(0.0);
+        if zk == 0.0 {
+            continue;
+        }
+        complementarity += row.slack(x).max(0.0) * zk;
+        match *row {
+            Row::Pair(i, j, _) => {
+                rho[i] += zk;
+                rho[j] -= zk;
+            }
+            Row::Bound(v, a, _) => rho[v] += a * zk,
+        }
+    }
+    complementarity + 0.5 * rho.iter().zip(d).map(|(r, d)| r * r / d).sum::<f64>()
+}

@@ -342,21 +342,15 @@ fn run_single(case: BenchCase, args: &BenchArgs) -> Result<String> {
                 (vec![(smooth(&grid, &h, &settings)?, f64::NAN)], nx * ny)
             }
         }
-        BenchCase::Volume(nx, ny, nz) => {
-            settings.selection = Selection::Count { minima: 7, maxima: 6 };
-            let grid = Grid3d::new(*nx, *ny, *nz)?;
-            let h = noisy_bumps3(*nx, *ny, *nz, args.seed);
-            let n = nx * ny * nz;
-            if many {
-                (through_smoother(grid, &h, &settings, args.fields)?, n)
+        &BenchCase::Volume(nx, ny, nz) | &BenchCase::Quantised(nx, ny, nz) => {
+            let h = if let BenchCase::Quantised(..) = case {
+                settings.selection = Selection::Relative(0.05);
+                quantised_phantom3(nx, ny, nz, args.seed)
             } else {
-                (vec![(smooth(&grid, &h, &settings)?, f64::NAN)], n)
-            }
-        }
-        BenchCase::Quantised(nx, ny, nz) => {
-            settings.selection = Selection::Relative(0.05);
-            let grid = Grid3d::new(*nx, *ny, *nz)?;
-            let h = quantised_phantom3(*nx, *ny, *nz, args.seed);
+                settings.selection = Selection::Count { minima: 7, maxima: 6 };
+                noisy_bumps3(nx, ny, nz, args.seed)
+            };
+            let grid = Grid3d::new(nx, ny, nz)?;
             let n = nx * ny * nz;
             if many {
                 (through_smoother(grid, &h, &settings, args.fields)?, n)

@@ -292,28 +292,32 @@ mod tests {
         assert!(edges.iter().all(|&(i, j)| with.x[j] - with.x[i] >= 0.5e-6));
     }
 
-    #[test]
-    fn both_solvers_project_onto_a_monotone_chain() {
-        // min Σ (f_i − h_i)² with f_0 = 0, f_3 = 3 fixed and f increasing: h = [0, 2, 1, 3]
+    type Chain = (Sparse, [f64; 4], [Option<f64>; 4], [(usize, usize); 3]);
+
+    /// min Σ (f_i − h_i)² with f_0 = 0, f_3 = 3 fixed and f increasing: h = [0, 2, 1, 3]
+    fn chain() -> Chain {
         let p =
             Sparse::try_new_from_triplets(4, 4, &(0..4).map(|i| Triplet::new(i, i, 1.0)).collect::<Vec<_>>()).unwrap();
-        let q = [0.0, -2.0, -1.0, -3.0];
-        let fixed = [Some(0.0), None, None, Some(3.0)];
-        let edges = [(0, 1), (1, 2), (2, 3)];
+        (p, [0.0, -2.0, -1.0, -3.0], [Some(0.0), None, None, Some(3.0)], [(0, 1), (1, 2), (2, 3)])
+    }
+
+    /// [`chain`]'s QP, without a data term, from `hint`.
+    fn chain_qp<'a>(
+        p: &'a Sparse,
+        q: &'a [f64],
+        fixed: &'a [Option<f64>],
+        edges: &'a [(usize, usize)],
+        hint: Option<&'a [f64]>,
+    ) -> MonotoneQp<'a> {
+        MonotoneQp { p, q, fixed, edges, margin: 1e-6, hint, bounds: &[], data: None, factor: None, condition: None }
+    }
+
+    #[test]
+    fn both_solvers_project_onto_a_monotone_chain() {
+        let (p, q, fixed, edges) = chain();
         for method in [Method::Structured, Method::Clarabel] {
             for hint in [None, Some(&[0.0, 1.0, 2.0, 3.0][..])] {
-                let qp = MonotoneQp {
-                    p: &p,
-                    q: &q,
-                    fixed: &fixed,
-                    edges: &edges,
-                    margin: 1e-6,
-                    hint,
-                    bounds: &[],
-                    data: None,
-                    factor: None,
-                    condition: None,
-                };
+                let qp = chain_qp(&p, &q, &fixed, &edges, hint);
                 let sol = solve_monotone_qp(&qp, &QpSettings { method, ..Default::default() }).unwrap();
                 assert_eq!(sol.method, method, "{:?}", sol.fallback);
                 assert!(matches!(sol.status, SolveStatus::Solved | SolveStatus::AlmostSolved));
@@ -339,21 +343,8 @@ mod tests {
             }
         }
         // no data term: the active-set iteration cannot bound its gap and hands over
-        let p =
-            Sparse::try_new_from_triplets(4, 4, &(0..4).map(|i| Triplet::new(i, i, 1.0)).collect::<Vec<_>>()).unwrap();
-        let (q, fixed, edges) = ([0.0, -2.0, -1.0, -3.0], [Some(0.0), None, None, Some(3.0)], [(0, 1), (1, 2), (2, 3)]);
-        let qp = MonotoneQp {
-            p: &p,
-            q: &q,
-            fixed: &fixed,
-            edges: &edges,
-            margin: 1e-6,
-            hint: None,
-            bounds: &[],
-            data: None,
-            factor: None,
-            condition: None,
-        };
+        let (p, q, fixed, edges) = chain();
+        let qp = chain_qp(&p, &q, &fixed, &edges, None);
         let ends = Arc::new(Ends::default());
         let sol = observe(ends.clone(), || {
             solve_monotone_qp(&qp, &QpSettings { method: Method::ActiveSet, ..Default::default() })

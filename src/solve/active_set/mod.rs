@@ -13,7 +13,7 @@
 //! cycles, and a tree's multipliers are one of many): if the flow carries the whole
 //! imbalance the multipliers are non-negative and the cluster stays; if not, the cluster
 //! splits along the minimum cut, the one split the gradient pulls apart. Violated rows
-//! within [`JOIN_SHARE`] of the worst join `S` (merging two clusters, never closing a
+//! within [`join::JOIN_SHARE`] of the worst join `S` (merging two clusters, never closing a
 //! cycle), and the iteration stops when nothing joins or leaves and the gap bound of
 //! [`super::optimality`] — `Σ s⁺z + ½ Σ ρ²/d` with the data term's diagonal `d` — is below
 //! the tolerance. Inside a cluster the values step by the margin along the tree's rows; a row
@@ -31,16 +31,13 @@ use super::settings::QpSettings;
 use super::status::{Outcome, SolveStatus};
 use crate::error::NumericalError;
 use clusters::{Clusters, NONE};
-use join::{join, Joined};
+use join::{join, Joined, ADD_ABOVE};
 use multipliers::{balanced_gradient, flow_multipliers, gap_bound, tree_multipliers};
 use objective::{solve_clustered, Csr, Objective};
 use rows::{rows_of, Row};
 
 /// Outer iterations at most.
 const MAX_OUTER: u32 = 200;
-/// A row joins the working set when violated by more than this (unit values; the margin
-/// repair closes smaller violations).
-const ADD_ABOVE: f64 = 1e-10;
 /// The iteration ends as stalled when the same working-set size, violated count and number
 /// of changes come back this many times within [`CYCLE_WINDOW`] outer iterations.
 const CYCLE_REPEATS: usize = 4;
@@ -53,11 +50,6 @@ const CYCLE_WINDOW: usize = 20;
 /// tie-heavy 48³ volume stalled on one row between two anchored clusters violated by 5.4
 /// margins, its gap 1.7 × 10⁻⁸ of the data term, and was handed over (170 s, 1.8 GiB).
 const STUCK_SHARE: f64 = 16.0;
-/// Violated rows join the working set when violated by at least this share of the worst
-/// violation: the others are mostly relieved by the same solve (joining every violated row
-/// merges clusters the next solve splits again: at 48³ 88 outer and 8,696 conjugate-gradient
-/// iterations with all of them, 35 and 2,412 with a share of 10⁻²).
-const JOIN_SHARE: f64 = 0.03;
 /// The first solve stops at this fraction of the data term.
 const FIRST_TOLERANCE: f64 = 1e-3;
 /// After a change of the working set the next solve stops at this share of the current gap

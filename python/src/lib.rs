@@ -190,8 +190,8 @@ fn watched<T: Send>(py: Python<'_>, watch: &Watch, work: impl FnOnce() -> toposm
                     }
                 }
             }
-            // checked before the end too: the last batch's callable may have been the one that
-            // saw Ctrl-C come (a loaded machine can hold this thread back for the whole run)
+            // checked before the end too: a signal raised while the last batch's callable ran
+            // (or since the last check) belongs to this call, not to the caller's next line
             if raised.is_none() {
                 if let Err(e) = py.check_signals() {
                     token.cancel();

@@ -231,6 +231,8 @@ impl BenchCase {
         let parts: Vec<usize> =
             s.split(['x', 'X', '×']).map(|p| p.trim().parse().map_err(|_| bad())).collect::<Result<_>>()?;
         let case = match parts[..] {
+            // the suffix q names a quantised volume only
+            _ if quantised && parts.len() != 3 => return Err(bad()),
             [n] => BenchCase::Series(n),
             [a, b] => BenchCase::Grid(a, b),
             [a, b, c] if quantised => BenchCase::Quantised(a, b, c),
@@ -537,4 +539,21 @@ pub fn bench_weights(cases: &[String], orders: &[u8], handles: usize) -> Result<
         }
     }
     Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_quantised_suffix_names_volumes_only() {
+        assert_eq!(BenchCase::parse("8x9x10q").unwrap(), BenchCase::Quantised(8, 9, 10));
+        assert_eq!(BenchCase::parse("8x9x10").unwrap(), BenchCase::Volume(8, 9, 10));
+        for bad in ["1000q", "30x40q", "q", "8x9x10qq", "1x9x10q"] {
+            assert!(matches!(BenchCase::parse(bad), Err(Error::Usage(_))), "{bad}");
+        }
+        let h = quantised_phantom3(12, 10, 8, 1);
+        assert_eq!(h.len(), 960);
+        assert!(h.iter().all(|&v| v == v.round() && (0.0..=255.0).contains(&v)));
+    }
 }

@@ -220,7 +220,7 @@ fn structured_again<D: Smoothable + Sync>(
         qp: crate::solve::QpSettings { method: Method::Structured, ..settings.qp.clone() },
         ..settings.clone()
     };
-    policy::announce_hand_over(&format!("{why}; the interior-point method takes over"));
+    policy::announce_hand_over(&why, Method::Structured);
     ops.own_fill = domain.own_fill_stiffness();
     let mut again = smooth_on(domain, ops, h, &structured, analyses, keep_analyses)?;
     again.report.solver_fallback = Some(match again.report.solver_fallback.take() {

@@ -26,9 +26,14 @@ pub fn route(requested: Method, n: usize, solid: bool) -> Method {
     }
 }
 
-/// Tells the progress observer (if any) that the route hands over, and why.
-pub fn announce_hand_over(why: &str) {
-    crate::progress::Stage::begin("hand-over").end(|| why.to_string());
+/// Tells the progress observer (if any) that `to` takes over, and why.
+pub fn announce_hand_over(why: &str, to: Method) {
+    let to = match to {
+        Method::Clarabel | Method::ClarabelAuxiliary => "Clarabel",
+        Method::ActiveSet => "the active-set iteration",
+        Method::Structured | Method::Auto => "the interior-point method",
+    };
+    crate::progress::Stage::begin("hand-over").end(|| format!("{why}; {to} takes over"));
 }
 
 #[cfg(test)]

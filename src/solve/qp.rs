@@ -115,9 +115,6 @@ pub fn solve_monotone_qp_with(
         }
         _ => None,
     };
-    if let (None, Some(why)) = (&attempt, &fallback) {
-        super::policy::announce_hand_over(&format!("{why}; the interior-point method takes over"));
-    }
     let mut predicted_peak = None;
     let (out, method) = match (attempt, settings.method) {
         (Some(out), _) => (out, Method::ActiveSet),
@@ -136,6 +133,9 @@ pub fn solve_monotone_qp_with(
                 }
                 predicted_peak = Some(peak);
             }
+            if let Some(why) = &fallback {
+                super::policy::announce_hand_over(why, Method::Structured);
+            }
             match super::ipm::solve(&reduced, hint.as_deref(), settings, analyses, prepared.take()) {
                 Ok(out) => (out, Method::Structured),
                 // the assembled normal matrix lost its definiteness (an energy without a data
@@ -153,7 +153,7 @@ pub fn solve_monotone_qp_with(
                         Err(why) => {
                             crate::progress::checkpoint()?;
                             fallback = Some(why.to_string());
-                            super::policy::announce_hand_over(&format!("{why}; Clarabel takes over"));
+                            super::policy::announce_hand_over(&why.to_string(), Method::Clarabel);
                             (clarabel(&reduced)?, Method::Clarabel)
                         }
                     }
@@ -161,7 +161,7 @@ pub fn solve_monotone_qp_with(
                 Err(why) => {
                     crate::progress::checkpoint()?;
                     fallback = Some(why.to_string());
-                    super::policy::announce_hand_over(&format!("{why}; Clarabel takes over"));
+                    super::policy::announce_hand_over(&why.to_string(), Method::Clarabel);
                     (clarabel(&reduced)?, Method::Clarabel)
                 }
             }

@@ -91,14 +91,23 @@ pub(super) fn join(
                 // several per cluster when their paths share no row a swap took out:
                 // each such path is then the new tree's path too (at 48³ of a quantised
                 // volume, one swap per cluster took 76 iterations for the last 240 rows)
+                // the tree row that goes out: the one on the path that runs the way i → j does,
+                // x rising along it, with the smallest multiplier (swapping it for the row
+                // keeps the tree's equalities consistent with every row on the cycle)
                 let c = cl.label[i] as usize;
                 let mut crosses = reanchored[c];
-                forest.walk_path(rows, i, j, |row, _| crosses |= taken_out[row]);
+                let mut rising: Option<usize> = None;
+                forest.walk_path(rows, i, j, |row, rises| {
+                    crosses |= taken_out[row];
+                    if rises && rising.is_none_or(|b| z[row] < z[b]) {
+                        rising = Some(row);
+                    }
+                });
                 if crosses {
                     stuck[0] += 1;
                     continue;
                 }
-                if let Some(out) = forest.rising_row_on_path(rows, z, i, j) {
+                if let Some(out) = rising {
                     swapped[c] = true;
                     taken_out[out] = true;
                     in_set[out] = false;

@@ -43,19 +43,6 @@ impl Forest {
             }
         }
     }
-
-    /// The tree row on the path from `i` to `j` that runs the way `i → j` does, `x` rising
-    /// along it, with the smallest multiplier: swapping it for the row `i → j` keeps the
-    /// tree's equalities consistent with every row on the cycle.
-    pub(super) fn rising_row_on_path(&self, rows: &[Row], z: &[f64], i: usize, j: usize) -> Option<usize> {
-        let mut best: Option<usize> = None;
-        self.walk_path(rows, i, j, |k, rises| {
-            if rises && best.is_none_or(|b| z[k] < z[b]) {
-                best = Some(k);
-            }
-        });
-        best
-    }
 }
 
 /// The gradient with each unanchored cluster's sum spread back over it in proportion to the

@@ -1,7 +1,8 @@
-//! The memory budget: a run whose interior-point route is predicted past `--memory-limit` is
-//! refused before the solve (exit 3, the estimate and the budget in the message, nothing
-//! written, no temporary left), and the prediction is never below the peak the run reaches by
-//! the end of its solve, on a series, grids, a tetrahedral mesh and a volume.
+//! The memory budget: a run whose route (interior point or active set) is predicted past
+//! `--memory-limit` is refused before the solve (exit 3, the estimate and the budget in the
+//! message, nothing written, no temporary left), and the prediction is never below the peak
+//! the run reaches by the end of its solve, on a series, grids, a tetrahedral mesh and volumes
+//! (both routes).
 
 mod common;
 
@@ -46,6 +47,13 @@ fn the_prediction_is_never_below_the_peak_reached_by_the_end_of_the_solve() {
         (dataset("soapfilm_piv_vorticity_63x63.csv"), vec!["--fill-missing", "--order", "3"], "p.npz"),
         (dataset("spot_tets.vtu"), vec!["--solver", "structured"], "t.vtu"),
         (dataset("mri_anatomical_33x41x25.nii"), vec!["--solver", "structured"], "m.vti"),
+        // the active-set route (the default on volumes)
+        (dataset("mri_anatomical_33x41x25.nii"), vec![], "a.vti"),
+        (
+            dataset("abc_flow_noisy_32x32x32.vti"),
+            vec!["--derive", "vorticity-magnitude", "--persistence", "10%", "--smooth-length", "0.03"],
+            "abc.vti",
+        ),
     ];
     for (input, extra, out) in cases {
         let (out, rep) = (dir.join(out), dir.join("run.json"));
@@ -55,10 +63,25 @@ fn the_prediction_is_never_below_the_peak_reached_by_the_end_of_the_solve() {
         assert!(o.status.success(), "{args:?}: {}", text(&o));
         let m = &report(&rep)["memory"];
         let (predicted, peak) = (m["predicted_peak"].as_u64(), m["peak_after_solve"].as_u64().unwrap());
-        let predicted = predicted.unwrap_or_else(|| panic!("{input}: the interior-point route ran, predicted"));
+        let predicted = predicted.unwrap_or_else(|| panic!("{input}: the route that ran predicted nothing"));
         assert!(peak > 0, "{input}");
         assert!(predicted >= peak, "{input}: predicted {predicted} B, reached {peak} B by the end of the solve");
     }
+}
+
+#[test]
+fn an_active_set_run_predicted_past_its_budget_is_refused_before_the_solve() {
+    let dir = scratch("memory-refused-active-set");
+    let out = dir.join("m.vti");
+    let mri = dataset("mri_anatomical_33x41x25.nii");
+    let o = toposmooth(&["smooth", &mri, "-o", out.to_str().unwrap(), "--memory-limit", "80M"]);
+    assert_eq!(o.status.code(), Some(3), "{}", text(&o));
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(stderr.contains("not enough memory: the active-set iteration would need about"), "{stderr}");
+    assert!(stderr.contains("over the memory budget of 80 MiB"), "{stderr}");
+    assert!(!stderr.contains("hand-over"), "refused, not handed to the interior-point route: {stderr}");
+    let left: Vec<_> = std::fs::read_dir(&dir).unwrap().map(|e| e.unwrap().file_name()).collect();
+    assert!(left.is_empty(), "nothing written, no temporary: {left:?}");
 }
 
 /// What the prediction does not foresee (here: a budget given above an address-space limit)

@@ -87,8 +87,18 @@ pub fn solve_monotone_qp_with(
     let mut fallback = None;
     let clarabel = |reduced: &ReducedQp| super::clarabel::solve(reduced, settings);
     let mut inner_iterations = 0;
+    let mut predicted_peak = None;
     let attempt = match settings.method {
         Method::ActiveSet if formulation == Formulation::Assembled && reduced.gap_bound => {
+            // the iteration's peak beside what the process holds: past the budget it is
+            // refused, not started (the interior-point route would need more still)
+            let budget = crate::memory::Budget::of(settings.memory_limit);
+            let extra = super::active_set::predicted_bytes(reduced.n, reduced.m(), reduced.p.len());
+            let peak = budget.in_use() + extra + budget.kernel_reserve();
+            if peak > budget.bytes {
+                return Err(crate::memory::over_budget("the active-set iteration", peak, &budget));
+            }
+            predicted_peak = Some(peak);
             match super::active_set::solve(&reduced, hint.as_deref(), settings) {
                 Ok(a) if a.outcome.status == SolveStatus::Solved => {
                     inner_iterations = a.cg_iterations;
@@ -115,7 +125,6 @@ pub fn solve_monotone_qp_with(
         }
         _ => None,
     };
-    let mut predicted_peak = None;
     let (out, method) = match (attempt, settings.method) {
         (Some(out), _) => (out, Method::ActiveSet),
         (None, Method::Auto | Method::Structured | Method::ActiveSet) => {
@@ -131,7 +140,7 @@ pub fn solve_monotone_qp_with(
                     };
                     return Err(crate::memory::over_budget(&what, peak, &budget));
                 }
-                predicted_peak = Some(peak);
+                predicted_peak = Some(predicted_peak.map_or(peak, |p: u64| p.max(peak)));
             }
             if let Some(why) = &fallback {
                 super::policy::announce_hand_over(why, Method::Structured);

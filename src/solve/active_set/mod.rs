@@ -67,6 +67,23 @@ pub(super) struct ActiveSetOutcome {
     pub(super) cg_iterations: usize,
 }
 
+/// Bytes the iteration allocates beside the reduced QP, at most, for `n` variables, `m` rows
+/// and `p_entries` stored entries of P's upper triangle: P in compressed rows (both triangles,
+/// 12 bytes an entry), the rows (32 bytes each) with their flags and multipliers, and per
+/// variable the clusters (labels, offsets, anchors, their adjacency), the conjugate gradients'
+/// eight vectors, the forest (order, parents, depths) and the join's tables; per row the
+/// cluster and forest adjacency and the flow network (two arcs of 16 bytes, doubled by the
+/// growth of its vectors, and the arc list). Counted as if every phase's storage were live at
+/// once, so an upper bound of the iteration's own peak.
+#[must_use]
+pub(crate) fn predicted_bytes(n: usize, m: usize, p_entries: usize) -> u64 {
+    let (n, m, p) = (n as u64, m as u64, p_entries as u64);
+    let csr = 12 * (2 * p) + 8 * (n + 1);
+    let per_variable = 24 + 72 + 72 + 70 + 28 + 4 + 15;
+    let per_row = 32 + 10 + 32 + 16 + 96 + 17;
+    csr + per_variable * n + per_row * m
+}
+
 /// Runs the iteration from `hint` (or the data's target); needs a data term at every
 /// variable (the gap bound and the conjugate gradients' start).
 pub(super) fn solve(

@@ -53,6 +53,9 @@ pub(super) struct Normal<'r> {
     spd: linalg::SpdFactor,
     spd_ok: bool,
     exact: Option<Exact>,
+    /// A banded pattern (a series): factorised in double-double from the start, whose cost
+    /// (about n·b² double-double products) is below a few refinement steps'.
+    banded: bool,
     t: std::cell::RefCell<Vec<fx128>>,
 }
 
@@ -99,6 +102,7 @@ impl<'r> Normal<'r> {
             base[pattern.pos_diag[j]] += fx128::from(d);
         }
         let analysis = std::sync::Arc::new(linalg::analyse(pattern.symbolic.as_ref())?);
+        let banded = linalg::is_banded(pattern.symbolic.as_ref());
         let spd = linalg::SpdFactor::new(analysis)?;
         Ok(Normal {
             f,
@@ -111,6 +115,7 @@ impl<'r> Normal<'r> {
             spd,
             spd_ok: false,
             exact: None,
+            banded,
             t: std::cell::RefCell::new(vec![fx128::from(0.0); f.f.nrows()]),
         })
     }
@@ -216,7 +221,7 @@ impl Objective<fx128> for Normal<'_> {
                 self.vals[p12] += wk * fx128::from(a1 * a2);
             }
         }
-        if self.exact.is_some() {
+        if self.exact.is_some() || self.banded {
             return self.factor_exact();
         }
         for (r, v) in self.rounded.iter_mut().zip(&self.vals) {

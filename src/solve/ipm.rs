@@ -288,6 +288,8 @@ struct Targets<T> {
     tol_mu: f64,
     gap_tolerance: f64,
     d: Vec<T>,
+    /// `1 / d`, for [`Real::div_by`].
+    inv_d: Vec<T>,
     q_free: Vec<T>,
     d_sum: f64,
 }
@@ -336,6 +338,7 @@ fn run<T: Real, O: Objective<T>>(
         tol_mu: 0.1 * settings.tolerance,
         gap_tolerance: settings.gap_tolerance,
         d: r.d.iter().map(|&v| of(v)).collect(),
+        inv_d: r.d.iter().map(|&v| of(1.0) / of(v)).collect(),
         q_free: r.q_free.iter().map(|&v| of(v)).collect(),
         d_sum: r.d.iter().sum(),
     };
@@ -351,6 +354,7 @@ fn run<T: Real, O: Objective<T>>(
     };
     let mut tmp_n = vec![zero; n];
     let mut w = vec![zero; m];
+    let (one, mut inv_s) = (of(1.0), vec![zero; m]);
     let mut newton = Newton::new(n, m);
     let mut last = (f64::INFINITY, f64::INFINITY, f64::INFINITY);
     let mut last_step = f64::INFINITY;
@@ -379,7 +383,8 @@ fn run<T: Real, O: Objective<T>>(
             Verdict::Go(fallback) => fallback,
         };
         for k in 0..m {
-            w[k] = point.z[k] / point.s[k];
+            inv_s[k] = one / point.s[k];
+            w[k] = point.z[k].div_by(point.s[k], inv_s[k]);
         }
         if let Err(e) = objective.factor(rows, &w) {
             return match fallback_status {
@@ -387,7 +392,7 @@ fn run<T: Real, O: Objective<T>>(
                 None => Err(e),
             };
         }
-        let alpha = newton.step(rows, objective, &point, &res, &w);
+        let alpha = newton.step(rows, objective, &point, &res, (&w, &inv_s));
         if alpha < 1e-12 {
             return Err(crate::error::NumericalError(format!("step length {alpha:e} at iteration {it}")));
         }
@@ -453,20 +458,20 @@ fn verdict_with_data<T: Real>(
 ) -> (Verdict, Option<Vec<T>>) {
     let At { it, res, small_step, iteration } = *at;
     let (zero, of) = (T::of(0.0), T::of);
-    let (x, z, d) = (&it.x, &it.z, &t.d);
+    let (x, z, d, inv_d) = (&it.x, &it.z, &t.d, &t.inv_d);
     let pres = res.pres;
     let comp = res.slack.iter().zip(z).fold(zero, |a, (&s, &z)| a + max(s, zero) * z);
-    let stat = res.rd.iter().zip(d).fold(zero, |a, (&g, &d)| a + g * g / d);
+    let stat = (0..x.len()).fold(zero, |a, i| a + (res.rd[i] * res.rd[i]).div_by(d[i], inv_d[i]));
     let gap = (comp + of(0.5) * stat).to_f64();
     let data = (0..x.len()).fold(zero, |a, i| {
         let e = d[i] * x[i] + t.q_free[i];
-        a + e * e / d[i]
+        a + (e * e).div_by(d[i], inv_d[i])
     });
     let data = (0.5 * data.to_f64()).max(1e-20 * t.d_sum);
     let mut polished = z.clone();
     let gap = if pres <= t.tol {
         let mut rho = res.rd.clone();
-        gap.min(polish_multipliers(rows, &res.slack, d, &mut rho, &mut polished, POLISH_SWEEPS).to_f64())
+        gap.min(polish_multipliers(rows, &res.slack, (d, inv_d), &mut rho, &mut polished, POLISH_SWEEPS).to_f64())
     } else {
         gap
     };
@@ -568,7 +573,7 @@ struct Newton<T> {
 /// The largest step in `[0, 1]` along `d` that keeps `v` non-negative.
 fn max_step<T: Real>(v: &[T], d: &[T]) -> f64 {
     let zero = T::of(0.0);
-    v.iter().zip(d).fold(1.0f64, |a, (&v, &d)| if d < zero { a.min((-v / d).to_f64()) } else { a })
+    v.iter().zip(d).fold(1.0f64, |a, (&v, &d)| if d < zero { a.min(-v.to_f64() / d.to_f64()) } else { a })
 }
 
 impl<T: Real> Newton<T> {
@@ -589,7 +594,7 @@ impl<T: Real> Newton<T> {
         objective: &mut O,
         it: &Iterate<T>,
         res: &Residuals<T>,
-        w: &[T],
+        (w, inv_s): (&[T], &[T]),
     ) -> f64 {
         let (zero, of) = (T::of(0.0), T::of);
         let (n, m) = (it.x.len(), it.s.len());
@@ -598,7 +603,7 @@ impl<T: Real> Newton<T> {
         // one Newton direction for complementarity target rc (s∘z − rc → 0)
         let mut direction = |rc: &[T], dx: &mut Vec<T>, ds: &mut Vec<T>, dz: &mut Vec<T>| {
             for k in 0..m {
-                tmp_m[k] = w[k] * res.rp[k] - rc[k] / s[k];
+                tmp_m[k] = w[k] * res.rp[k] - rc[k].div_by(s[k], inv_s[k]);
             }
             rows.atz(tmp_m, dx);
             for i in 0..n {
@@ -608,7 +613,7 @@ impl<T: Real> Newton<T> {
             rows.ax(dx, ds);
             for k in 0..m {
                 let adx = ds[k];
-                dz[k] = w[k] * (adx + res.rp[k]) - rc[k] / s[k];
+                dz[k] = w[k] * (adx + res.rp[k]) - rc[k].div_by(s[k], inv_s[k]);
                 ds[k] = -res.rp[k] - adx;
             }
         };
@@ -693,17 +698,25 @@ pub(crate) fn normal_pattern(r: &ReducedQp) -> faer::sparse::SymbolicSparseColMa
 
 /// Coordinate descent on the gap bound `Σ max(s, 0) z + ½ Σ ρ²/d` over the multipliers
 /// `z ≥ 0` for a fixed point (ρ = ∇φ + Aᵀz updated in place): returns the bound reached.
-fn polish_multipliers<T: Real>(rows: &Rows, slack: &[T], d: &[T], rho: &mut [T], z: &mut [T], sweeps: usize) -> T {
+fn polish_multipliers<T: Real>(
+    rows: &Rows,
+    slack: &[T],
+    (d, inv_d): (&[T], &[T]),
+    rho: &mut [T],
+    z: &mut [T],
+    sweeps: usize,
+) -> T {
     let zero = T::of(0.0);
     for _ in 0..sweeps {
         for k in 0..z.len() {
             let s = max(slack[k], zero);
             let [c0, c1] = rows.cols[k];
             let [v0, v1] = rows.vals[k];
-            let (mut grad, mut curv) = (s + T::of(v0) * rho[c0] / d[c0], T::of(v0 * v0) / d[c0]);
+            let (mut grad, mut curv) =
+                (s + (T::of(v0) * rho[c0]).div_by(d[c0], inv_d[c0]), T::of(v0 * v0).div_by(d[c0], inv_d[c0]));
             if rows.len[k] == 2 {
-                grad += T::of(v1) * rho[c1] / d[c1];
-                curv += T::of(v1 * v1) / d[c1];
+                grad += (T::of(v1) * rho[c1]).div_by(d[c1], inv_d[c1]);
+                curv += T::of(v1 * v1).div_by(d[c1], inv_d[c1]);
             }
             let new = max(z[k] - grad / curv, zero);
             let delta = new - z[k];
@@ -717,6 +730,6 @@ fn polish_multipliers<T: Real>(rows: &Rows, slack: &[T], d: &[T], rho: &mut [T],
         }
     }
     let comp = slack.iter().zip(z.iter()).fold(zero, |a, (&s, &z)| a + max(s, zero) * z);
-    let stat = rho.iter().zip(d).fold(zero, |a, (&g, &d)| a + g * g / d);
+    let stat = (0..rho.len()).fold(zero, |a, i| a + (rho[i] * rho[i]).div_by(d[i], inv_d[i]));
     comp + T::of(0.5) * stat
 }

@@ -139,6 +139,10 @@ pub(super) trait Real:
 {
     fn of(x: f64) -> Self;
     fn to_f64(self) -> f64;
+    /// `self / den`, given `inv = 1 / den`: a division in double, a product with the
+    /// reciprocal in double-double (a division there costs about ten products, and the
+    /// iteration divides by the same slacks and data diagonal many times per step).
+    fn div_by(self, den: Self, inv: Self) -> Self;
 }
 
 impl Real for f64 {
@@ -148,6 +152,9 @@ impl Real for f64 {
     fn to_f64(self) -> f64 {
         self
     }
+    fn div_by(self, den: Self, _inv: Self) -> Self {
+        self / den
+    }
 }
 
 impl Real for faer::fx128 {
@@ -156,6 +163,9 @@ impl Real for faer::fx128 {
     }
     fn to_f64(self) -> f64 {
         self.0 + self.1
+    }
+    fn div_by(self, _den: Self, inv: Self) -> Self {
+        self * inv
     }
 }
 

@@ -270,7 +270,7 @@ fn the_output_is_the_optimum_to_its_certified_gap_at_every_order() {
         .collect();
     let h: Vec<f64> = (0..n).map(|i| (x[i] * 0.35).sin() * 2.0 + 0.4 * (noise[i] - 0.5) + 0.02 * x[i]).collect();
     let series = Series::with_coordinates(x.clone()).unwrap();
-    let mut checked_factored = 0;
+    let (mut checked_factored, mut checked_double_iteration) = (0, 0);
     for energy in ["1", "2", "3", "4", "1:0.3,2:1,4:0.2"] {
         for smooth_length in [None, Some(0.3), Some(0.5)] {
             let settings = SmoothSettings {
@@ -314,10 +314,16 @@ fn the_output_is_the_optimum_to_its_certified_gap_at_every_order() {
             }
             if fit.formulation == toposmooth::solve::Formulation::Factored {
                 checked_factored += 1;
+                if fit.condition.unwrap() <= toposmooth::solve::DOUBLE_DOUBLE_ABOVE {
+                    checked_double_iteration += 1;
+                }
             }
         }
     }
     assert!(checked_factored >= 3, "the long smoothing length takes the factored path at orders ≥ 3");
+    // both ways of the factored form: the iteration in double with the gradient in
+    // double-double (up to DOUBLE_DOUBLE_ABOVE), and in double-double throughout
+    assert!(checked_double_iteration >= 2 && checked_factored - checked_double_iteration >= 2);
 }
 
 /// Item 2 (issue 15): on the bundled EUR/USD series at every order the structured solver and

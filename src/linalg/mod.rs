@@ -66,7 +66,7 @@ const ND_LEAF: usize = 128;
 const BANDED_MAX: usize = 8;
 
 /// The largest distance of an entry of the upper-triangular pattern `a` from the diagonal.
-fn bandwidth(a: SymbolicSparseColMatRef<'_, usize>) -> usize {
+pub(crate) fn bandwidth(a: SymbolicSparseColMatRef<'_, usize>) -> usize {
     (0..a.ncols()).map(|j| a.row_idx_of_col(j).map(|i| j.saturating_sub(i)).max().unwrap_or(0)).max().unwrap_or(0)
 }
 

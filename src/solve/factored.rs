@@ -16,6 +16,7 @@
 //! eigenvalues: κ beyond about 10¹⁴), the normal matrix is factorised in double-double itself
 //! (simplicial: faer's dense kernels are for native floats only), from then on.
 
+use super::banded::Banded;
 use super::newton::{Normal as Pattern, Objective, Rows};
 use super::problem::{ReducedFactor, ReducedQp};
 use crate::linalg;
@@ -53,9 +54,9 @@ pub(super) struct Normal<'r> {
     spd: linalg::SpdFactor,
     spd_ok: bool,
     exact: Option<Exact>,
-    /// A banded pattern (a series): factorised in double-double from the start, whose cost
-    /// (about n·b² double-double products) is below a few refinement steps'.
-    banded: bool,
+    /// A banded pattern (a series): factorised in double-double from the start
+    /// ([`Banded`]: about n·b² products, below a few refinement steps').
+    banded: Option<Banded<fx128>>,
     t: std::cell::RefCell<Vec<fx128>>,
 }
 
@@ -102,7 +103,8 @@ impl<'r> Normal<'r> {
             base[pattern.pos_diag[j]] += fx128::from(d);
         }
         let analysis = std::sync::Arc::new(linalg::analyse(pattern.symbolic.as_ref())?);
-        let banded = linalg::is_banded(pattern.symbolic.as_ref());
+        let banded = linalg::is_banded(pattern.symbolic.as_ref())
+            .then(|| Banded::new(pattern.symbolic.as_ref(), linalg::bandwidth(pattern.symbolic.as_ref())));
         let spd = linalg::SpdFactor::new(analysis)?;
         Ok(Normal {
             f,
@@ -221,7 +223,16 @@ impl Objective<fx128> for Normal<'_> {
                 self.vals[p12] += wk * fx128::from(a1 * a2);
             }
         }
-        if self.exact.is_some() || self.banded {
+        if let Some(banded) = &mut self.banded {
+            // the same regularisation as the general factorisation's, if it must
+            for reg in [0.0, 1e-24, 1e-18, 1e-12] {
+                if banded.factor(&self.vals, fx128::from(reg)) {
+                    return Ok(());
+                }
+            }
+            return Err("the double-double normal matrix is not positive definite".into());
+        }
+        if self.exact.is_some() {
             return self.factor_exact();
         }
         for (r, v) in self.rounded.iter_mut().zip(&self.vals) {
@@ -236,6 +247,10 @@ impl Objective<fx128> for Normal<'_> {
     }
 
     fn solve_in_place(&mut self, rhs: &mut [fx128]) {
+        if let Some(banded) = &self.banded {
+            banded.solve_in_place(rhs);
+            return;
+        }
         let n = rhs.len();
         if self.exact.is_none() && self.spd_ok {
             let norm = |v: &[fx128]| v.iter().fold(0.0f64, |a, x| a.max((x.0 + x.1).abs()));
@@ -283,5 +298,67 @@ impl Objective<fx128> for Normal<'_> {
         let mut t = vec![fx128::from(0.0); self.f.f.nrows()];
         self.auxiliary_into(x, &mut t);
         Some(t.iter().map(|t| t.0 + t.1).collect())
+    }
+}
+
+/// The factored objective for an iteration in double, for a QP with a data term: the gradient
+/// `Fᵀ(F x + g) + d∘x + q_d` formed in double-double at the double iterate and rounded, the
+/// normal matrix factorised and solved as [`Normal`] does, the direction rounded.
+///
+/// What the double-double form is for is the gradient: an assembled `P` of condition κ
+/// evaluates it with errors of `10⁻¹⁶ κ |x|`, where this one is exact up to its rounding
+/// (`10⁻¹⁶ |∇φ|`), and the gap bound squares that residual over the data diagonal. The
+/// iterate itself loses nothing that matters in double (the objective at the rounded optimum
+/// is `½ δᵀPδ` above it, `δ ≈ 10⁻¹⁶ |x|`: about `10⁻³² κ` of the data term), nor do the
+/// slacks, multipliers and their Newton updates, whose errors the next residual measures.
+/// Keeping those in double-double as well made a series of 10⁶ samples cost 7× the assembled
+/// form per iteration (issue 38's "conditioning cliff").
+pub(super) struct Rounded<'r> {
+    inner: Normal<'r>,
+    x: Vec<fx128>,
+    out: Vec<fx128>,
+    w: Vec<fx128>,
+}
+
+impl<'r> Rounded<'r> {
+    pub(super) fn new(inner: Normal<'r>, n: usize, m: usize) -> Rounded<'r> {
+        let zero = fx128::from(0.0);
+        Rounded { inner, x: vec![zero; n], out: vec![zero; n], w: vec![zero; m] }
+    }
+}
+
+fn widen(from: &[f64], to: &mut [fx128]) {
+    for (t, &f) in to.iter_mut().zip(from) {
+        *t = fx128::from(f);
+    }
+}
+
+fn round(from: &[fx128], to: &mut [f64]) {
+    for (t, f) in to.iter_mut().zip(from) {
+        *t = f.0 + f.1;
+    }
+}
+
+impl Objective<f64> for Rounded<'_> {
+    fn gradient(&mut self, x: &[f64], out: &mut [f64]) {
+        widen(x, &mut self.x);
+        self.inner.gradient(&self.x, &mut self.out);
+        round(&self.out, out);
+    }
+
+    fn factor(&mut self, rows: &Rows, w: &[f64]) -> std::result::Result<(), crate::error::NumericalError> {
+        widen(w, &mut self.w);
+        self.inner.factor(rows, &self.w)
+    }
+
+    fn solve_in_place(&mut self, rhs: &mut [f64]) {
+        widen(rhs, &mut self.out);
+        self.inner.solve_in_place(&mut self.out);
+        round(&self.out, rhs);
+    }
+
+    fn auxiliary(&self, x: &[f64]) -> Option<Vec<f64>> {
+        let x: Vec<fx128> = x.iter().map(|&v| fx128::from(v)).collect();
+        self.inner.auxiliary(&x)
     }
 }

@@ -122,7 +122,8 @@ const POLISH_SWEEPS: usize = 5;
 /// diag(d)), with the multipliers polished for the point, is below `settings.gap_tolerance` ×
 /// the data term; without one, when `sᵀz + ½ρᵀP⁻¹ρ` (P factorised alone) is below it × the
 /// energy, or — where P alone cannot be factorised — when the mean complementarity is 10×
-/// below the feasibility tolerance. The factored form runs in double-double throughout.
+/// below the feasibility tolerance. The factored form forms its gradient in double-double, and
+/// keeps the whole iteration in it above [`super::settings::DOUBLE_DOUBLE_ABOVE`].
 ///
 /// The normal matrix's analysis comes from `analyses` (and is kept there for the next solve
 /// on the same pattern); `prepared`, made in advance, is kept there first.
@@ -138,8 +139,14 @@ pub(super) fn solve(
     match &r.factor {
         Some(factor) => {
             drop(spare);
-            let mut objective = super::factored::Normal::new(r, factor, &rows.cols, &rows.len)?;
-            run::<faer::fx128, _>(r, &rows, &mut objective, hint, settings)
+            let objective = super::factored::Normal::new(r, factor, &rows.cols, &rows.len)?;
+            if factor.double_iteration {
+                let mut objective = super::factored::Rounded::new(objective, r.n, r.m());
+                run::<f64, _>(r, &rows, &mut objective, hint, settings)
+            } else {
+                let mut objective = objective;
+                run::<faer::fx128, _>(r, &rows, &mut objective, hint, settings)
+            }
         }
         None => {
             let normal = Normal::new(r, &rows.cols, &rows.len);

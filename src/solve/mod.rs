@@ -5,6 +5,7 @@
 //! This layer knows matrices, vectors and index pairs only: no domain, no mesh.
 
 mod active_set;
+mod banded;
 mod bounded;
 mod clarabel;
 mod condition;
@@ -27,5 +28,5 @@ pub use optimality::{optimality, optimality_with, Optimality};
 pub use problem::{constraint_rows, Bound, MonotoneQp, Row};
 pub use qp::{prepare, solve_monotone_qp, solve_monotone_qp_with};
 pub use repair::{meet_margin, repair, MarginSummary, RepairSummary};
-pub use settings::{Formulation, Method, QpSettings, ACTIVE_SET_FROM, FACTORED_ABOVE};
+pub use settings::{Formulation, Method, QpSettings, ACTIVE_SET_FROM, DOUBLE_DOUBLE_ABOVE, FACTORED_ABOVE};
 pub use status::{QpSolution, SolveStatus};

@@ -83,6 +83,10 @@ pub struct ReducedFactor {
     pub lo: Vec<f64>,
     /// `F_X x_X`: the fixed columns' contribution.
     pub g: Vec<f64>,
+    /// Whether the interior-point iteration may run in double with the gradient formed in
+    /// double-double (a data term and a condition estimate up to
+    /// [`super::settings::DOUBLE_DOUBLE_ABOVE`]); else it runs in double-double throughout.
+    pub double_iteration: bool,
 }
 
 impl ReducedFactor {
@@ -263,5 +267,10 @@ pub(super) fn reduce_factor(qp: &MonotoneQp<'_>, f: &Factor, free: &[usize], sca
         }
     }
     let symbolic = faer::sparse::SymbolicSparseColMat::new_checked(m.nrows(), free.len(), col_ptr, None, row_idx);
-    ReducedFactor { f: Sparse::new(symbolic, val), lo, g: g.iter().map(|v| v.0 + v.1).collect() }
+    ReducedFactor {
+        f: Sparse::new(symbolic, val),
+        lo,
+        g: g.iter().map(|v| v.0 + v.1).collect(),
+        double_iteration: false,
+    }
 }

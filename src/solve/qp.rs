@@ -3,7 +3,7 @@
 
 use super::newton::Prepared;
 use super::problem::{constraint_rows, reduce, reduce_factor, rescale, MonotoneQp, ReducedQp};
-use super::settings::{Formulation, Method, QpSettings, FACTORED_ABOVE};
+use super::settings::{Formulation, Method, QpSettings, DOUBLE_DOUBLE_ABOVE, FACTORED_ABOVE};
 use super::status::{QpSolution, SolveStatus};
 use crate::error::Result;
 use crate::linalg::Analyses;
@@ -67,7 +67,9 @@ pub fn solve_monotone_qp_with(
         if d_mean > 0.0 {
             rescale(reduced, d_mean);
         }
-        reduced.factor = Some(reduce_factor(qp, f, &free, reduced.scale));
+        let mut factor = reduce_factor(qp, f, &free, reduced.scale);
+        factor.double_iteration = reduced.gap_bound && condition.is_some_and(|c| c <= DOUBLE_DOUBLE_ABOVE);
+        reduced.factor = Some(factor);
     };
     let mut formulation = match (wants_factored, qp.factor) {
         (true, Some(f)) => {

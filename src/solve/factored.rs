@@ -14,7 +14,9 @@
 //! correction is formed in double-double, until it is below 10⁻²⁶ of the right-hand side. Where
 //! that stalls (the rounded matrix is not positive definite, or its errors exceed its smallest
 //! eigenvalues: κ beyond about 10¹⁴), the normal matrix is factorised in double-double itself
-//! (simplicial: faer's dense kernels are for native floats only), from then on.
+//! (simplicial: faer's dense kernels are for native floats only), from then on. A banded
+//! normal matrix (a series) is factorised in double-double from the start ([`Banded`]).
+//! [`Rounded`] runs the iteration itself in double, with this gradient and this solve.
 
 use super::banded::Banded;
 use super::newton::{Normal as Pattern, Objective, Rows};
@@ -25,6 +27,10 @@ use faer::fx128;
 use faer::sparse::linalg::cholesky::{LltRef, SymbolicCholesky};
 use faer::sparse::SparseColMatRef;
 use faer::{Conj, Par, Side, Spec};
+
+/// The diagonal shifts tried, in turn, when a double-double factorisation finds the normal
+/// matrix not positive definite (rounding at its smallest eigenvalues).
+const SHIFTS: [f64; 4] = [0.0, 1e-24, 1e-18, 1e-12];
 
 /// Refinement steps per solve before it counts as stalled.
 const REFINEMENT_STEPS: usize = 12;
@@ -149,8 +155,7 @@ impl<'r> Normal<'r> {
             self.exact = Some(Exact { symbolic, l, mem });
         }
         let e = self.exact.as_mut().expect("made above");
-        let mut reg = 0.0;
-        for attempt in 0..4 {
+        for reg in SHIFTS {
             let mut vals = self.vals.clone();
             if reg > 0.0 {
                 for &d in &self.pattern.pos_diag {
@@ -173,7 +178,6 @@ impl<'r> Normal<'r> {
             if ok {
                 return Ok(());
             }
-            reg = if attempt == 0 { 1e-24 } else { reg * 1e6 };
         }
         Err("the double-double normal matrix is not positive definite".into())
     }
@@ -225,7 +229,7 @@ impl Objective<fx128> for Normal<'_> {
         }
         if let Some(banded) = &mut self.banded {
             // the same regularisation as the general factorisation's, if it must
-            for reg in [0.0, 1e-24, 1e-18, 1e-12] {
+            for reg in SHIFTS {
                 if banded.factor(&self.vals, fx128::from(reg)) {
                     return Ok(());
                 }

@@ -55,9 +55,10 @@ pub(super) struct Normal<'r> {
     /// The normal matrix of the last factorisation, and rounded to double.
     vals: Vec<fx128>,
     rounded: Vec<f64>,
-    /// Its double-precision Cholesky factor (`None` when the rounded matrix is not positive
-    /// definite).
-    spd: linalg::SpdFactor,
+    /// Its double-precision Cholesky factor (`None` for a banded pattern, factorised in
+    /// double-double only).
+    spd: Option<linalg::SpdFactor>,
+    /// Whether `spd` holds the last normal matrix (its rounding is positive definite).
     spd_ok: bool,
     exact: Option<Exact>,
     /// A banded pattern (a series): factorised in double-double from the start
@@ -108,16 +109,20 @@ impl<'r> Normal<'r> {
         for (j, &d) in r.d.iter().enumerate() {
             base[pattern.pos_diag[j]] += fx128::from(d);
         }
-        let analysis = std::sync::Arc::new(linalg::analyse(pattern.symbolic.as_ref())?);
         let banded = linalg::is_banded(pattern.symbolic.as_ref())
             .then(|| Banded::new(pattern.symbolic.as_ref(), linalg::bandwidth(pattern.symbolic.as_ref())));
-        let spd = linalg::SpdFactor::new(analysis)?;
+        // the double factor and its rounded matrix only where refinement may use them
+        let spd = match banded {
+            Some(_) => None,
+            None => Some(linalg::SpdFactor::new(std::sync::Arc::new(linalg::analyse(pattern.symbolic.as_ref())?))?),
+        };
+        let rounded = if spd.is_some() { vec![0.0; base.len()] } else { Vec::new() };
         Ok(Normal {
             f,
             d: r.d.iter().map(|&v| fx128::from(v)).collect(),
             q: r.q_free.iter().map(|&v| fx128::from(v)).collect(),
             vals: base.clone(),
-            rounded: vec![0.0; base.len()],
+            rounded,
             base,
             pattern,
             spd,
@@ -128,12 +133,13 @@ impl<'r> Normal<'r> {
         })
     }
 
-    /// `y = N x` for the last normal matrix (upper triangle stored), in double-double.
-    fn multiply(&self, x: &[fx128], y: &mut [fx128]) {
+    /// `y = N x` for the normal matrix `vals` on `pattern` (upper triangle stored), in
+    /// double-double.
+    fn multiply(pattern: &Pattern, vals: &[fx128], x: &[fx128], y: &mut [fx128]) {
         y.iter_mut().for_each(|v| *v = fx128::from(0.0));
-        let (cp, ri) = (self.pattern.symbolic.col_ptr(), self.pattern.symbolic.row_idx());
+        let (cp, ri) = (pattern.symbolic.col_ptr(), pattern.symbolic.row_idx());
         for (j, &xj) in x.iter().enumerate() {
-            for (&i, &a) in ri[cp[j]..cp[j + 1]].iter().zip(&self.vals[cp[j]..cp[j + 1]]) {
+            for (&i, &a) in ri[cp[j]..cp[j + 1]].iter().zip(&vals[cp[j]..cp[j + 1]]) {
                 y[i] += a * xj;
                 if i != j {
                     y[j] += a * x[i];
@@ -242,8 +248,11 @@ impl Objective<fx128> for Normal<'_> {
         for (r, v) in self.rounded.iter_mut().zip(&self.vals) {
             *r = v.0 + v.1;
         }
+        let Some(spd) = self.spd.as_mut() else {
+            return self.factor_exact();
+        };
         let a = SparseColMatRef::new(self.pattern.symbolic.as_ref(), &self.rounded);
-        self.spd_ok = self.spd.factor(a).is_ok();
+        self.spd_ok = spd.factor(a).is_ok();
         if !self.spd_ok {
             return self.factor_exact();
         }
@@ -256,7 +265,7 @@ impl Objective<fx128> for Normal<'_> {
             return;
         }
         let n = rhs.len();
-        if self.exact.is_none() && self.spd_ok {
+        if let (None, true, Some(spd)) = (&self.exact, self.spd_ok, self.spd.as_mut()) {
             let norm = |v: &[fx128]| v.iter().fold(0.0f64, |a, x| a.max((x.0 + x.1).abs()));
             let target = REFINED * norm(rhs);
             let mut x = vec![fx128::from(0.0); n];
@@ -268,11 +277,11 @@ impl Objective<fx128> for Normal<'_> {
                 for (di, ri) in d.iter_mut().zip(&r) {
                     *di = ri.0 + ri.1;
                 }
-                self.spd.solve_in_place(&mut d);
+                spd.solve_in_place(&mut d);
                 for (xi, &di) in x.iter_mut().zip(&d) {
                     *xi += fx128::from(di);
                 }
-                self.multiply(&x, &mut nx);
+                Self::multiply(&self.pattern, &self.vals, &x, &mut nx);
                 for i in 0..n {
                     r[i] = rhs[i] - nx[i];
                 }

@@ -8,6 +8,12 @@ mod common;
 
 use common::{dataset, scratch, text, toposmooth};
 
+/// No output and no temporary in `dir`.
+fn nothing_left(dir: &std::path::Path) {
+    let left: Vec<_> = std::fs::read_dir(dir).unwrap().map(|e| e.unwrap().file_name()).collect();
+    assert!(left.is_empty(), "nothing written, no temporary: {left:?}");
+}
+
 fn report(path: &std::path::Path) -> serde_json::Value {
     serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
 }
@@ -25,8 +31,7 @@ fn a_run_predicted_past_its_budget_is_refused_before_the_solve_and_leaves_nothin
     assert!(stderr.contains("not enough memory: the interior-point route would need about"), "{stderr}");
     assert!(stderr.contains("over the memory budget of 4 MiB (the memory limit given)"), "{stderr}");
     assert!(stderr.contains("soapfilm_piv_vorticity_63x63.csv"), "the message names the file: {stderr}");
-    let left: Vec<_> = std::fs::read_dir(&dir).unwrap().map(|e| e.unwrap().file_name()).collect();
-    assert!(left.is_empty(), "nothing written, no temporary: {left:?}");
+    nothing_left(&dir);
     // the same run with room succeeds, and says what it predicted
     let o = toposmooth(&[&args[..], &["--memory-limit", "2G"]].concat());
     assert!(o.status.success(), "{}", text(&o));
@@ -80,8 +85,7 @@ fn an_active_set_run_predicted_past_its_budget_is_refused_before_the_solve() {
     assert!(stderr.contains("not enough memory: the active-set iteration would need about"), "{stderr}");
     assert!(stderr.contains("over the memory budget of 80 MiB"), "{stderr}");
     assert!(!stderr.contains("hand-over"), "refused, not handed to the interior-point route: {stderr}");
-    let left: Vec<_> = std::fs::read_dir(&dir).unwrap().map(|e| e.unwrap().file_name()).collect();
-    assert!(left.is_empty(), "nothing written, no temporary: {left:?}");
+    nothing_left(&dir);
 }
 
 /// What the prediction does not foresee (here: a budget given above an address-space limit)
@@ -112,6 +116,5 @@ fn an_allocation_refused_by_the_address_space_limit_ends_with_a_message_and_exit
         stderr.contains("error: not enough memory: an allocation of") && stderr.contains("bytes failed"),
         "{stderr}"
     );
-    let left: Vec<_> = std::fs::read_dir(&dir).unwrap().map(|e| e.unwrap().file_name()).collect();
-    assert!(left.is_empty(), "no output, no temporary: {left:?}");
+    nothing_left(&dir);
 }

@@ -65,22 +65,20 @@ const ND_LEAF: usize = 128;
 /// samples: 0.7 s per interior-point iteration, docs/performance.md).
 const BANDED_MAX: usize = 8;
 
-/// The largest distance of an entry of the upper-triangular pattern `a` from the diagonal.
-pub(crate) fn bandwidth(a: SymbolicSparseColMatRef<'_, usize>) -> usize {
-    (0..a.ncols()).map(|j| a.row_idx_of_col(j).map(|i| j.saturating_sub(i)).max().unwrap_or(0)).max().unwrap_or(0)
-}
-
-/// Whether the upper-triangular pattern `a` is banded ([`BANDED_MAX`]): factorised in its own
-/// order, at about n·b² flops.
-pub(crate) fn is_banded(a: SymbolicSparseColMatRef<'_, usize>) -> bool {
-    bandwidth(a) <= BANDED_MAX
+/// The band of the upper-triangular pattern `a` (the largest distance of an entry from the
+/// diagonal) if it is at most [`BANDED_MAX`]: such a pattern is factorised in its own order, at
+/// about n·b² flops.
+pub(crate) fn band(a: SymbolicSparseColMatRef<'_, usize>) -> Option<usize> {
+    let b = (0..a.ncols()).map(|j| a.row_idx_of_col(j).map(|i| j.saturating_sub(i)).max().unwrap_or(0)).max();
+    let b = b.unwrap_or(0);
+    (b <= BANDED_MAX).then_some(b)
 }
 
 /// The banded analysis of `a` ([`BANDED_MAX`]), if it is banded.
 fn banded(
     a: SymbolicSparseColMatRef<'_, usize>,
 ) -> Option<std::result::Result<SymbolicCholesky<usize>, NumericalError>> {
-    is_banded(a).then(|| {
+    band(a).map(|_| {
         let params = CholeskySymbolicParams {
             supernodal_flop_ratio_threshold: faer::sparse::linalg::SupernodalThreshold::FORCE_SIMPLICIAL,
             ..Default::default()

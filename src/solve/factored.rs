@@ -109,8 +109,7 @@ impl<'r> Normal<'r> {
         for (j, &d) in r.d.iter().enumerate() {
             base[pattern.pos_diag[j]] += fx128::from(d);
         }
-        let banded = linalg::is_banded(pattern.symbolic.as_ref())
-            .then(|| Banded::new(pattern.symbolic.as_ref(), linalg::bandwidth(pattern.symbolic.as_ref())));
+        let banded = linalg::band(pattern.symbolic.as_ref()).map(|b| Banded::new(pattern.symbolic.as_ref(), b));
         // the double factor and its rounded matrix only where refinement may use them
         let spd = match banded {
             Some(_) => None,
@@ -322,10 +321,12 @@ impl Objective<fx128> for Normal<'_> {
 /// evaluates it with errors of `10⁻¹⁶ κ |x|`, where this one is exact up to its rounding
 /// (`10⁻¹⁶ |∇φ|`), and the gap bound squares that residual over the data diagonal. The
 /// iterate itself loses nothing that matters in double (the objective at the rounded optimum
-/// is `½ δᵀPδ` above it, `δ ≈ 10⁻¹⁶ |x|`: about `10⁻³² κ` of the data term), nor do the
-/// slacks, multipliers and their Newton updates, whose errors the next residual measures.
-/// Keeping those in double-double as well made a series of 10⁶ samples cost 7× the assembled
-/// form per iteration (issue 38's "conditioning cliff").
+/// is `½ δᵀPδ` above it, `δ ≈ 10⁻¹⁶ |x|`: about `10⁻³² κ` of the data term), nor do the slacks.
+/// The multipliers do, at large κ: they grow like `κ·d·|x|`, and in double `Aᵀz` is resolved to
+/// `10⁻¹⁶ |z|` only, which floors `ρ = ∇φ + Aᵀz` and the bound's `½ Σ ρ²/d` (at κ = 10¹³ the
+/// gap stalled at 3·10⁻³ of the data term): hence [`super::settings::DOUBLE_DOUBLE_ABOVE`].
+/// Keeping everything in double-double below it made a series of 10⁶ samples cost 7× the
+/// assembled form per iteration (issue 38's "conditioning cliff").
 pub(super) struct Rounded<'r> {
     inner: Normal<'r>,
     x: Vec<fx128>,

@@ -74,7 +74,8 @@ pub const FACTORED_ABOVE: f64 = 1e9;
 /// form's cost instead of about 10×. Measured on a random walk of 3·10⁵ samples (1 % kept):
 /// at κ = 8·10⁹ and 1.3·10¹¹ both ways reach the same gap (6.9·10⁻⁸ and 2.0·10⁻⁷ of the data
 /// term; the assembled form 1.4·10⁻⁶ at 1.3·10¹¹); at 3.6·10¹² (3·10⁶ samples) the double
-/// iteration stalled at 2.4·10⁻⁵, and at 10¹³ its normal matrix lost definiteness.
+/// iteration stalled at 2.4·10⁻⁵, and at 10¹³ its normal matrix lost definiteness (the
+/// multipliers, of size κ·d·|x|, resolved in double only to 10⁻¹⁶ of that: `factored::Rounded`).
 pub const DOUBLE_DOUBLE_ABOVE: f64 = 1e11;
 
 /// Vertices from which [`Method::Auto`] takes the active-set iteration on a volume, whose

@@ -2,7 +2,6 @@
 //! `X,input,output,u,role`, X the input's x column name (`x` when it has none), plus a last
 //! column `filled` when missing samples were filled; and reading it back for `verify`.
 
-use super::format_f64;
 use crate::error::{Error, Location, Result};
 use crate::topology::Role;
 use std::path::Path;
@@ -45,30 +44,28 @@ pub fn stage_series_output(path: &Path, out: &SeriesOutput) -> Result<super::Sta
             COLUMNS.join(","),
             if filled.is_some() { ",filled" } else { "" }
         )?;
+        // one line at a time into a reused buffer: no string per number or cell
+        let mut line = String::new();
         for i in 0..out.input.len() {
-            write!(
-                w,
-                "{},{},{},{},{}",
-                csv_cell(&out.x_text[i]),
-                format_f64(out.input[i]),
-                format_f64(out.output[i]),
-                format_f64(out.u[i]),
-                out.roles[i].label()
-            )?;
-            match filled {
-                Some(f) => writeln!(w, ",{}", u8::from(f[i]))?,
-                None => writeln!(w)?,
+            use std::fmt::Write as _;
+            line.clear();
+            line.push_str(&csv_cell(&out.x_text[i]));
+            let _ = write!(line, ",{:?},{:?},{:?},{}", out.input[i], out.output[i], out.u[i], out.roles[i].label());
+            if let Some(f) = filled {
+                line.push_str(if f[i] { ",1" } else { ",0" });
             }
+            line.push('\n');
+            w.write_all(line.as_bytes())?;
         }
         Ok(())
     })
 }
 
-fn csv_cell(s: &str) -> String {
+fn csv_cell(s: &str) -> std::borrow::Cow<'_, str> {
     if s.contains([',', '"', '\n', '\r']) || s.trim() != s {
-        format!("\"{}\"", s.replace('"', "\"\""))
+        format!("\"{}\"", s.replace('"', "\"\"")).into()
     } else {
-        s.to_string()
+        s.into()
     }
 }
 
@@ -106,8 +103,8 @@ pub fn read_series_output(path: &Path) -> Result<SeriesOutput> {
     let mut out =
         SeriesOutput { x_name, x_text: vec![], input: vec![], output: vec![], u: vec![], roles: vec![], filled: None };
     let mut filled = Vec::new();
-    for rec in reader.records() {
-        let rec = rec.map_err(|e| err(format!("malformed CSV: {e}")))?;
+    let mut rec = csv::StringRecord::new();
+    while reader.read_record(&mut rec).map_err(|e| err(format!("malformed CSV: {e}")))? {
         let line = rec.position().map(|p| p.line()).unwrap_or(0);
         let bad = |msg: String| err(format!("line {line}: {msg}")).at(Location::Line(line as usize));
         let num = |c: usize, name: &str| -> Result<f64> {

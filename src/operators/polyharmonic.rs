@@ -1,8 +1,12 @@
 //! Polyharmonic energies of order 1..4, their blends, and sharp vertices.
 
-use super::sparse::{from_triplets, matmul, scale_cols, scale_rows, triplets, with_pattern_of, without_zeros, Sparse};
+use super::sparse::{
+    from_triplets, matmul, scale_cols_owned, scale_rows, scale_rows_owned, scaled_owned, triplets, with_pattern_of,
+    without_zeros, Sparse,
+};
 use crate::error::{Error, Result};
 use faer::sparse::Triplet;
+use std::borrow::Cow;
 
 /// A smoothness energy: a weighted sum of polyharmonic orders (Botsch & Kobbelt 2004) and
 /// the vertices where orders ≥ 2 are not penalised.
@@ -106,13 +110,13 @@ pub fn polyharmonic(k: &Sparse, m: &[f64], energy: &Energy, scale: &[f64]) -> Sp
     // The products run on K's non-zero entries only; the result keeps K's whole pattern (every
     // edge of the domain), where a monotone QP's constrained pairs lie.
     let k_full = k;
-    let k = &without_zeros(k_full);
+    let k = &*without_zeros(k_full);
     let mut sharp = vec![false; n];
     for &v in &energy.sharp {
         sharp[v] = true;
     }
     let d: Vec<f64> = (0..n).map(|i| if sharp[i] { 0.0 } else { 1.0 / m[i] }).collect();
-    let k_cut = if energy.sharp.is_empty() { k.clone() } else { cut_edges(k, &sharp) };
+    let k_cut = if energy.sharp.is_empty() { Cow::Borrowed(k) } else { Cow::Owned(cut_edges(k, &sharp)) };
     let minv: Vec<f64> = m.iter().map(|x| 1.0 / x).collect();
     let mut all = Vec::new();
     let mut single: Option<Sparse> = None;
@@ -126,17 +130,17 @@ pub fn polyharmonic(k: &Sparse, m: &[f64], energy: &Energy, scale: &[f64]) -> Sp
             1 => k_full.clone(),
             _ => {
                 let g = scale_rows(k, &d); // D K
-                let gt = scale_cols(k, &d); // K D = Gᵀ (K symmetric)
                 let inner = match order {
-                    2 => scale_rows(&g, m),                                       // M G
-                    3 => matmul(&k_cut, &g),                                      // K′ G
-                    _ => matmul(&k_cut, &scale_rows(&matmul(&k_cut, &g), &minv)), // K′ M⁻¹ K′ G
+                    2 => scale_rows_owned(g, m),                                       // M G
+                    3 => matmul(&k_cut, &g),                                           // K′ G
+                    _ => matmul(&k_cut, &scale_rows_owned(matmul(&k_cut, &g), &minv)), // K′ M⁻¹ K′ G
                 };
+                let gt = scale_cols_owned(k.clone(), &d); // K D = Gᵀ (K symmetric)
                 matmul(&gt, &inner)
             }
         };
         if active == 1 {
-            single = Some(super::sparse::scaled_plus_diagonal(&q, c, &vec![0.0; n]));
+            single = Some(scaled_owned(q, c));
         } else {
             all.extend(triplets(&q).into_iter().map(|t| Triplet::new(t.row, t.col, c * t.val)));
         }

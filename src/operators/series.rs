@@ -1,8 +1,7 @@
 //! Linear finite elements on a series (the 1D cotangent Laplacian).
 
-use super::sparse::{from_triplets, Sparse};
+use super::sparse::Sparse;
 use crate::domain::Series;
-use faer::sparse::Triplet;
 
 /// Stiffness `K = −L` (`#V × #V`) of piecewise-linear elements on a non-uniform series:
 /// `K[i][i+1] = −1/h_i`, `K[i][i] = 1/h_{i−1} + 1/h_i`, so `fᵀ K f = ∫ f′²` exactly for the
@@ -11,15 +10,32 @@ use faer::sparse::Triplet;
 /// See also [`series_mass`].
 pub fn series_stiffness(series: &Series) -> Sparse {
     let n = series.x().len();
-    let mut t = Vec::with_capacity(4 * n);
-    for (i, h) in series.spacings().into_iter().enumerate() {
-        let w = 1.0 / h;
-        t.push(Triplet::new(i, i, w));
-        t.push(Triplet::new(i + 1, i + 1, w));
-        t.push(Triplet::new(i, i + 1, -w));
-        t.push(Triplet::new(i + 1, i, -w));
+    let w: Vec<f64> = series.spacings().into_iter().map(|h| 1.0 / h).collect();
+    // tridiagonal, built column by column: rows j − 1, j, j + 1
+    let mut col_ptr = Vec::with_capacity(n + 1);
+    let (mut row_idx, mut val) = (Vec::with_capacity(3 * n), Vec::with_capacity(3 * n));
+    col_ptr.push(0);
+    for j in 0..n {
+        if j > 0 {
+            row_idx.push(j - 1);
+            val.push(-w[j - 1]);
+        }
+        let before = if j > 0 { w[j - 1] } else { 0.0 };
+        let after = if j + 1 < n { w[j] } else { 0.0 };
+        row_idx.push(j);
+        val.push(match (j > 0, j + 1 < n) {
+            (true, true) => before + after,
+            (true, false) => before,
+            _ => after,
+        });
+        if j + 1 < n {
+            row_idx.push(j + 1);
+            val.push(-w[j]);
+        }
+        col_ptr.push(row_idx.len());
     }
-    from_triplets(n, n, &t)
+    let symbolic = faer::sparse::SymbolicSparseColMat::new_checked(n, n, col_ptr, None, row_idx);
+    Sparse::new(symbolic, val)
 }
 
 /// Lumped (diagonal) mass: half of each adjacent interval, `M_ii = (h_{i−1} + h_i)/2`;
@@ -38,7 +54,26 @@ pub fn series_mass(series: &Series) -> Vec<f64> {
 mod tests {
     use super::*;
     use crate::operators::quadratic_form;
-    use crate::operators::sparse::mul_vec;
+    use crate::operators::sparse::{from_triplets, mul_vec};
+
+    #[test]
+    fn stiffness_is_the_sum_of_its_intervals() {
+        // against the element-by-element assembly it replaces, entry for entry
+        let s = Series::with_coordinates(vec![0.0, 0.5, 2.0, 2.25, 7.0]).unwrap();
+        let mut t = Vec::new();
+        for (i, h) in s.spacings().into_iter().enumerate() {
+            let w = 1.0 / h;
+            t.extend(
+                [(i, i, w), (i + 1, i + 1, w), (i, i + 1, -w), (i + 1, i, -w)]
+                    .map(|(a, b, v)| faer::sparse::Triplet::new(a, b, v)),
+            );
+        }
+        let assembled = from_triplets(5, 5, &t);
+        let k = series_stiffness(&s);
+        assert_eq!(k.symbolic().col_ptr(), assembled.symbolic().col_ptr());
+        assert_eq!(k.symbolic().row_idx(), assembled.symbolic().row_idx());
+        assert_eq!(k.val(), assembled.val());
+    }
 
     #[test]
     fn stiffness_is_the_dirichlet_energy() {

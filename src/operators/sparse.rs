@@ -23,27 +23,30 @@ pub(crate) fn triplets(a: &Sparse) -> Vec<Triplet<usize, usize, f64>> {
     out
 }
 
-/// `diag(d) · A` (same pattern, values scaled in place).
+/// `diag(d) · A` (same pattern).
 pub(crate) fn scale_rows(a: &Sparse, d: &[f64]) -> Sparse {
-    let mut out = a.clone();
-    let rows: Vec<usize> = out.symbolic().row_idx().to_vec();
-    for (v, &r) in out.val_mut().iter_mut().zip(&rows) {
-        *v *= d[r];
-    }
-    out
+    scale_rows_owned(a.clone(), d)
 }
 
-/// `A · diag(d)` (same pattern, values scaled in place).
-pub(crate) fn scale_cols(a: &Sparse, d: &[f64]) -> Sparse {
-    let mut out = a.clone();
-    let cp: Vec<usize> = out.symbolic().col_ptr().to_vec();
-    let val = out.val_mut();
-    for j in 0..d.len() {
+/// `diag(d) · A`, scaling `a`'s values in place.
+pub(crate) fn scale_rows_owned(mut a: Sparse, d: &[f64]) -> Sparse {
+    let (symbolic, val) = a.parts_mut();
+    for (v, &r) in val.iter_mut().zip(symbolic.row_idx()) {
+        *v *= d[r];
+    }
+    a
+}
+
+/// `A · diag(d)`, scaling `a`'s values in place.
+pub(crate) fn scale_cols_owned(mut a: Sparse, d: &[f64]) -> Sparse {
+    let (symbolic, val) = a.parts_mut();
+    let cp = symbolic.col_ptr();
+    for (j, &dj) in d.iter().enumerate() {
         for v in &mut val[cp[j]..cp[j + 1]] {
-            *v *= d[j];
+            *v *= dj;
         }
     }
-    out
+    a
 }
 
 /// `c · A + diag(d)`; the diagonal is added to the pattern where missing.
@@ -51,19 +54,35 @@ pub fn scaled_plus_diagonal(a: &Sparse, c: f64, d: &[f64]) -> Sparse {
     let n = a.nrows();
     let (cp, ri) = (a.symbolic().col_ptr(), a.symbolic().row_idx());
     if (0..n).all(|j| ri[cp[j]..cp[j + 1]].contains(&j)) {
-        let mut out = a.clone();
-        let (cp, ri) = (cp.to_vec(), ri.to_vec());
-        let val = out.val_mut();
-        for j in 0..n {
-            for p in cp[j]..cp[j + 1] {
-                val[p] = c * val[p] + if ri[p] == j { d[j] } else { 0.0 };
-            }
-        }
-        return out;
+        return scaled_plus_diagonal_owned(a.clone(), c, d);
     }
     let mut t: Vec<_> = triplets(a).into_iter().map(|t| Triplet::new(t.row, t.col, c * t.val)).collect();
     t.extend((0..n).map(|i| Triplet::new(i, i, d[i])));
     from_triplets(n, n, &t)
+}
+
+/// `c · A + diag(d)` in `a`'s storage, whose pattern holds every diagonal entry (checked).
+fn scaled_plus_diagonal_owned(mut a: Sparse, c: f64, d: &[f64]) -> Sparse {
+    let (symbolic, val) = a.parts_mut();
+    let (cp, ri) = (symbolic.col_ptr(), symbolic.row_idx());
+    for (j, &dj) in d.iter().enumerate() {
+        for p in cp[j]..cp[j + 1] {
+            val[p] = c * val[p] + if ri[p] == j { dj } else { 0.0 };
+        }
+    }
+    a
+}
+
+/// `c · A` for a matrix whose pattern holds every diagonal entry, in its own storage
+/// (`c · A + diag(0)` of [`scaled_plus_diagonal`], without a copy).
+pub(crate) fn scaled_owned(a: Sparse, c: f64) -> Sparse {
+    let n = a.nrows();
+    let (cp, ri) = (a.symbolic().col_ptr(), a.symbolic().row_idx());
+    if (0..n).all(|j| ri[cp[j]..cp[j + 1]].contains(&j)) {
+        scaled_plus_diagonal_owned(a, c, &vec![0.0; n])
+    } else {
+        scaled_plus_diagonal(&a, c, &vec![0.0; n])
+    }
 }
 
 /// `A + diag(d)`, reusing `a`'s storage when its pattern holds every diagonal entry.
@@ -105,10 +124,10 @@ pub fn quadratic_form_without_diagonal(a: &Sparse, d: &[f64], f: &[f64]) -> f64 
 /// grid split along one diagonal the cotangent weight of every diagonal edge is exactly 0, and
 /// without those entries a bilaplacian has 13 entries a column instead of 19, which halves the
 /// flops of its Cholesky factor.
-pub(crate) fn without_zeros(a: &Sparse) -> Sparse {
+pub(crate) fn without_zeros(a: &Sparse) -> std::borrow::Cow<'_, Sparse> {
     let (cp, ri, v) = (a.symbolic().col_ptr(), a.symbolic().row_idx(), a.val());
     if !(0..a.ncols()).any(|j| (cp[j]..cp[j + 1]).any(|p| v[p] == 0.0 && ri[p] != j)) {
-        return a.clone();
+        return std::borrow::Cow::Borrowed(a);
     }
     let mut col_ptr = Vec::with_capacity(a.ncols() + 1);
     let (mut row_idx, mut val) = (Vec::with_capacity(ri.len()), Vec::with_capacity(ri.len()));
@@ -123,7 +142,7 @@ pub(crate) fn without_zeros(a: &Sparse) -> Sparse {
         col_ptr.push(row_idx.len());
     }
     let symbolic = faer::sparse::SymbolicSparseColMat::new_checked(a.nrows(), a.ncols(), col_ptr, None, row_idx);
-    SparseColMat::new(symbolic, val)
+    std::borrow::Cow::Owned(SparseColMat::new(symbolic, val))
 }
 
 /// `A` with every position of `B`'s pattern stored (as an explicit zero where `A` has none).
@@ -226,6 +245,7 @@ mod tests {
         let w = without_zeros(&z);
         assert_eq!(pattern(&w), vec![vec![0, 2], vec![1], vec![2]]);
         assert_eq!(dense(&w), dense(&z));
+        assert!(matches!(without_zeros(&w), std::borrow::Cow::Borrowed(_)), "nothing to drop: no copy");
         assert_eq!(pattern(&without_zeros(&a)), vec![vec![1], vec![1, 4], vec![], vec![0]]);
     }
 }

@@ -1,5 +1,10 @@
 //! `LDLᵀ` of a symmetric banded matrix in the iteration's arithmetic, with reciprocal pivots:
-//! the factored form's normal matrix on a series, in double-double.
+//! the normal matrix on a series, in double (the assembled form) or double-double (the
+//! factored form).
+//!
+//! In double, faer's simplicial factorisation and solves of a pentadiagonal matrix spend
+//! most of their time on the general pattern's bookkeeping (at 10⁷ samples about 0.3 s a
+//! factorisation); the band's own loops do the n·b² products alone.
 //!
 //! faer's simplicial Cholesky in double-double divides by a pivot for every entry of the
 //! factor and of each triangular solve; a double-double division costs about ten products, and

@@ -13,6 +13,7 @@
 //! double-double ([`super::factored`]). Whatever it returns, the certificate decides the
 //! topology and the gap bound of the output as written decides the fit.
 
+use super::banded::Banded;
 use super::newton::{max, Normal, Objective, Prepared, Real, Rows};
 use super::problem::ReducedQp;
 use super::settings::QpSettings;
@@ -31,7 +32,10 @@ struct Assembled<'r> {
     r: &'r ReducedQp,
     normal: Normal,
     analysis: std::sync::Arc<ordering::Analysis>,
-    spd: ordering::SpdFactor,
+    /// The factor: faer's Cholesky, or for a banded pattern (a series) the band's own `LDLᵀ`
+    /// ([`Banded`]: faer's simplicial factorisation and solves of a pentadiagonal matrix cost
+    /// several times its n·b² products).
+    factor: Factorised,
     vals: Vec<f64>,
     /// `P` alone factorised (on the normal matrix's pattern), for [`Objective::energy_dual`].
     energy: Option<ordering::SpdFactor>,
@@ -71,17 +75,23 @@ impl Objective<f64> for Assembled<'_> {
                     vals[d] += reg;
                 }
             }
-            let mat = SparseColMatRef::new(normal.symbolic.as_ref(), vals);
-            match self.spd.factor(mat) {
-                Ok(()) => return Ok(()),
-                Err(_) => reg = if attempt == 0 { 1e-12 } else { reg * 1e3 },
+            let done = match &mut self.factor {
+                Factorised::Spd(spd) => spd.factor(SparseColMatRef::new(normal.symbolic.as_ref(), vals)).is_ok(),
+                Factorised::Banded(banded) => banded.factor(vals, 0.0),
+            };
+            if done {
+                return Ok(());
             }
+            reg = if attempt == 0 { 1e-12 } else { reg * 1e3 };
         }
         Err("the normal matrix is not positive definite".into())
     }
 
     fn solve_in_place(&mut self, rhs: &mut [f64]) {
-        self.spd.solve_in_place(rhs);
+        match &mut self.factor {
+            Factorised::Spd(spd) => spd.solve_in_place(rhs),
+            Factorised::Banded(banded) => banded.solve_in_place(rhs),
+        }
     }
 
     fn auxiliary(&self, _: &[f64]) -> Option<Vec<f64>> {
@@ -102,6 +112,12 @@ impl Objective<f64> for Assembled<'_> {
         self.energy.as_mut()?.solve_in_place(&mut y);
         Some(0.5 * r.iter().zip(&y).map(|(a, b)| a * b).sum::<f64>())
     }
+}
+
+/// How the assembled normal matrix is factorised.
+enum Factorised {
+    Spd(ordering::SpdFactor),
+    Banded(Banded<f64>),
 }
 
 /// The largest relative change of the iterate in one step at which the solver may stop (the
@@ -129,16 +145,17 @@ const POLISH_SWEEPS: usize = 5;
 /// on the same pattern); `prepared`, made in advance, is kept there first.
 pub(super) fn solve(
     r: &ReducedQp,
+    assembly: Option<Assembly>,
     hint: Option<&[f64]>,
     settings: &QpSettings,
     analyses: &mut ordering::Analyses,
     prepared: Option<Prepared>,
 ) -> std::result::Result<Outcome, crate::error::NumericalError> {
     let spare = prepared.and_then(|p| p.keep_in(analyses));
-    let rows = Rows::new(r)?;
     match &r.factor {
         Some(factor) => {
             drop(spare);
+            let rows = Rows::new(r)?;
             let objective = super::factored::Normal::new(r, factor, &rows.cols, &rows.len)?;
             if factor.double_iteration {
                 let mut objective = super::factored::Rounded::new(objective, r.n, r.m());
@@ -149,45 +166,68 @@ pub(super) fn solve(
             }
         }
         None => {
-            let normal = Normal::new(r, &rows.cols, &rows.len);
+            let Assembly { rows, normal } = match assembly {
+                Some(assembly) => assembly,
+                None => Assembly::new(r)?,
+            };
             let analysis = analyses.of(normal.symbolic.as_ref())?;
-            let spare = spare.filter(|(a, _)| std::sync::Arc::ptr_eq(a, &analysis));
-            let spd = match spare {
-                Some((_, workspace)) => ordering::SpdFactor::with_workspace(analysis.clone(), workspace),
-                None => ordering::SpdFactor::new(analysis.clone())?,
+            let factor = match ordering::band(normal.symbolic.as_ref()) {
+                Some(b) => Factorised::Banded(Banded::new(normal.symbolic.as_ref(), b)),
+                None => {
+                    let spare = spare.filter(|(a, _)| std::sync::Arc::ptr_eq(a, &analysis));
+                    Factorised::Spd(match spare {
+                        Some((_, workspace)) => ordering::SpdFactor::with_workspace(analysis.clone(), workspace),
+                        None => ordering::SpdFactor::new(analysis.clone())?,
+                    })
+                }
             };
             let vals = vec![0.0f64; normal.symbolic.row_idx().len()];
-            let mut objective = Assembled { r, normal, analysis, spd, vals, energy: None };
+            let mut objective = Assembled { r, normal, analysis, factor, vals, energy: None };
             run::<f64, _>(r, &rows, &mut objective, hint, settings)
         }
+    }
+}
+
+/// The assembled form's constraint rows and normal-matrix pattern, made once for both the
+/// memory prediction and the solve (at 10⁷ samples of a series each took seconds).
+pub(super) struct Assembly {
+    rows: Rows,
+    normal: Normal,
+}
+
+impl Assembly {
+    fn new(r: &ReducedQp) -> std::result::Result<Assembly, crate::error::NumericalError> {
+        let rows = Rows::new(r)?;
+        let normal = Normal::new(r, &rows.cols, &rows.len);
+        Ok(Assembly { rows, normal })
     }
 }
 
 /// The bytes the structured solver allocates for `r` (the assembled form) beyond what the
 /// caller holds, known before it allocates them: the normal matrix's factor and faer's
 /// scratch (from its analysis, made here and kept in `analyses`, where [`solve`] takes it),
-/// the normal matrix's values and pattern, the rows, and the iterate's vectors. `None` for
-/// the factored form, whose double-double storage is not predicted yet.
+/// the normal matrix's values and pattern, the rows, and the iterate's vectors; with the rows
+/// and the pattern made for it, which [`solve`] takes. `None` for the factored form, whose
+/// double-double storage is not predicted yet.
 ///
 /// # Errors
 /// A message if the analysis fails.
 pub(super) fn predicted_bytes(
     r: &ReducedQp,
     analyses: &mut ordering::Analyses,
-) -> std::result::Result<Option<u64>, crate::error::NumericalError> {
+) -> std::result::Result<Option<(u64, Assembly)>, crate::error::NumericalError> {
     if r.factor.is_some() {
         return Ok(None);
     }
-    let rows = Rows::new(r)?;
-    let normal = Normal::new(r, &rows.cols, &rows.len);
-    let analysis = analyses.of(normal.symbolic.as_ref())?;
-    let (n, m, nnz) = (r.n as u64, r.m() as u64, normal.symbolic.row_idx().len() as u64);
+    let assembly = Assembly::new(r)?;
+    let analysis = analyses.of(assembly.normal.symbolic.as_ref())?;
+    let (n, m, nnz) = (r.n as u64, r.m() as u64, assembly.normal.symbolic.row_idx().len() as u64);
     // values and row indices of the normal matrix, its position tables; the rows (two
     // columns, two values, a length); about 14 vectors of n and 18 of m in the iteration
     let normal_bytes = 16 * nnz + 8 * (n + 1) + 8 * (r.p.len() as u64 + 4 * m + n);
     let row_bytes = 33 * m;
     let vectors = 8 * (14 * n + 18 * m);
-    Ok(Some(analysis.numeric_bytes() + normal_bytes + row_bytes + vectors))
+    Ok(Some((analysis.numeric_bytes() + normal_bytes + row_bytes + vectors, assembly)))
 }
 
 /// The primal–dual iterate: `x`, the slacks `s = b − Ax` and the multipliers `z`.
@@ -363,6 +403,7 @@ fn run<T: Real, O: Objective<T>>(
     let mut w = vec![zero; m];
     let (one, mut inv_s) = (of(1.0), vec![zero; m]);
     let mut newton = Newton::new(n, m);
+    let (mut polished, mut rho) = if r.gap_bound { (vec![zero; m], vec![zero; n]) } else { (Vec::new(), Vec::new()) };
     let mut last = (f64::INFINITY, f64::INFINITY, f64::INFINITY);
     let mut last_step = f64::INFINITY;
     let mut progress = Progress { best_gap: f64::INFINITY, best_at: 0, first: None };
@@ -379,13 +420,13 @@ fn run<T: Real, O: Objective<T>>(
         let small_step = last_step <= STEP_TOLERANCE * (1.0 + xmax);
         let at = At { it: &point, res: &res, small_step, iteration: it };
         let (verdict, reported_z) = if r.gap_bound {
-            verdict_with_data(rows, &at, &targets, &mut progress)
+            verdict_with_data(rows, &at, &targets, &mut progress, (&mut polished, &mut rho))
         } else {
             (verdict_without_data(r, objective, &at, &targets, &mut progress), None)
         };
         let fallback_status = match verdict {
             Verdict::Stop(status) => {
-                return Ok(finish(&point.x, reported_z.as_deref().unwrap_or(&point.z), status, it, objective))
+                return Ok(finish(&point.x, reported_z.unwrap_or(&point.z), status, it, objective))
             }
             Verdict::Go(fallback) => fallback,
         };
@@ -457,12 +498,13 @@ fn residuals<T: Real, O: Objective<T>>(
 /// far from active still carries complementarity the point no longer needs; about one
 /// iteration less on the benchmark grids) against the data term. Returns the verdict and the
 /// polished multipliers, reported when it stops.
-fn verdict_with_data<T: Real>(
+fn verdict_with_data<'s, T: Real>(
     rows: &Rows,
     at: &At<'_, T>,
     t: &Targets<T>,
     progress: &mut Progress,
-) -> (Verdict, Option<Vec<T>>) {
+    (polished, rho): (&'s mut [T], &mut [T]),
+) -> (Verdict, Option<&'s [T]>) {
     let At { it, res, small_step, iteration } = *at;
     let (zero, of) = (T::of(0.0), T::of);
     let (x, z, d, inv_d) = (&it.x, &it.z, &t.d, &t.inv_d);
@@ -475,10 +517,12 @@ fn verdict_with_data<T: Real>(
         a + (e * e).div_by(d[i], inv_d[i])
     });
     let data = (0.5 * data.to_f64()).max(1e-20 * t.d_sum);
-    let mut polished = z.clone();
+    // the polished multipliers and their ρ in storage kept across iterations (at 10⁷ rows two
+    // fresh vectors an iteration were seconds of page faults)
+    polished.copy_from_slice(z);
     let gap = if pres <= t.tol {
-        let mut rho = res.rd.clone();
-        gap.min(polish_multipliers(rows, &res.slack, (d, inv_d), &mut rho, &mut polished, POLISH_SWEEPS).to_f64())
+        rho.copy_from_slice(&res.rd);
+        gap.min(polish_multipliers(rows, &res.slack, (d, inv_d), rho, polished, POLISH_SWEEPS).to_f64())
     } else {
         gap
     };
@@ -492,7 +536,7 @@ fn verdict_with_data<T: Real>(
     });
     progress.tell(gap / data, t.gap_tolerance);
     if pres <= t.tol && small_step && gap <= target {
-        return (Verdict::Stop(SolveStatus::Solved), Some(polished));
+        return (Verdict::Stop(SolveStatus::Solved), Some(&*polished));
     }
     let fallback = if pres > t.tol {
         None
@@ -507,7 +551,7 @@ fn verdict_with_data<T: Real>(
         (progress.best_gap, progress.best_at) = (gap, iteration);
     } else if pres <= t.tol && iteration >= progress.best_at + STALL_ITERATIONS && gap <= 1e2 * target {
         // the bound has reached its rounding floor, within 100× the target
-        return (Verdict::Stop(SolveStatus::AlmostSolved), Some(polished));
+        return (Verdict::Stop(SolveStatus::AlmostSolved), Some(&*polished));
     }
     (Verdict::Go(fallback), None)
 }

@@ -103,7 +103,10 @@ impl Prepared {
         let analysis = ordering::analyse(pattern.as_ref())?;
         // without it (faer's scratch could not be allocated, or it would not fit the budget) the
         // solver makes the storage, or refuses to
-        let workspace = if fits(analysis.numeric_bytes()) { ordering::Workspace::new(&analysis).ok() } else { None };
+        // (and a banded pattern, a series, gets its own factor in the solver: none made here)
+        let banded = ordering::band(pattern.as_ref()).is_some();
+        let workspace =
+            if !banded && fits(analysis.numeric_bytes()) { ordering::Workspace::new(&analysis).ok() } else { None };
         Ok(Prepared { pattern, analysis, workspace })
     }
 

@@ -148,7 +148,8 @@ pub(super) fn reduce(qp: &MonotoneQp<'_>, free: &[usize]) -> ReducedQp {
     let xfix = |i: usize| qp.fixed[i].unwrap_or(0.0);
     let mut q: Vec<f64> = free.iter().map(|&i| qp.q[i]).collect();
     let (cp, ri, val) = (qp.p.symbolic().col_ptr(), qp.p.symbolic().row_idx(), qp.p.val());
-    let mut p = Vec::new();
+    // the upper triangle of a symmetric pattern: half the off-diagonal entries and the diagonal
+    let mut p = Vec::with_capacity(cp[n] / 2 + n);
     let mut constant = 0.0;
     for j in 0..n {
         for k in cp[j]..cp[j + 1] {
@@ -185,7 +186,13 @@ pub(super) fn reduce(qp: &MonotoneQp<'_>, free: &[usize]) -> ReducedQp {
         scale,
         constant: constant / scale,
     };
-    for row in constraint_rows(qp) {
+    let rows = constraint_rows(qp);
+    r.b.reserve_exact(rows.len());
+    for v in [&mut r.a_row, &mut r.a_col] {
+        v.reserve_exact(2 * rows.len());
+    }
+    r.a_val.reserve_exact(2 * rows.len());
+    for row in rows {
         let at = r.b.len();
         let mut push = |col: usize, v: f64| {
             r.a_row.push(at);

@@ -36,11 +36,10 @@ pub fn solve_monotone_qp_with(
     assert_eq!(qp.p.nrows(), n);
     let free: Vec<usize> = (0..n).filter(|&i| qp.fixed[i].is_none()).collect();
     let mut x: Vec<f64> = qp.fixed.iter().map(|f| f.unwrap_or(0.0)).collect();
-    let rows = constraint_rows(qp);
     if free.is_empty() {
         return Ok(QpSolution {
             x,
-            z: vec![0.0; rows.len()],
+            z: vec![0.0; constraint_rows(qp).len()],
             y: None,
             status: SolveStatus::Trivial,
             iterations: 0,
@@ -131,8 +130,10 @@ pub fn solve_monotone_qp_with(
         (Some(out), _) => (out, Method::ActiveSet),
         (None, Method::Auto | Method::Structured | Method::ActiveSet) => {
             // the interior-point route's peak, predicted from its analysis before it allocates
-            // (the analysis is kept for the solve); past the budget it is refused, not started
-            if let Some(extra) = super::ipm::predicted_bytes(&reduced, analyses).ok().flatten() {
+            // (the analysis, the rows and the pattern are kept for the solve); past the budget
+            // it is refused, not started
+            let mut assembly = None;
+            if let Some((extra, made)) = super::ipm::predicted_bytes(&reduced, analyses).ok().flatten() {
                 let budget = crate::memory::Budget::of(settings.memory_limit);
                 let peak = budget.in_use() + extra + budget.kernel_reserve();
                 if peak > budget.bytes {
@@ -143,11 +144,12 @@ pub fn solve_monotone_qp_with(
                     return Err(crate::memory::over_budget(&what, peak, &budget));
                 }
                 predicted_peak = Some(predicted_peak.map_or(peak, |p: u64| p.max(peak)));
+                assembly = Some(made);
             }
             if let Some(why) = &fallback {
                 super::policy::announce_hand_over(why, Method::Structured);
             }
-            match super::ipm::solve(&reduced, hint.as_deref(), settings, analyses, prepared.take()) {
+            match super::ipm::solve(&reduced, assembly, hint.as_deref(), settings, analyses, prepared.take()) {
                 Ok(out) => (out, Method::Structured),
                 // the assembled normal matrix lost its definiteness (an energy without a data
                 // term, ill-conditioned on its own): the factored form in double-double next
@@ -159,7 +161,7 @@ pub fn solve_monotone_qp_with(
                 {
                     to_factored(&mut reduced, qp.factor.expect("checked"));
                     formulation = Formulation::Factored;
-                    match super::ipm::solve(&reduced, hint.as_deref(), settings, analyses, None) {
+                    match super::ipm::solve(&reduced, None, hint.as_deref(), settings, analyses, None) {
                         Ok(out) => (out, Method::Structured),
                         Err(why) => {
                             crate::progress::checkpoint()?;

@@ -205,7 +205,8 @@ impl Assembly {
 
 /// The bytes the structured solver allocates for `r` (the assembled form) beyond what the
 /// caller holds, known before it allocates them: the normal matrix's factor and faer's
-/// scratch (from its analysis, made here and kept in `analyses`, where [`solve`] takes it),
+/// scratch (from its analysis, made here and kept in `analyses`, where [`solve`] takes it; a
+/// banded pattern's own factor from its band),
 /// the normal matrix's values and pattern, the rows, and the iterate's vectors; with the rows
 /// and the pattern made for it, which [`solve`] takes. `None` for the factored form, whose
 /// double-double storage is not predicted yet.
@@ -227,7 +228,12 @@ pub(super) fn predicted_bytes(
     let normal_bytes = 16 * nnz + 8 * (n + 1) + 8 * (r.p.len() as u64 + 4 * m + n);
     let row_bytes = 33 * m;
     let vectors = 8 * (14 * n + 18 * m);
-    Ok(Some((analysis.numeric_bytes() + normal_bytes + row_bytes + vectors, assembly)))
+    let factor_bytes = match ordering::band(assembly.normal.symbolic.as_ref()) {
+        // the band's own LDLᵀ: L and the band (n·b and n·(b + 1) values), 1/D, the entries' slots
+        Some(b) => 8 * (n * (2 * b as u64 + 2) + nnz),
+        None => analysis.numeric_bytes(),
+    };
+    Ok(Some((factor_bytes + normal_bytes + row_bytes + vectors, assembly)))
 }
 
 /// The primal–dual iterate: `x`, the slacks `s = b − Ax` and the multipliers `z`.

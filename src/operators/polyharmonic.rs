@@ -1,8 +1,8 @@
 //! Polyharmonic energies of order 1..4, their blends, and sharp vertices.
 
 use super::sparse::{
-    from_triplets, matmul, scale_cols_owned, scale_rows, scale_rows_owned, scaled_owned, triplets, with_pattern_of,
-    without_zeros, Sparse,
+    from_triplets, matmul, scale_cols_owned, scale_rows, scale_rows_owned, scaled_plus_diagonal_owned, triplets,
+    with_pattern_of, without_zeros, Sparse,
 };
 use crate::error::{Error, Result};
 use faer::sparse::Triplet;
@@ -140,7 +140,7 @@ pub fn polyharmonic(k: &Sparse, m: &[f64], energy: &Energy, scale: &[f64]) -> Sp
             }
         };
         if active == 1 {
-            single = Some(scaled_owned(q, c));
+            single = Some(scaled_plus_diagonal_owned(q, c, &vec![0.0; n]));
         } else {
             all.extend(triplets(&q).into_iter().map(|t| Triplet::new(t.row, t.col, c * t.val)));
         }

@@ -16,21 +16,18 @@ pub fn series_stiffness(series: &Series) -> Sparse {
     let (mut row_idx, mut val) = (Vec::with_capacity(3 * n), Vec::with_capacity(3 * n));
     col_ptr.push(0);
     for j in 0..n {
-        if j > 0 {
-            row_idx.push(j - 1);
-            val.push(-w[j - 1]);
-        }
+        // the intervals left and right of sample j (0 past an end: w + 0 is w exactly)
         let before = if j > 0 { w[j - 1] } else { 0.0 };
         let after = if j + 1 < n { w[j] } else { 0.0 };
+        if j > 0 {
+            row_idx.push(j - 1);
+            val.push(-before);
+        }
         row_idx.push(j);
-        val.push(match (j > 0, j + 1 < n) {
-            (true, true) => before + after,
-            (true, false) => before,
-            _ => after,
-        });
+        val.push(before + after);
         if j + 1 < n {
             row_idx.push(j + 1);
-            val.push(-w[j]);
+            val.push(-after);
         }
         col_ptr.push(row_idx.len());
     }

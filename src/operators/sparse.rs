@@ -51,18 +51,33 @@ pub(crate) fn scale_cols_owned(mut a: Sparse, d: &[f64]) -> Sparse {
 
 /// `c · A + diag(d)`; the diagonal is added to the pattern where missing.
 pub fn scaled_plus_diagonal(a: &Sparse, c: f64, d: &[f64]) -> Sparse {
-    let n = a.nrows();
-    let (cp, ri) = (a.symbolic().col_ptr(), a.symbolic().row_idx());
-    if (0..n).all(|j| ri[cp[j]..cp[j + 1]].contains(&j)) {
-        return scaled_plus_diagonal_owned(a.clone(), c, d);
+    if holds_diagonal(a) {
+        let mut out = a.clone();
+        scale_and_add_diagonal(&mut out, c, d);
+        out
+    } else {
+        with_diagonal_added(a, c, d)
     }
-    let mut t: Vec<_> = triplets(a).into_iter().map(|t| Triplet::new(t.row, t.col, c * t.val)).collect();
-    t.extend((0..n).map(|i| Triplet::new(i, i, d[i])));
-    from_triplets(n, n, &t)
 }
 
-/// `c · A + diag(d)` in `a`'s storage, whose pattern holds every diagonal entry (checked).
-fn scaled_plus_diagonal_owned(mut a: Sparse, c: f64, d: &[f64]) -> Sparse {
+/// [`scaled_plus_diagonal`] in `a`'s own storage where its pattern holds the diagonal.
+pub(crate) fn scaled_plus_diagonal_owned(mut a: Sparse, c: f64, d: &[f64]) -> Sparse {
+    if holds_diagonal(&a) {
+        scale_and_add_diagonal(&mut a, c, d);
+        a
+    } else {
+        with_diagonal_added(&a, c, d)
+    }
+}
+
+/// Whether every diagonal entry is in `a`'s pattern.
+fn holds_diagonal(a: &Sparse) -> bool {
+    let (cp, ri) = (a.symbolic().col_ptr(), a.symbolic().row_idx());
+    (0..a.nrows()).all(|j| ri[cp[j]..cp[j + 1]].contains(&j))
+}
+
+/// `A ← c · A + diag(d)` for a pattern that holds the diagonal.
+fn scale_and_add_diagonal(a: &mut Sparse, c: f64, d: &[f64]) {
     let (symbolic, val) = a.parts_mut();
     let (cp, ri) = (symbolic.col_ptr(), symbolic.row_idx());
     for (j, &dj) in d.iter().enumerate() {
@@ -70,19 +85,14 @@ fn scaled_plus_diagonal_owned(mut a: Sparse, c: f64, d: &[f64]) -> Sparse {
             val[p] = c * val[p] + if ri[p] == j { dj } else { 0.0 };
         }
     }
-    a
 }
 
-/// `c · A` for a matrix whose pattern holds every diagonal entry, in its own storage
-/// (`c · A + diag(0)` of [`scaled_plus_diagonal`], without a copy).
-pub(crate) fn scaled_owned(a: Sparse, c: f64) -> Sparse {
+/// `c · A + diag(d)` through triplets, for a pattern missing diagonal entries.
+fn with_diagonal_added(a: &Sparse, c: f64, d: &[f64]) -> Sparse {
     let n = a.nrows();
-    let (cp, ri) = (a.symbolic().col_ptr(), a.symbolic().row_idx());
-    if (0..n).all(|j| ri[cp[j]..cp[j + 1]].contains(&j)) {
-        scaled_plus_diagonal_owned(a, c, &vec![0.0; n])
-    } else {
-        scaled_plus_diagonal(&a, c, &vec![0.0; n])
-    }
+    let mut t: Vec<_> = triplets(a).into_iter().map(|t| Triplet::new(t.row, t.col, c * t.val)).collect();
+    t.extend((0..n).map(|i| Triplet::new(i, i, d[i])));
+    from_triplets(n, n, &t)
 }
 
 /// `A + diag(d)`, reusing `a`'s storage when its pattern holds every diagonal entry.

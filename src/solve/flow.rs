@@ -13,17 +13,35 @@ pub(super) struct Network {
     next: Vec<u32>,
     to: Vec<u32>,
     residual: Vec<f64>,
+    /// Each node's level in the current phase (END outside it), and its current arc: kept
+    /// between calls so that a flow through one small component of a large network touches
+    /// that component only.
+    level: Vec<u32>,
+    current: Vec<u32>,
 }
 
 const END: u32 = u32::MAX;
 
 impl Network {
     pub(super) fn new(nodes: usize) -> Network {
-        Network { first: vec![END; nodes], next: Vec::new(), to: Vec::new(), residual: Vec::new() }
+        Network {
+            first: vec![END; nodes],
+            next: Vec::new(),
+            to: Vec::new(),
+            residual: Vec::new(),
+            level: vec![END; nodes],
+            current: vec![END; nodes],
+        }
+    }
+
+    pub(super) fn nodes(&self) -> usize {
+        self.first.len()
     }
 
     pub(super) fn add_node(&mut self) -> usize {
         self.first.push(END);
+        self.level.push(END);
+        self.current.push(END);
         self.first.len() - 1
     }
 
@@ -44,39 +62,40 @@ impl Network {
         self.residual[a ^ 1]
     }
 
-    fn levels(&self, s: usize, t: usize, eps: f64, level: &mut [u32], queue: &mut Vec<usize>) -> bool {
-        level.iter_mut().for_each(|l| *l = END);
-        level[s] = 0;
+    /// Levels by breadth-first search from `s` over the nodes it reaches (listed in `queue`;
+    /// every other node stays at END); true when `t` is among them.
+    fn levels(&mut self, s: usize, t: usize, eps: f64, queue: &mut Vec<usize>) -> bool {
+        for &u in queue.iter() {
+            self.level[u] = END;
+        }
+        self.level[s] = 0;
         queue.clear();
         queue.push(s);
         let mut head = 0;
         while head < queue.len() {
             let u = queue[head];
             head += 1;
+            self.current[u] = self.first[u];
             let mut a = self.first[u];
             while a != END {
                 let v = self.to[a as usize] as usize;
-                if level[v] == END && self.residual[a as usize] > eps {
-                    level[v] = level[u] + 1;
+                if self.level[v] == END && self.residual[a as usize] > eps {
+                    self.level[v] = self.level[u] + 1;
                     queue.push(v);
                 }
                 a = self.next[a as usize];
             }
         }
-        level[t] != END
+        self.level[t] != END
     }
 
     /// Pushes the maximum flow from `s` to `t`, ignoring residuals at or below `eps`; returns
-    /// its value.
+    /// its value. The work is within the nodes `s` reaches.
     pub(super) fn max_flow(&mut self, s: usize, t: usize, eps: f64) -> f64 {
-        let n = self.first.len();
-        let mut level = vec![END; n];
         let mut queue = Vec::new();
-        let mut current = vec![END; n];
         let mut path: Vec<u32> = Vec::new();
         let mut total = 0.0;
-        while self.levels(s, t, eps, &mut level, &mut queue) {
-            current.copy_from_slice(&self.first);
+        while self.levels(s, t, eps, &mut queue) {
             path.clear();
             let mut u = s;
             loop {
@@ -97,38 +116,40 @@ impl Network {
                     continue;
                 }
                 // advance along the current arc of u, or retreat when u has none left
-                let mut a = current[u];
+                let mut a = self.current[u];
                 while a != END {
                     let v = self.to[a as usize] as usize;
-                    if self.residual[a as usize] > eps && level[v] == level[u] + 1 {
+                    if self.residual[a as usize] > eps && self.level[v] == self.level[u] + 1 {
                         break;
                     }
                     a = self.next[a as usize];
                 }
-                current[u] = a;
+                self.current[u] = a;
                 if a != END {
                     path.push(a);
                     u = self.to[a as usize] as usize;
                     continue;
                 }
                 // dead end: no node at u's level reaches t through it any more
-                level[u] = END;
+                self.level[u] = END;
                 match path.pop() {
                     Some(back) => {
                         u = self.to[(back ^ 1) as usize] as usize;
-                        current[u] = self.next[current[u] as usize];
+                        self.current[u] = self.next[self.current[u] as usize];
                     }
                     None => break,
                 }
             }
         }
+        for &u in &queue {
+            self.level[u] = END;
+        }
         total
     }
 
-    /// The nodes reachable from `s` through residuals above `eps` (after [`Self::max_flow`]:
-    /// the source side of a minimum cut).
-    pub(super) fn reachable(&self, s: usize, eps: f64) -> Vec<bool> {
-        let mut seen = vec![false; self.first.len()];
+    /// Marks in `seen` the nodes reachable from `s` through residuals above `eps` (after
+    /// [`Self::max_flow`]: the source side of a minimum cut).
+    pub(super) fn mark_reachable(&self, s: usize, eps: f64, seen: &mut [bool]) {
         seen[s] = true;
         let mut stack = vec![s];
         while let Some(u) = stack.pop() {
@@ -142,6 +163,13 @@ impl Network {
                 a = self.next[a as usize];
             }
         }
+    }
+
+    /// The nodes reachable from `s` (see [`Self::mark_reachable`]).
+    #[cfg(test)]
+    pub(super) fn reachable(&self, s: usize, eps: f64) -> Vec<bool> {
+        let mut seen = vec![false; self.first.len()];
+        self.mark_reachable(s, eps, &mut seen);
         seen
     }
 }
@@ -192,6 +220,24 @@ mod tests {
         for (&(_, _, c), &a) in arcs.iter().zip(&ids) {
             assert!((0.0..=c + 1e-12).contains(&net.flow(a)));
         }
+    }
+
+    #[test]
+    fn flows_in_separate_components_stay_in_them() {
+        // component A: 0 → 2 → 1 (cap 3, then 5); component B: 3 → 4 → 5 (cap 7, then 2)
+        let mut net = Network::new(6);
+        let a_in = net.add_arc(0, 2, 3.0);
+        net.add_arc(2, 1, 5.0);
+        let b_in = net.add_arc(3, 4, 7.0);
+        let b_out = net.add_arc(4, 5, 2.0);
+        assert_eq!(net.max_flow(0, 1, 1e-12), 3.0);
+        assert_eq!(net.flow(b_in), 0.0);
+        assert_eq!(net.max_flow(3, 5, 1e-12), 2.0);
+        assert_eq!((net.flow(a_in), net.flow(b_out)), (3.0, 2.0));
+        let mut side = vec![false; net.nodes()];
+        net.mark_reachable(0, 1e-12, &mut side);
+        net.mark_reachable(3, 1e-12, &mut side);
+        assert_eq!(side, [true, false, false, true, true, false]);
     }
 
     #[test]

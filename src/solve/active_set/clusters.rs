@@ -100,14 +100,6 @@ impl Clusters {
         }
     }
 
-    /// `x` with the unknowns' values from `y` and the anchored ones at 0 (for products).
-    pub(super) fn expand_unknowns(&self, y: &[f64], x: &mut [f64]) {
-        for (xv, &c) in x.iter_mut().zip(&self.label) {
-            let u = self.unknown[c as usize];
-            *xv = if u == NONE { 0.0 } else { y[u as usize] };
-        }
-    }
-
     pub(super) fn gather(&self, x: &[f64], out: &mut [f64]) {
         out.iter_mut().for_each(|o| *o = 0.0);
         for (xv, &c) in x.iter().zip(&self.label) {

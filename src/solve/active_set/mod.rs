@@ -24,6 +24,7 @@ mod clusters;
 mod join;
 mod multipliers;
 mod objective;
+mod operator;
 mod rows;
 
 use super::problem::ReducedQp;
@@ -33,7 +34,8 @@ use crate::error::NumericalError;
 use clusters::{Clusters, NONE};
 use join::{join, Joined, ADD_ABOVE};
 use multipliers::{balanced_gradient, flow_multipliers, gap_bound, tree_multipliers};
-use objective::{solve_clustered, Csr, Objective};
+use objective::{solve_clustered, Objective};
+use operator::RowClasses;
 use rows::{rows_of, Row};
 
 /// Outer iterations at most.
@@ -69,9 +71,12 @@ pub(super) struct ActiveSetOutcome {
 
 /// Bytes the iteration allocates beside the reduced QP, at most, for `n` variables, `m` rows
 /// and `p_entries` stored entries of P's upper triangle: P in compressed rows (both triangles,
-/// 12 bytes an entry), the rows (32 bytes each) with their flags and multipliers, and per
-/// variable the clusters (labels, offsets, anchors, their adjacency), the conjugate gradients'
-/// eight vectors, the forest (order, parents, depths) and the join's tables; per row the
+/// 12 bytes an entry, before its repeated rows are merged), the rows (32 bytes each) with
+/// their flags and multipliers, and per variable its row class and the classes' hash (36
+/// bytes when no row repeats), the clusters (labels, offsets, anchors, their adjacency), the
+/// conjugate gradients' eight vectors and unknown map, the forest (order, parents, depths)
+/// and the join's tables, the flow's nodes (a variable's, its cluster's source and sink: 36
+/// bytes); per row the
 /// cluster and forest adjacency and the flow network (two arcs of 16 bytes, doubled by the
 /// growth of its vectors, and the arc list). Counted as if every phase's storage were live at
 /// once, so an upper bound of the iteration's own peak.
@@ -79,7 +84,7 @@ pub(super) struct ActiveSetOutcome {
 pub(crate) fn predicted_bytes(n: usize, m: usize, p_entries: usize) -> u64 {
     let (n, m, p) = (n as u64, m as u64, p_entries as u64);
     let csr = 12 * (2 * p) + 8 * (n + 1);
-    let per_variable = 24 + 72 + 72 + 70 + 28 + 4 + 15;
+    let per_variable = 36 + 24 + 72 + 76 + 70 + 28 + 4 + 15 + 36;
     let per_row = 32 + 10 + 32 + 16 + 96 + 17;
     csr + per_variable * n + per_row * m
 }
@@ -99,7 +104,10 @@ pub(super) fn solve(
     }
     let n = r.n;
     let rows = rows_of(r)?;
-    let obj = Objective { p: Csr::from_upper(n, &r.p), q: &r.q, d: &r.d, q_free: &r.q_free };
+    let obj = Objective { p: RowClasses::from_upper(n, &r.p)?, q: &r.q, d: &r.d, q_free: &r.q_free };
+    if std::env::var_os("TOPOSMOOTH_TRACE_ACTIVE").is_some() {
+        eprintln!("active set: {n} variables, {} rows, P in {} row classes", rows.len(), obj.p.classes());
+    }
     let mut x: Vec<f64> = match hint {
         Some(h) => h.to_vec(),
         None => r.q_free.iter().zip(&r.d).map(|(q, d)| -q / d).collect(),

@@ -195,22 +195,29 @@ pub(super) fn flow_multipliers(
 ) -> usize {
     let n = x.len();
     let nc = cl.anchor.len();
+    // per marked cluster its own source and sink (a network per cluster: each flow's phases
+    // search that cluster only), then a node per variable
+    let mut terminals = vec![(NONE, NONE); nc];
     let mut node = vec![NONE; n];
-    let mut count = 2usize; // 0 the source, 1 the sink
+    let mut count = 0usize;
     let mut scale = 0.0f64;
     for v in 0..n {
-        if marked[cl.label[v] as usize] {
+        let c = cl.label[v] as usize;
+        if marked[c] {
+            if terminals[c].0 == NONE {
+                terminals[c] = (count as u32, count as u32 + 1);
+                count += 2;
+            }
             node[v] = count as u32;
             count += 1;
             scale = scale.max(balanced[v].abs());
         }
     }
-    if count == 2 || scale == 0.0 {
+    if count == 0 || scale == 0.0 {
         return 0;
     }
     let eps = 1e-14 * scale;
     let mut net = Network::new(count);
-    let (source, sink) = (0, 1);
     // per cluster: the sum to send out, the supply arcs, the smallest data diagonal
     let mut sum = vec![0.0; nc];
     let mut dmin = vec![f64::INFINITY; nc];
@@ -220,6 +227,7 @@ pub(super) fn flow_multipliers(
             continue;
         }
         let c = cl.label[v] as usize;
+        let (source, sink) = (terminals[c].0 as usize, terminals[c].1 as usize);
         let out = -balanced[v];
         sum[c] += out;
         dmin[c] = dmin[c].min(d[v]);
@@ -240,6 +248,7 @@ pub(super) fn flow_multipliers(
             }
             Row::Bound(v, a, _) if in_set[k] && node[v] != NONE => {
                 let c = cl.label[v] as usize;
+                let (source, sink) = (terminals[c].0 as usize, terminals[c].1 as usize);
                 let hub = net.add_node();
                 if a > 0.0 {
                     // x_v ≤ b: the anchor takes what the cluster sends out
@@ -253,13 +262,16 @@ pub(super) fn flow_multipliers(
             Row::Bound(..) => {}
         }
     }
-    net.max_flow(source, sink, eps);
+    let mut side = vec![false; net.nodes()];
+    for &(source, sink) in terminals.iter().filter(|t| t.0 != NONE) {
+        net.max_flow(source as usize, sink as usize, eps);
+        net.mark_reachable(source as usize, eps, &mut side);
+    }
     let mut deficit = vec![0.0; nc];
     for &(c, a, cap) in &supply {
         deficit[c as usize] += cap - net.flow(a);
     }
     let cut: Vec<bool> = (0..nc).map(|c| marked[c] && deficit[c] * deficit[c] / dmin[c] > significant).collect();
-    let side = net.reachable(source, eps);
     let mut dropped = 0;
     for &(k, a) in &arcs {
         z[k] = net.flow(a);

@@ -1,79 +1,14 @@
-//! The objective as the iteration uses it: P in compressed rows and the conjugate gradients
-//! on the cluster values.
+//! The objective as the iteration uses it and the conjugate gradients on the cluster values.
 
 use super::clusters::{Clusters, NONE};
+use super::operator::RowClasses;
 
 /// Conjugate-gradient iterations per solve at most.
 const MAX_CG: usize = 5000;
 
-/// P (both triangles, exact zeros dropped) in compressed rows.
-pub(super) struct Csr {
-    pub(super) ptr: Vec<usize>,
-    pub(super) col: Vec<u32>,
-    pub(super) val: Vec<f64>,
-}
-
-impl Csr {
-    pub(super) fn from_upper(n: usize, p: &[(usize, usize, f64)]) -> Csr {
-        let mut count = vec![0usize; n + 1];
-        for &(i, j, v) in p {
-            if v != 0.0 {
-                count[i + 1] += 1;
-                if i != j {
-                    count[j + 1] += 1;
-                }
-            }
-        }
-        for k in 0..n {
-            count[k + 1] += count[k];
-        }
-        let ptr = count.clone();
-        let nnz = ptr[n];
-        let (mut col, mut val) = (vec![0u32; nnz], vec![0.0; nnz]);
-        let mut at = count;
-        for &(i, j, v) in p {
-            if v != 0.0 {
-                col[at[i]] = j as u32;
-                val[at[i]] = v;
-                at[i] += 1;
-                if i != j {
-                    col[at[j]] = i as u32;
-                    val[at[j]] = v;
-                    at[j] += 1;
-                }
-            }
-        }
-        Csr { ptr, col, val }
-    }
-
-    pub(super) fn rows_into(&self, start: usize, x: &[f64], y: &mut [f64]) {
-        for (k, yi) in y.iter_mut().enumerate() {
-            let i = start + k;
-            let mut acc = 0.0;
-            for p in self.ptr[i]..self.ptr[i + 1] {
-                acc += self.val[p] * x[self.col[p] as usize];
-            }
-            *yi = acc;
-        }
-    }
-
-    /// `y = P x`, the rows split between the threads the cap allows.
-    pub(super) fn apply(&self, x: &[f64], y: &mut [f64]) {
-        let n = y.len();
-        if n < 20_000 || crate::parallel::threads() < 2 {
-            return self.rows_into(0, x, y);
-        }
-        // split where the stored entries halve
-        let half = self.ptr[n] / 2;
-        let mid = self.ptr.partition_point(|&p| p < half).clamp(1, n - 1);
-        let (a, b) = y.split_at_mut(mid);
-        crate::parallel::join(|| self.rows_into(0, x, a), || self.rows_into(mid, x, b));
-    }
-}
-
 /// The objective's pieces the iteration needs.
 pub(super) struct Objective<'a> {
-    pub(super) p: Csr,
+    pub(super) p: RowClasses,
     pub(super) q: &'a [f64],
     pub(super) d: &'a [f64],
     pub(super) q_free: &'a [f64],
@@ -127,9 +62,9 @@ pub(super) fn solve_clustered(obj: &Objective<'_>, cl: &Clusters, x: &mut [f64],
         if u == NONE {
             continue;
         }
-        for p in obj.p.ptr[i]..obj.p.ptr[i + 1] {
-            if cl.label[obj.p.col[p] as usize] == ci {
-                diag[u as usize] += obj.p.val[p];
+        for (j, v) in obj.p.row(i) {
+            if cl.label[j] == ci {
+                diag[u as usize] += v;
             }
         }
     }
@@ -146,25 +81,45 @@ pub(super) fn solve_clustered(obj: &Objective<'_>, cl: &Clusters, x: &mut [f64],
     let mut dir = zv.clone();
     let mut rz: f64 = r.iter().zip(&zv).map(|(a, b)| a * b).sum();
     let mut hd = vec![0.0; nu];
+    // each variable's unknown (NONE when anchored); the identity when no row is in the set
+    let of_vertex: Vec<u32> = cl.label.iter().map(|&c| cl.unknown[c as usize]).collect();
+    let identity = nu == n && of_vertex.iter().enumerate().all(|(v, &u)| u as usize == v);
     let mut it = 0;
-    while it < MAX_CG && measure(&r) > tolerance {
+    let mut m = measure(&r);
+    while it < MAX_CG && m > tolerance {
         if it % 32 == 31 && crate::progress::cancelled() {
             break;
         }
-        cl.expand_unknowns(&dir, &mut xs);
-        obj.p.apply(&xs, &mut px);
-        cl.gather(&px, &mut hd);
+        if identity {
+            obj.p.apply(&dir, &mut hd);
+        } else {
+            for (xv, &u) in xs.iter_mut().zip(&of_vertex) {
+                *xv = if u == NONE { 0.0 } else { dir[u as usize] };
+            }
+            obj.p.apply(&xs, &mut px);
+            hd.iter_mut().for_each(|h| *h = 0.0);
+            for (&pv, &u) in px.iter().zip(&of_vertex) {
+                if u != NONE {
+                    hd[u as usize] += pv;
+                }
+            }
+        }
         let dhd: f64 = dir.iter().zip(&hd).map(|(a, b)| a * b).sum();
         if dhd <= 0.0 || !dhd.is_finite() {
             break;
         }
         let alpha = rz / dhd;
+        // one pass: the step, the residual, its preconditioned form and both sums (each
+        // summed in index order, as separate passes would)
+        let (mut rz_new, mut rd) = (0.0, 0.0);
         for k in 0..nu {
             y[k] += alpha * dir[k];
             r[k] -= alpha * hd[k];
+            zv[k] = r[k] / diag[k];
+            rz_new += r[k] * zv[k];
+            rd += r[k] * r[k] / dsum[k].max(f64::MIN_POSITIVE);
         }
-        zv.iter_mut().zip(&r).zip(&diag).for_each(|((z, r), d)| *z = r / d);
-        let rz_new: f64 = r.iter().zip(&zv).map(|(a, b)| a * b).sum();
+        m = 0.5 * rd;
         let beta = rz_new / rz;
         rz = rz_new;
         dir.iter_mut().zip(&zv).for_each(|(p, z)| *p = z + beta * *p);

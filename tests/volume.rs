@@ -1036,3 +1036,28 @@ fn a_tie_heavy_quantised_volume_is_solved_by_the_active_set_iteration_without_a_
     assert_eq!(maxs, (0..count).filter(|&v| out.roles[v] == Role::Max).collect::<Vec<_>>());
     assert!(mins.len() + maxs.len() > 20, "a selection with {} kept extrema", mins.len() + maxs.len());
 }
+
+#[test]
+fn the_active_set_iteration_gives_the_same_bits_on_1_2_and_3_threads() {
+    use toposmooth::parallel::with_threads;
+    use toposmooth::solve::Method;
+    // large enough that the products, the unknowns' blocks and the flows split between threads
+    let n = [40, 36, 30];
+    let count: usize = n.iter().product();
+    let noise = uniform(11, count);
+    let h: Vec<f64> = (0..count)
+        .map(|v| {
+            let (x, y, z) = ((v % n[0]) as f64, ((v / n[0]) % n[1]) as f64, (v / (n[0] * n[1])) as f64);
+            (0.25 * x).sin() * (0.2 * y).cos() + 0.3 * (0.3 * z).sin() + 0.2 * (noise[v] - 0.5)
+        })
+        .collect();
+    let g = Grid3d::with_geometry(n, [1.0; 3], [0.0; 3]).unwrap();
+    let settings = SmoothSettings { selection: Selection::Relative(0.1), ..Default::default() };
+    let runs: Vec<_> = (1..=3).map(|t| with_threads(t, || smooth(&g, &h, &settings).unwrap())).collect();
+    for (t, r) in runs.iter().enumerate() {
+        assert_eq!(r.report.solver, Method::ActiveSet, "{:?}", r.report.solver_fallback);
+        assert!(r.report.certificate.passed);
+        assert!(r.output == runs[0].output, "1 and {} threads give different outputs", t + 1);
+    }
+    assert!(runs[0].report.solver_inner_iterations > 100, "{}", runs[0].report.solver_inner_iterations);
+}

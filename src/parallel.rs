@@ -94,19 +94,6 @@ pub fn join<RA, RB: Send>(a: impl FnOnce() -> RA, b: impl FnOnce() -> RB + Send)
     })
 }
 
-/// `f` on each item, the items split in halves between the threads the cap allows; the
-/// results in the items' order (so a sum over them, added in order, is the same for every
-/// thread count).
-pub fn map_items<W: Send, R: Send>(items: &mut [W], f: &(impl Fn(&mut W) -> R + Sync)) -> Vec<R> {
-    if items.len() < 2 || threads() < 2 {
-        return items.iter_mut().map(f).collect();
-    }
-    let (a, b) = items.split_at_mut(items.len() / 2);
-    let (mut ra, rb) = join(|| map_items(a, f), || map_items(b, f));
-    ra.extend(rb);
-    ra
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -126,20 +113,5 @@ mod tests {
         assert_eq!(threads(), default_threads(), "restored after a panic");
         // faer's kernels follow the cap: one thread is sequential
         assert_eq!(with_threads(1, faer_par), faer::Par::Seq);
-    }
-
-    #[test]
-    fn items_are_mapped_in_order_on_any_thread_count() {
-        for t in [1, 2, 3, 5] {
-            let mut items: Vec<(usize, Vec<u64>)> = (0..11).map(|i| (i, vec![i as u64; 3])).collect();
-            let out = with_threads(t, || {
-                map_items(&mut items, &|(i, v)| {
-                    v.iter_mut().for_each(|x| *x += 1);
-                    *i * 10
-                })
-            });
-            assert_eq!(out, (0..11).map(|i| i * 10).collect::<Vec<_>>(), "{t} threads");
-            assert!(items.iter().all(|(i, v)| v.iter().all(|&x| x == *i as u64 + 1)));
-        }
     }
 }

@@ -69,18 +69,23 @@ impl Network {
             self.level[u] = END;
         }
         self.level[s] = 0;
+        self.current[s] = self.first[s];
         queue.clear();
         queue.push(s);
         let mut head = 0;
         while head < queue.len() {
             let u = queue[head];
+            // no shortest path runs through a node at t's level or beyond: stop there
+            if self.level[t] != END && self.level[u] >= self.level[t] {
+                break;
+            }
             head += 1;
-            self.current[u] = self.first[u];
             let mut a = self.first[u];
             while a != END {
                 let v = self.to[a as usize] as usize;
                 if self.level[v] == END && self.residual[a as usize] > eps {
                     self.level[v] = self.level[u] + 1;
+                    self.current[v] = self.first[v];
                     queue.push(v);
                 }
                 a = self.next[a as usize];

@@ -288,21 +288,24 @@ fn a_volume_with_one_flat_axis_is_a_2d_grid() {
     assert!(text(&o).contains("9 × 7 grid"), "{}", text(&o));
 }
 
+/// `f(x, y, z, noise)` at every voxel of an `n` volume, x fastest, the noise uniform in [0, 1)
+/// from `seed`.
+fn noisy_field(n: [usize; 3], seed: u64, f: impl Fn(f64, f64, f64, f64) -> f64) -> Vec<f64> {
+    let count: usize = n.iter().product();
+    let noise = uniform(seed, count);
+    (0..count).map(|v| f((v % n[0]) as f64, ((v / n[0]) % n[1]) as f64, (v / (n[0] * n[1])) as f64, noise[v])).collect()
+}
+
 #[test]
 fn the_active_set_iteration_and_clarabel_smooth_a_noisy_volume_to_the_interior_point_optimum() {
     use toposmooth::solve::{Method, QpSettings};
     let n = [18, 15, 12];
     let count: usize = n.iter().product();
-    let noise = uniform(7, count);
     // two bumps and a dip with 5 % noise
-    let h: Vec<f64> = (0..count)
-        .map(|v| {
-            let (x, y, z) = ((v % n[0]) as f64, ((v / n[0]) % n[1]) as f64, (v / (n[0] * n[1])) as f64);
-            let bump =
-                |cx: f64, cy: f64, cz: f64| (-((x - cx).powi(2) + (y - cy).powi(2) + (z - cz).powi(2)) / 12.0).exp();
-            bump(4.0, 4.0, 3.0) + bump(13.0, 10.0, 8.0) - bump(9.0, 11.0, 3.0) + 0.1 * (noise[v] - 0.5)
-        })
-        .collect();
+    let h = noisy_field(n, 7, |x, y, z, noise| {
+        let bump = |cx: f64, cy: f64, cz: f64| (-((x - cx).powi(2) + (y - cy).powi(2) + (z - cz).powi(2)) / 12.0).exp();
+        bump(4.0, 4.0, 3.0) + bump(13.0, 10.0, 8.0) - bump(9.0, 11.0, 3.0) + 0.1 * (noise - 0.5)
+    });
     let g = Grid3d::with_geometry(n, [1.0; 3], [0.0; 3]).unwrap();
     let run = |method| {
         let settings = SmoothSettings {
@@ -342,15 +345,10 @@ fn the_active_set_iteration_and_clarabel_smooth_a_noisy_volume_to_the_interior_p
 #[test]
 fn the_default_solver_is_the_active_set_iteration_on_volumes_of_1000_voxels_and_more() {
     use toposmooth::solve::{Method, ACTIVE_SET_FROM};
-    let field = |n: [usize; 3]| -> Vec<f64> {
-        let count: usize = n.iter().product();
-        let noise = uniform(3, count);
-        (0..count)
-            .map(|v| {
-                let (x, y, z) = ((v % n[0]) as f64, ((v / n[0]) % n[1]) as f64, (v / (n[0] * n[1])) as f64);
-                (0.4 * x).sin() * (0.3 * y).cos() + 0.2 * (0.5 * z).sin() + 0.05 * (noise[v] - 0.5)
-            })
-            .collect()
+    let field = |n: [usize; 3]| {
+        noisy_field(n, 3, |x, y, z, noise| {
+            (0.4 * x).sin() * (0.3 * y).cos() + 0.2 * (0.5 * z).sin() + 0.05 * (noise - 0.5)
+        })
     };
     for (n, expected) in [([9, 8, 7], Method::Structured), ([18, 15, 12], Method::ActiveSet)] {
         let count: usize = n.iter().product();
@@ -1041,16 +1039,11 @@ fn a_tie_heavy_quantised_volume_is_solved_by_the_active_set_iteration_without_a_
 fn the_active_set_iteration_gives_the_same_bits_on_1_2_and_3_threads() {
     use toposmooth::parallel::with_threads;
     use toposmooth::solve::Method;
-    // large enough that the products, the unknowns' blocks and the flows split between threads
+    // large enough (over 20,000 variables) that the products split between threads
     let n = [40, 36, 30];
-    let count: usize = n.iter().product();
-    let noise = uniform(11, count);
-    let h: Vec<f64> = (0..count)
-        .map(|v| {
-            let (x, y, z) = ((v % n[0]) as f64, ((v / n[0]) % n[1]) as f64, (v / (n[0] * n[1])) as f64);
-            (0.25 * x).sin() * (0.2 * y).cos() + 0.3 * (0.3 * z).sin() + 0.2 * (noise[v] - 0.5)
-        })
-        .collect();
+    let h = noisy_field(n, 11, |x, y, z, noise| {
+        (0.25 * x).sin() * (0.2 * y).cos() + 0.3 * (0.3 * z).sin() + 0.2 * (noise - 0.5)
+    });
     let g = Grid3d::with_geometry(n, [1.0; 3], [0.0; 3]).unwrap();
     let settings = SmoothSettings { selection: Selection::Relative(0.1), ..Default::default() };
     let runs: Vec<_> = (1..=3).map(|t| with_threads(t, || smooth(&g, &h, &settings).unwrap())).collect();

@@ -99,14 +99,4 @@ impl Clusters {
             };
         }
     }
-
-    pub(super) fn gather(&self, x: &[f64], out: &mut [f64]) {
-        out.iter_mut().for_each(|o| *o = 0.0);
-        for (xv, &c) in x.iter().zip(&self.label) {
-            let u = self.unknown[c as usize];
-            if u != NONE {
-                out[u as usize] += xv;
-            }
-        }
-    }
 }

@@ -42,12 +42,15 @@ pub(super) fn solve_clustered(obj: &Objective<'_>, cl: &Clusters, x: &mut [f64],
         cl.expand(&[], x);
         return 0;
     }
+    // each variable's unknown (NONE when anchored); the identity when no row is in the set
+    let of_vertex: Vec<u32> = cl.label.iter().map(|&c| cl.unknown[c as usize]).collect();
+    let identity = nu == n && of_vertex.iter().enumerate().all(|(v, &u)| u as usize == v);
     // start: cluster means; weights D_c; Jacobi diagonal of CᵀPC
     let mut y = vec![0.0; nu];
     let mut size = vec![0.0; nu];
     let mut dsum = vec![0.0; nu];
     for (v, xv) in x.iter().enumerate() {
-        let u = cl.unknown[cl.label[v] as usize];
+        let u = of_vertex[v];
         if u != NONE {
             y[u as usize] += xv - cl.offset[v];
             size[u as usize] += 1.0;
@@ -56,14 +59,12 @@ pub(super) fn solve_clustered(obj: &Objective<'_>, cl: &Clusters, x: &mut [f64],
     }
     y.iter_mut().zip(&size).for_each(|(y, s)| *y /= s);
     let mut diag = vec![0.0; nu];
-    for i in 0..n {
-        let ci = cl.label[i];
-        let u = cl.unknown[ci as usize];
+    for (i, &u) in of_vertex.iter().enumerate() {
         if u == NONE {
             continue;
         }
         for (j, v) in obj.p.row(i) {
-            if cl.label[j] == ci {
+            if cl.label[j] == cl.label[i] {
                 diag[u as usize] += v;
             }
         }
@@ -74,16 +75,13 @@ pub(super) fn solve_clustered(obj: &Objective<'_>, cl: &Clusters, x: &mut [f64],
     cl.expand(&y, x);
     obj.gradient(x, &mut px);
     let mut r = vec![0.0; nu];
-    cl.gather(&px, &mut r);
+    gather(&of_vertex, &px, &mut r);
     r.iter_mut().for_each(|v| *v = -*v);
     let measure = |r: &[f64]| 0.5 * r.iter().zip(&dsum).map(|(r, d)| r * r / d.max(f64::MIN_POSITIVE)).sum::<f64>();
     let mut zv: Vec<f64> = r.iter().zip(&diag).map(|(r, d)| r / d).collect();
     let mut dir = zv.clone();
     let mut rz: f64 = r.iter().zip(&zv).map(|(a, b)| a * b).sum();
     let mut hd = vec![0.0; nu];
-    // each variable's unknown (NONE when anchored); the identity when no row is in the set
-    let of_vertex: Vec<u32> = cl.label.iter().map(|&c| cl.unknown[c as usize]).collect();
-    let identity = nu == n && of_vertex.iter().enumerate().all(|(v, &u)| u as usize == v);
     let mut it = 0;
     let mut m = measure(&r);
     while it < MAX_CG && m > tolerance {
@@ -97,12 +95,7 @@ pub(super) fn solve_clustered(obj: &Objective<'_>, cl: &Clusters, x: &mut [f64],
                 *xv = if u == NONE { 0.0 } else { dir[u as usize] };
             }
             obj.p.apply(&xs, &mut px);
-            hd.iter_mut().for_each(|h| *h = 0.0);
-            for (&pv, &u) in px.iter().zip(&of_vertex) {
-                if u != NONE {
-                    hd[u as usize] += pv;
-                }
-            }
+            gather(&of_vertex, &px, &mut hd);
         }
         let dhd: f64 = dir.iter().zip(&hd).map(|(a, b)| a * b).sum();
         if dhd <= 0.0 || !dhd.is_finite() {
@@ -127,4 +120,15 @@ pub(super) fn solve_clustered(obj: &Objective<'_>, cl: &Clusters, x: &mut [f64],
     }
     cl.expand(&y, x);
     it
+}
+
+/// `out[u] = Σ values[v]` over the variables `v` of unknown `u`, in their order (anchored
+/// variables, NONE, are left out).
+fn gather(of_vertex: &[u32], values: &[f64], out: &mut [f64]) {
+    out.iter_mut().for_each(|o| *o = 0.0);
+    for (&value, &u) in values.iter().zip(of_vertex) {
+        if u != NONE {
+            out[u as usize] += value;
+        }
+    }
 }

@@ -2,10 +2,11 @@
 //!
 //! On a grid or a volume almost every row of the energy is the same stencil — the same
 //! offsets from the row to its columns and the same values in the same order — so P is kept
-//! as a class per row and one table of offsets and values per class (the 128³ bench volume:
-//! a few hundred classes for two million rows). A product then reads the vector, a class id
-//! and a table that stays in cache, instead of twelve bytes per stored entry: the conjugate
-//! gradients' products are bound by memory traffic. Each row's sum runs over its entries in
+//! as a class per row and one table of offsets and values per class (586 classes for the
+//! 262,131 rows of the 64³ bench volume). A product reads the vector, a class id and a table
+//! that stays in cache instead of twelve bytes per stored entry, and sums consecutive rows of
+//! one class side by side: one running sum per row over 25 entries had made the product wait
+//! on its additions (docs/performance.md §3). Each row's sum runs over its entries in
 //! the order compressed rows would hold them, so the products are those of the compressed
 //! rows bit for bit; on a mesh, where rows rarely repeat, each row is its own class.
 

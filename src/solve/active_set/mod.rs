@@ -9,8 +9,8 @@
 //! iteration, nothing factorised). The rows of `S` in a cluster form a spanning tree, and the
 //! multipliers follow from stationarity: on the tree each row's is the gradient summed over
 //! the subtree it cuts off. Where that gives a negative one, the cluster's multipliers are
-//! taken instead as a maximum flow over all its tight rows (a cluster's tight rows form
-//! cycles, and a tree's multipliers are one of many): if the flow carries the whole
+//! taken instead as a maximum flow over all its tight or violated rows (a cluster's tight
+//! rows form cycles, and a tree's multipliers are one of many): if the flow carries the whole
 //! imbalance the multipliers are non-negative and the cluster stays; if not, the cluster
 //! splits along the minimum cut, the one split the gradient pulls apart. Violated rows
 //! within [`join::JOIN_SHARE`] of the worst join `S` (merging two clusters, never closing a
@@ -105,6 +105,7 @@ pub(super) fn solve(
     let n = r.n;
     let rows = rows_of(r)?;
     let obj = Objective { p: RowClasses::from_upper(n, &r.p)?, q: &r.q, d: &r.d, q_free: &r.q_free };
+    let margin = rows.iter().map(|r| if let Row::Pair(_, _, b) = *r { -b } else { 0.0 }).fold(0.0, f64::max);
     if std::env::var_os("TOPOSMOOTH_TRACE_ACTIVE").is_some() {
         eprintln!("active set: {n} variables, {} rows, P in {} row classes", rows.len(), obj.p.classes());
     }
@@ -121,7 +122,6 @@ pub(super) fn solve(
     let mut status = SolveStatus::MaxIterations;
     let mut outer = 0;
     let mut history: Vec<(usize, usize, usize)> = Vec::new();
-    let margin = rows.iter().map(|r| if let Row::Pair(_, _, b) = *r { -b } else { 0.0 }).fold(0.0, f64::max);
     let stuck_above = (STUCK_SHARE * margin).max(ADD_ABOVE);
     // how often a row joined two anchored clusters (an anchor left for it): twice at most,
     // once per anchor, as the next cut tends to undo it

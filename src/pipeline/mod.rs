@@ -320,7 +320,7 @@ fn smooth_stages<D: Smoothable + Sync>(
             let prepared = match (&built, settings.qp.method) {
                 // a failed analysis is redone (and reported) by the solver itself
                 (Ok(o), Method::Structured) if o.factor.is_none() => {
-                    crate::solve::prepare(&o.p, &problem.fixed, settings.qp.memory_limit).ok()
+                    crate::solve::prepare(&o.p, &problem.fixed, settings.qp.memory_limit).ok().flatten()
                 }
                 _ => None,
             };

@@ -31,7 +31,9 @@ const CORRECTOR_STEP: f64 = 0.3;
 struct Assembled<'r> {
     r: &'r ReducedQp,
     normal: Normal,
-    analysis: std::sync::Arc<ordering::Analysis>,
+    /// The normal pattern's analysis; none for a banded pattern, which needs none (made when
+    /// [`Objective::energy_dual`] factorises P alone).
+    analysis: Option<std::sync::Arc<ordering::Analysis>>,
     /// The factor: faer's Cholesky, or for a banded pattern (a series) the band's own `LDLᵀ`
     /// ([`Banded`]: faer's simplicial factorisation and solves of a pentadiagonal matrix cost
     /// several times its n·b² products).
@@ -104,7 +106,10 @@ impl Objective<f64> for Assembled<'_> {
             for (k, &(_, _, v)) in self.r.p.iter().enumerate() {
                 vals[self.normal.pos_p[k]] += v;
             }
-            let mut f = ordering::SpdFactor::new(self.analysis.clone()).ok()?;
+            if self.analysis.is_none() {
+                self.analysis = Some(std::sync::Arc::new(ordering::analyse(self.normal.symbolic.as_ref()).ok()?));
+            }
+            let mut f = ordering::SpdFactor::new(self.analysis.clone()?).ok()?;
             f.factor(SparseColMatRef::new(self.normal.symbolic.as_ref(), &vals)).ok()?;
             self.energy = Some(f);
         }
@@ -170,15 +175,18 @@ pub(super) fn solve(
                 Some(assembly) => assembly,
                 None => Assembly::new(r)?,
             };
-            let analysis = analyses.of(normal.symbolic.as_ref())?;
-            let factor = match ordering::band(normal.symbolic.as_ref()) {
-                Some(b) => Factorised::Banded(Banded::new(normal.symbolic.as_ref(), b)),
+            // a banded pattern (a series) is factorised by the band's own LDLᵀ: no analysis
+            // (faer's symbolic factorisation of 10⁷ samples took seconds and 300 MB)
+            let (factor, analysis) = match ordering::band(normal.symbolic.as_ref()) {
+                Some(b) => (Factorised::Banded(Banded::new(normal.symbolic.as_ref(), b)), None),
                 None => {
+                    let analysis = analyses.of(normal.symbolic.as_ref())?;
                     let spare = spare.filter(|(a, _)| std::sync::Arc::ptr_eq(a, &analysis));
-                    Factorised::Spd(match spare {
+                    let factor = Factorised::Spd(match spare {
                         Some((_, workspace)) => ordering::SpdFactor::with_workspace(analysis.clone(), workspace),
                         None => ordering::SpdFactor::new(analysis.clone())?,
-                    })
+                    });
+                    (factor, Some(analysis))
                 }
             };
             let vals = vec![0.0f64; normal.symbolic.row_idx().len()];
@@ -206,7 +214,7 @@ impl Assembly {
 /// The bytes the structured solver allocates for `r` (the assembled form) beyond what the
 /// caller holds, known before it allocates them: the normal matrix's factor and faer's
 /// scratch (from its analysis, made here and kept in `analyses`, where [`solve`] takes it; a
-/// banded pattern's own factor from its band),
+/// banded pattern's own factor from its band, with no analysis),
 /// the normal matrix's values and pattern, the rows, and the iterate's vectors; with the rows
 /// and the pattern made for it, which [`solve`] takes. `None` for the factored form, whose
 /// double-double storage is not predicted yet.
@@ -221,7 +229,6 @@ pub(super) fn predicted_bytes(
         return Ok(None);
     }
     let assembly = Assembly::new(r)?;
-    let analysis = analyses.of(assembly.normal.symbolic.as_ref())?;
     let (n, m, nnz) = (r.n as u64, r.m() as u64, assembly.normal.symbolic.row_idx().len() as u64);
     // values and row indices of the normal matrix, its position tables; the rows (two
     // columns, two values, a length); about 14 vectors of n and 18 of m in the iteration
@@ -231,7 +238,7 @@ pub(super) fn predicted_bytes(
     let factor_bytes = match ordering::band(assembly.normal.symbolic.as_ref()) {
         // the band's own LDLᵀ: L and the band (n·b and n·(b + 1) values), 1/D, the entries' slots
         Some(b) => 8 * (n * (2 * b as u64 + 2) + nnz),
-        None => analysis.numeric_bytes(),
+        None => analyses.of(assembly.normal.symbolic.as_ref())?.numeric_bytes(),
     };
     Ok(Some((factor_bytes + normal_bytes + row_bytes + vectors, assembly)))
 }

@@ -212,13 +212,19 @@ pub fn solve_monotone_qp_with(
 /// `memory_limit` (`None`: the machine's) beside what the process holds now: past it the
 /// solver's own prediction refuses the route.
 ///
+/// `None` when `p` is banded (a series): the solver factorises such a normal matrix by the
+/// band's own `LDLᵀ`, with nothing to analyse or prepare.
+///
 /// # Errors
 /// A message if the analysis fails.
 pub fn prepare(
     p: &Sparse,
     fixed: &[Option<f64>],
     memory_limit: Option<u64>,
-) -> std::result::Result<Prepared, crate::error::NumericalError> {
+) -> std::result::Result<Option<Prepared>, crate::error::NumericalError> {
+    if crate::linalg::band(p.symbolic()).is_some() {
+        return Ok(None);
+    }
     let mut slot = vec![usize::MAX; fixed.len()];
     let mut n = 0;
     for (i, f) in fixed.iter().enumerate() {
@@ -228,7 +234,7 @@ pub fn prepare(
         }
     }
     let budget = crate::memory::Budget::of(memory_limit);
-    Prepared::new(p.symbolic(), &slot, n, |bytes| budget.in_use().saturating_add(bytes) <= budget.bytes)
+    Prepared::new(p.symbolic(), &slot, n, |bytes| budget.in_use().saturating_add(bytes) <= budget.bytes).map(Some)
 }
 
 #[cfg(test)]
@@ -253,6 +259,15 @@ mod tests {
             }
         }
         (Sparse::try_new_from_triplets(n, n, &t).unwrap(), edges)
+    }
+
+    #[test]
+    fn a_banded_energy_is_not_prepared_and_a_grid_s_is() {
+        // a path's P = K + I is tridiagonal: the solver factorises its normal matrix by the band
+        let (path, _) = grid_qp(40, 1);
+        assert!(prepare(&path, &[None; 40], None).unwrap().is_none());
+        let (grid, _) = grid_qp(12, 10);
+        assert!(prepare(&grid, &[None; 120], None).unwrap().is_some());
     }
 
     #[test]
@@ -281,7 +296,7 @@ mod tests {
         };
         let free: Vec<usize> = (0..n).filter(|&i| fixed[i].is_none()).collect();
         let reduced = reduce(&qp, &free);
-        let prepared = prepare(&p, &fixed, None).unwrap();
+        let prepared = prepare(&p, &fixed, None).unwrap().expect("a grid's P is not banded");
         let normal = super::super::ipm::normal_pattern(&reduced);
         let same = |a: faer::sparse::SymbolicSparseColMatRef<'_, usize>| {
             a.col_ptr() == normal.col_ptr() && a.row_idx() == normal.row_idx()
@@ -294,8 +309,7 @@ mod tests {
         let settings = QpSettings::default();
         let plain = solve_monotone_qp(&qp, &settings).unwrap();
         let mut analyses = Analyses::default();
-        let with =
-            solve_monotone_qp_with(&qp, &settings, &mut analyses, Some(prepare(&p, &fixed, None).unwrap())).unwrap();
+        let with = solve_monotone_qp_with(&qp, &settings, &mut analyses, prepare(&p, &fixed, None).unwrap()).unwrap();
         assert_eq!(plain.iterations, with.iterations);
         // kept for the next solve on the pattern: the same result again
         let again = solve_monotone_qp_with(&qp, &settings, &mut analyses, None).unwrap();

@@ -22,7 +22,7 @@ fn smooth_then_verify_the_exchange_rate() {
     assert!(text(&o).contains("certified"));
     let v = toposmooth(&["verify", &out, "--input", &fx]);
     assert_eq!(v.status.code(), Some(0), "{}", text(&v));
-    let r: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    let r = common::json(&report);
     assert_eq!(r["certificate"]["passed"], true);
     assert_eq!(r["vertices"], 4754);
     assert!(r["kept"].as_array().unwrap().len() >= 2);
@@ -255,7 +255,7 @@ fn reports_carry_the_version_the_command_line_and_a_structured_selection() {
     let args = ["smooth", &piv, "--fill-missing", "-o", &out, "--persistence", "5%", "--report", &report];
     let o = toposmooth(&args);
     assert!(o.status.success(), "{}", text(&o));
-    let r: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    let r = common::json(&report);
     assert_eq!(r["tool"], "toposmooth");
     assert_eq!(r["version"], env!("CARGO_PKG_VERSION"));
     let line: Vec<&str> = r["command_line"].as_array().unwrap().iter().map(|v| v.as_str().unwrap()).collect();
@@ -283,6 +283,6 @@ fn reports_carry_the_version_the_command_line_and_a_structured_selection() {
         &report,
     ]);
     assert!(o.status.success(), "{}", text(&o));
-    let r: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    let r = common::json(&report);
     assert_eq!(r["settings"]["selection"], serde_json::json!({"rule": "count", "minima": 2, "maxima": 3}));
 }

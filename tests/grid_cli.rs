@@ -76,7 +76,7 @@ fn piv_vorticity_with_holes_keeps_nine_minima_and_four_maxima() {
     for f in [&vtp, &png] {
         assert!(std::fs::metadata(f).unwrap().len() > 1000, "{f}");
     }
-    let r: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let r = common::json(&json);
     assert_eq!(r["filled_missing"], 774);
     assert_eq!(r["certificate"]["passed"], true);
     assert!(r["saddles"].as_u64().unwrap() >= 1);
@@ -174,7 +174,7 @@ fn elevation_formats_and_representatives() {
         ]);
         assert!(o.status.success(), "{}", text(&o));
         check_output(&npz_out);
-        let r: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+        let r = common::json(&json);
         assert!(r["representative"].as_str().unwrap().starts_with(rep), "{}", r["representative"]);
         rms.push(r["rms_deviation"].as_f64().unwrap());
     }
@@ -445,7 +445,7 @@ fn an_explicit_representative_is_built_or_refused() {
         let o = toposmooth(&["smooth", &g, "-o", &out, "--representative", "separatrix", "--report", &json]);
         match o.status.code() {
             Some(0) => {
-                let rep: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+                let rep = common::json(&json);
                 assert!(
                     rep["representative"].as_str().unwrap().starts_with("separatrix"),
                     "seed {seed}: {}",
@@ -464,7 +464,7 @@ fn an_explicit_representative_is_built_or_refused() {
         }
         let o = toposmooth(&["smooth", &g, "-o", &out, "--report", &json]);
         assert!(o.status.success(), "seed {seed}: {}", text(&o));
-        let rep: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+        let rep = common::json(&json);
         let used = rep["representative"].as_str().unwrap();
         let named = rep["representative_fallbacks"].as_array().unwrap();
         // the automatic choice starts with the flooded one: any other names why it was not used

@@ -14,10 +14,6 @@ fn nothing_left(dir: &std::path::Path) {
     assert!(left.is_empty(), "nothing written, no temporary: {left:?}");
 }
 
-fn report(path: &std::path::Path) -> serde_json::Value {
-    serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
-}
-
 #[test]
 fn a_run_predicted_past_its_budget_is_refused_before_the_solve_and_leaves_nothing() {
     let dir = scratch("memory-refused");
@@ -35,7 +31,7 @@ fn a_run_predicted_past_its_budget_is_refused_before_the_solve_and_leaves_nothin
     // the same run with room succeeds, and says what it predicted
     let o = toposmooth(&[&args[..], &["--memory-limit", "2G"]].concat());
     assert!(o.status.success(), "{}", text(&o));
-    let m = &report(&rep)["memory"];
+    let m = &common::json(&rep)["memory"];
     assert_eq!(m["budget"], 2u64 << 30);
     assert_eq!(m["budget_source"], "the memory limit given");
     assert!(m["predicted_peak"].as_u64().unwrap() > 4 << 20);
@@ -66,7 +62,7 @@ fn the_prediction_is_never_below_the_peak_reached_by_the_end_of_the_solve() {
         args.extend(extra);
         let o = toposmooth(&args);
         assert!(o.status.success(), "{args:?}: {}", text(&o));
-        let m = &report(&rep)["memory"];
+        let m = &common::json(&rep)["memory"];
         let (predicted, peak) = (m["predicted_peak"].as_u64(), m["peak_after_solve"].as_u64().unwrap());
         let predicted = predicted.unwrap_or_else(|| panic!("{input}: the route that ran predicted nothing"));
         assert!(peak > 0, "{input}");

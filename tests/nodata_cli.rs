@@ -76,7 +76,7 @@ fn four_methods_on_a_bar_with_two_point_handles() {
         "--plot",
         &out(&dir, "w.png"),
     ]);
-    let r: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    let r = common::json(&report);
     let cmp = r["comparison"].as_array().unwrap();
     let get = |m: &str| cmp.iter().find(|c| c["method"] == m).unwrap_or_else(|| panic!("{m} missing"));
     assert_eq!(get("monotone")["spurious_exact"], serde_json::json!([0, 0]));
@@ -172,7 +172,7 @@ fn diffusion_stays_in_the_colour_box_and_the_biharmonic_one_does_not() {
         "--plot",
         &out(&dir, "plot.png"),
     ]);
-    let c: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&colors).unwrap()).unwrap();
+    let c = common::json(&colors);
     let rgbs: Vec<[u8; 3]> = c["points"]
         .as_array()
         .unwrap()
@@ -245,7 +245,7 @@ fn cage_weights_on_the_horse() {
         &report,
     ]);
     assert!(text(&o).contains("7 of 7 monotone functions"), "{}", text(&o));
-    let r: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    let r = common::json(&report);
     assert!(r["linear_reproduction_error"].as_f64().unwrap() < 1e-6);
     // the interpolated weights are not certified: verify points to the cage file
     let o = toposmooth(&["verify", &w]);
@@ -343,7 +343,7 @@ fn a_bone_across_a_bar_fills_the_part_beyond_it() {
     let w = out(&dir, "w.vtu");
     let report = out(&dir, "r.json");
     succeeds(&["weights", &bar, "--handles", &h, "-o", &w, "--report", &report]);
-    let r: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    let r = common::json(&report);
     // the bone takes the columns at x = 7 (±0.2 reaches only that column of vertices: spacing 0.25);
     // the 12 columns beyond (x = 7.25 … 10) are filled, 5 vertices each
     assert_eq!(r["functions"][1]["handle_vertices"], 5);
@@ -541,7 +541,7 @@ fn order_four_weights_stay_with_the_structured_solver() {
         "--report",
         &report,
     ]);
-    let r: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    let r = common::json(&report);
     let functions = r["functions"].as_array().unwrap();
     assert_eq!(functions.len(), 4);
     for f in functions {

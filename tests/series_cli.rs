@@ -79,7 +79,7 @@ fn fill_missing_fills_a_series_linearly_and_marks_the_filled_samples() {
     // ends: the nearest given value
     assert!((num(&cells[0][1]) - num(&rows[2].1)).abs() < 1e-12);
     assert!((num(&cells[23][1]) - num(&rows[22].1)).abs() < 1e-12);
-    let r: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    let r = common::json(&report);
     assert_eq!(r["filled_missing"], 5);
     assert_eq!(r["filled_samples"], serde_json::json!([0, 1, 7, 8, 23]));
     let o = succeeds(&["verify", &out.display().to_string(), "--input", &input]);

@@ -1046,7 +1046,7 @@ fn the_bundled_fmri_frame_inside_its_mask_is_solved_by_the_active_set_iteration_
     let report = dir.join("run.json").display().to_string();
     let src = dataset("fmri_example4d_vol0_128x96x24.vti");
     succeeds(&["smooth", &src, "--mask-below", "1", "-o", &out, "--report", &report]);
-    let r: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    let r = common::json(&report);
     assert_eq!(r["solver"], "active-set", "handed over: {}", r["solver_fallback"]);
     assert!(r["solver_fallback"].is_null(), "{}", r["solver_fallback"]);
     assert_eq!(r["certificate"]["passed"], true);

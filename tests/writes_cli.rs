@@ -466,7 +466,7 @@ fn names_that_differ_only_in_invalid_utf8_bytes_get_their_own_files() {
         .unwrap();
     assert_eq!(o.status.code(), Some(0), "{}", text(&o));
     assert!(std::fs::read_to_string(&csv).unwrap().starts_with("date,input,output,u,role\n"), "the output's own bytes");
-    let r: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    let r = common::json(&report);
     assert_eq!(r["tool"], "toposmooth", "the report's own bytes");
     assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 2, "the two outputs and nothing else");
 }

@@ -110,6 +110,11 @@ pub fn toposmooth(args: &[&str]) -> std::process::Output {
 }
 
 /// A bundled dataset's path.
+/// A JSON file the tool wrote (a run's report, the colours of `colors --json`) as a value.
+pub fn json(path: impl AsRef<std::path::Path>) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
+}
+
 pub fn dataset(name: &str) -> String {
     std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("datasets").join(name).display().to_string()
 }

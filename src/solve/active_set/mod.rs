@@ -108,7 +108,6 @@ pub(super) fn solve(
     let n = r.n;
     let rows = rows_of(r)?;
     let obj = Objective { p: RowClasses::from_upper(n, &r.p)?, q: &r.q, d: &r.d, q_free: &r.q_free };
-    let margin = rows.iter().map(|r| if let Row::Pair(_, _, b) = *r { -b } else { 0.0 }).fold(0.0, f64::max);
     if std::env::var_os("TOPOSMOOTH_TRACE_ACTIVE").is_some() {
         eprintln!("active set: {n} variables, {} rows, P in {} row classes", rows.len(), obj.p.classes());
     }
@@ -125,6 +124,7 @@ pub(super) fn solve(
     let mut status = SolveStatus::MaxIterations;
     let mut outer = 0;
     let mut history: Vec<(usize, usize, usize)> = Vec::new();
+    let margin = rows.iter().map(|r| if let Row::Pair(_, _, b) = *r { -b } else { 0.0 }).fold(0.0, f64::max);
     let stuck_above = (STUCK_SHARE * margin).max(ADD_ABOVE);
     // how often a row joined two anchored clusters (an anchor left for it): twice at most,
     // once per anchor, as the next cut tends to undo it

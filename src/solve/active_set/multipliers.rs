@@ -175,9 +175,9 @@ const TIGHT: f64 = 1e-10;
 
 /// Multipliers for the clusters marked in `marked` as a non-negative flow over all their
 /// tight rows, tree rows or not, and the rows the cluster's offsets violate (a row closing a
-/// cycle may miss its margin by a few ε): stationarity `g + Aᵀz = 0` asks each variable to send out
-/// `−g` (balanced) along rows `x_i ≤ x_j − ε` from `i` to `j`, an anchor row taking or giving
-/// the cluster's sum. Where no such flow exists the minimum cut's source side is a set the
+/// cycle may miss its margin by a few ε): stationarity `g + Aᵀz = 0` asks each variable to
+/// send out `−g` (balanced) along rows `x_i ≤ x_j − ε` from `i` to `j`, an anchor row taking
+/// or giving the cluster's sum. Where no such flow exists the minimum cut's source side is a set the
 /// objective falls by raising (or its complement, by lowering) with every tight row
 /// respected: the tree rows across it leave the set, splitting the cluster once, for good.
 /// A tree row's negative multiplier alone says nothing of this when tight rows close cycles,

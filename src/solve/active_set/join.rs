@@ -3,8 +3,7 @@
 //! (never closing a cycle among them), swapping out a tree row where a row closes a cycle
 //! inside one cluster, or a bound where two anchored clusters are pulled together.
 
-use super::clusters::{find, Clusters};
-use super::multipliers::Forest;
+use super::clusters::{find, Forest, Labels};
 use super::rows::Row;
 
 /// A row joins the working set when violated by more than this (unit values; the margin
@@ -46,7 +45,9 @@ pub(super) fn join(
     mut changed: usize,
 ) -> Joined {
     let n = x.len();
-    let cl = Clusters::new(n, rows, in_set);
+    // the clusters after the cuts: labels are union-find roots, so the tables below run
+    // over variables
+    let cl = Labels::new(n, rows, in_set);
     let mut violated: Vec<(f64, usize)> = rows
         .iter()
         .enumerate()
@@ -57,15 +58,10 @@ pub(super) fn join(
     violated.sort_by(|a, b| b.0.total_cmp(&a.0));
     let worst = violated.first().map_or(0.0, |v| v.0);
     let joining = violated.partition_point(|v| v.0 >= JOIN_SHARE * worst);
-    let nc = cl.anchor.len();
+    let nc = n;
     let mut parent: Vec<u32> = (0..nc as u32).collect();
-    let mut anchored: Vec<bool> = cl.anchor.iter().map(Option::is_some).collect();
-    let mut anchor_row = vec![usize::MAX; nc];
-    for (k, row) in rows.iter().enumerate().filter(|(k, _)| in_set[*k]) {
-        if let Row::Bound(v, _, _) = *row {
-            anchor_row[cl.label[v] as usize] = k;
-        }
-    }
+    let anchor_row = cl.anchor_row;
+    let mut anchored: Vec<bool> = anchor_row.iter().map(|&k| k != usize::MAX).collect();
     // a cluster's anchor changes by one swap per iteration at most, and not beside a swap
     // in its tree; the tree rows that swaps took out this iteration
     let mut swapped = vec![false; nc];

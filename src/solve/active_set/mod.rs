@@ -143,7 +143,7 @@ pub(super) fn solve(
         let t2 = std::time::Instant::now();
         obj.gradient(&x, &mut g);
         let balanced = balanced_gradient(&cl, &g, &r.d);
-        let forest = tree_multipliers(&rows, &in_set, &cl, &balanced, &mut z);
+        tree_multipliers(&rows, &cl, &balanced, &mut z);
         let data = obj.data_term(&x).max(f64::MIN_POSITIVE);
         let target = settings.gap_tolerance * data;
         // leave: an anchor whose multiplier is negative (the whole cluster moves off its
@@ -176,7 +176,7 @@ pub(super) fn solve(
         changed += drops;
         let t4 = std::time::Instant::now();
         let Joined { changed, swaps, stuck, worst, violated } =
-            join(&rows, &mut in_set, &mut z, &x, &forest, &mut tabu, changed);
+            join(&rows, &mut in_set, &mut z, &x, &cl.forest, &mut tabu, changed);
         let gap = gap_bound(&rows, &x, &z, &g, &r.d);
         let t5 = std::time::Instant::now();
         crate::progress::update("solve", || {

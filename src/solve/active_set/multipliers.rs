@@ -3,47 +3,8 @@
 //! along the minimum cut where no flow carries its imbalance), and the gap bound they give.
 
 use super::super::flow::Network;
-use super::clusters::{Clusters, NONE};
+use super::clusters::{Clusters, Forest, NONE};
 use super::rows::Row;
-
-/// The working set's trees as the multipliers walked them: each variable's row to its parent
-/// (`usize::MAX` at a root) and its depth.
-pub(super) struct Forest {
-    pub(super) parent_row: Vec<usize>,
-    pub(super) depth: Vec<u32>,
-}
-
-impl Forest {
-    /// Calls `visit(row, rises)` for each tree row on the path from `i` to `j` (one tree),
-    /// `rises` when `x` rises along it in the direction `i → j`.
-    pub(super) fn walk_path(&self, rows: &[Row], mut i: usize, mut j: usize, mut visit: impl FnMut(usize, bool)) {
-        // Pair(a, b) is x_a − x_b ≤ −ε: x rises from a to b. Walking up from i, a row rises
-        // along i → j when i's side is its a; walking up from j, when j's side is its b.
-        let other = |k: usize, v: usize| match rows[k] {
-            Row::Pair(a, b, _) => (if a == v { b } else { a }, a == v),
-            Row::Bound(..) => unreachable!("tree rows are pairs"),
-        };
-        while i != j {
-            if self.depth[i] >= self.depth[j] {
-                let k = self.parent_row[i];
-                if k == usize::MAX {
-                    return;
-                }
-                let (p, from_a) = other(k, i);
-                visit(k, from_a);
-                i = p;
-            } else {
-                let k = self.parent_row[j];
-                if k == usize::MAX {
-                    return;
-                }
-                let (p, from_a) = other(k, j);
-                visit(k, !from_a);
-                j = p;
-            }
-        }
-    }
-}
 
 /// The gradient with each unanchored cluster's sum spread back over it in proportion to the
 /// data diagonal (the conjugate gradients leave a residual of their tolerance): what the
@@ -69,94 +30,18 @@ pub(super) fn balanced_gradient(cl: &Clusters, g: &[f64], d: &[f64]) -> Vec<f64>
         .collect()
 }
 
-/// The multipliers of the working set's rows by stationarity on each tree (zero elsewhere).
-pub(super) fn tree_multipliers(
-    rows: &[Row],
-    in_set: &[bool],
-    cl: &Clusters,
-    balanced: &[f64],
-    z: &mut [f64],
-) -> Forest {
-    let n = balanced.len();
+/// The multipliers of the working set's rows by stationarity on each cluster's tree (zero
+/// elsewhere), leaves to roots: a row's multiplier carries its subtree's gradient.
+pub(super) fn tree_multipliers(rows: &[Row], cl: &Clusters, balanced: &[f64], z: &mut [f64]) {
     z.iter_mut().for_each(|v| *v = 0.0);
-    // adjacency of the set's pair rows, the anchor row of each anchored cluster
-    let mut deg = vec![0usize; n + 1];
-    let mut anchor_row = vec![usize::MAX; cl.anchor.len()];
-    for (k, row) in rows.iter().enumerate().filter(|(k, _)| in_set[*k]) {
-        match *row {
-            Row::Pair(i, j, _) => {
-                deg[i + 1] += 1;
-                deg[j + 1] += 1;
-            }
-            Row::Bound(v, _, _) => anchor_row[cl.label[v] as usize] = k,
-        }
-    }
-    for v in 0..n {
-        deg[v + 1] += deg[v];
-    }
-    let mut adj = vec![0usize; deg[n]];
-    let mut at = deg.clone();
-    for (k, row) in rows.iter().enumerate().filter(|(k, _)| in_set[*k]) {
-        if let Row::Pair(i, j, _) = *row {
-            adj[at[i]] = k;
-            at[i] += 1;
-            adj[at[j]] = k;
-            at[j] += 1;
-        }
-    }
-    let nc = cl.anchor.len();
     let mut acc = balanced.to_vec();
-    // breadth-first from each cluster's root (the anchor row's variable when anchored)
-    let mut seen = vec![false; n];
-    let mut order = Vec::with_capacity(n);
-    let mut parent_row = vec![usize::MAX; n];
-    let mut depth = vec![0u32; n];
-    let mut root_of = vec![usize::MAX; nc];
-    for (c, &k) in anchor_row.iter().enumerate() {
-        if k != usize::MAX {
-            if let Row::Bound(v, _, _) = rows[k] {
-                root_of[c] = v;
-            }
-        }
-    }
-    for v in 0..n {
-        let c = cl.label[v] as usize;
-        if root_of[c] == usize::MAX {
-            root_of[c] = v;
-        }
-    }
-    for &root in &root_of {
-        if root == usize::MAX || seen[root] {
-            continue;
-        }
-        seen[root] = true;
-        let start = order.len();
-        order.push(root);
-        let mut head = start;
-        while head < order.len() {
-            let v = order[head];
-            head += 1;
-            for &k in &adj[deg[v]..deg[v + 1]] {
-                let Row::Pair(i, j, _) = rows[k] else { continue };
-                let w = if i == v { j } else { i };
-                if !seen[w] {
-                    seen[w] = true;
-                    parent_row[w] = k;
-                    depth[w] = depth[v] + 1;
-                    order.push(w);
-                }
-            }
-        }
-    }
-    // leaves to roots: a row's multiplier carries its subtree's gradient
+    let Forest { parent_row, order, .. } = &cl.forest;
     for &v in order.iter().rev() {
         let k = parent_row[v];
         if k == usize::MAX {
-            let c = cl.label[v] as usize;
-            if anchor_row[c] != usize::MAX {
-                if let Row::Bound(_, a, _) = rows[anchor_row[c]] {
-                    z[anchor_row[c]] = -a * acc[v];
-                }
+            let anchor = cl.anchor_row[cl.label[v] as usize];
+            if let Some(Row::Bound(_, a, _)) = rows.get(anchor) {
+                z[anchor] = -a * acc[v];
             }
             continue;
         }
@@ -166,7 +51,6 @@ pub(super) fn tree_multipliers(
         z[k] = -a_v * acc[v];
         acc[parent] += acc[v];
     }
-    Forest { parent_row, depth }
 }
 
 /// A row is tight (an arc of the multipliers' network) within this of its bound; a violated

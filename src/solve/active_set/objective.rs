@@ -63,6 +63,11 @@ pub(super) fn solve_clustered(obj: &Objective<'_>, cl: &Clusters, x: &mut [f64],
         if u == NONE {
             continue;
         }
+        if size[u as usize] == 1.0 {
+            // a cluster of one: its diagonal alone (the same sum, in the same order)
+            diag[u as usize] = obj.p.diagonal(i);
+            continue;
+        }
         for (j, v) in obj.p.row(i) {
             if cl.label[j] == cl.label[i] {
                 diag[u as usize] += v;

@@ -27,6 +27,8 @@ pub(super) struct RowClasses {
     /// Column minus row of each class entry.
     offset: Vec<i32>,
     value: Vec<f64>,
+    /// Per class its diagonal entry (its entries at offset 0 summed in order).
+    diagonal: Vec<f64>,
 }
 
 impl RowClasses {
@@ -102,12 +104,19 @@ impl RowClasses {
         offset.shrink_to_fit();
         value.truncate(used);
         value.shrink_to_fit();
-        Ok(RowClasses { class, start, offset, value })
+        let diagonal =
+            start.windows(2).map(|w| (w[0]..w[1]).filter(|&e| offset[e] == 0).fold(0.0, |a, e| a + value[e])).collect();
+        Ok(RowClasses { class, start, offset, value, diagonal })
     }
 
     /// The classes (for the trace).
     pub(super) fn classes(&self) -> usize {
         self.start.len() - 1
+    }
+
+    /// `P_ii`.
+    pub(super) fn diagonal(&self, i: usize) -> f64 {
+        self.diagonal[self.class[i] as usize]
     }
 
     /// Row `i`'s entries as (column, value), in the order the products sum them.
@@ -224,6 +233,7 @@ mod tests {
             let mut sorted = row.clone();
             sorted.sort_by_key(|e| e.0);
             assert_eq!(sorted, written, "row {i}");
+            assert_eq!(rc.diagonal(i), dense[i][i], "row {i}'s diagonal");
         }
     }
 }

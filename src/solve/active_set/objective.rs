@@ -82,8 +82,10 @@ pub(super) fn solve_clustered(obj: &Objective<'_>, cl: &Clusters, x: &mut [f64],
     let mut r = vec![0.0; nu];
     gather(&of_vertex, &px, &mut r);
     r.iter_mut().for_each(|v| *v = -*v);
-    let measure = |r: &[f64]| 0.5 * r.iter().zip(&dsum).map(|(r, d)| r * r / d.max(f64::MIN_POSITIVE)).sum::<f64>();
-    let mut zv: Vec<f64> = r.iter().zip(&diag).map(|(r, d)| r / d).collect();
+    let inv_dsum: Vec<f64> = dsum.iter().map(|d| 1.0 / d.max(f64::MIN_POSITIVE)).collect();
+    let inv_diag: Vec<f64> = diag.iter().map(|d| 1.0 / d).collect();
+    let measure = |r: &[f64]| 0.5 * r.iter().zip(&inv_dsum).map(|(r, w)| r * r * w).sum::<f64>();
+    let mut zv: Vec<f64> = r.iter().zip(&inv_diag).map(|(r, w)| r * w).collect();
     let mut dir = zv.clone();
     let mut rz: f64 = r.iter().zip(&zv).map(|(a, b)| a * b).sum();
     let mut hd = vec![0.0; nu];
@@ -102,21 +104,13 @@ pub(super) fn solve_clustered(obj: &Objective<'_>, cl: &Clusters, x: &mut [f64],
             obj.p.apply(&xs, &mut px);
             gather(&of_vertex, &px, &mut hd);
         }
-        let dhd: f64 = dir.iter().zip(&hd).map(|(a, b)| a * b).sum();
+        let dhd = dot(&dir, &hd);
         if dhd <= 0.0 || !dhd.is_finite() {
             break;
         }
         let alpha = rz / dhd;
-        // one pass: the step, the residual, its preconditioned form and both sums (each
-        // summed in index order, as separate passes would)
-        let (mut rz_new, mut rd) = (0.0, 0.0);
-        for k in 0..nu {
-            y[k] += alpha * dir[k];
-            r[k] -= alpha * hd[k];
-            zv[k] = r[k] / diag[k];
-            rz_new += r[k] * zv[k];
-            rd += r[k] * r[k] / dsum[k].max(f64::MIN_POSITIVE);
-        }
+        // one pass: the step, the residual, its preconditioned form and both sums
+        let (rz_new, rd) = step(alpha, (&mut y, &mut r, &mut zv), (&dir, &hd), (&inv_diag, &inv_dsum));
         m = 0.5 * rd;
         let beta = rz_new / rz;
         rz = rz_new;
@@ -136,4 +130,49 @@ fn gather(of_vertex: &[u32], values: &[f64], out: &mut [f64]) {
             out[u as usize] += value;
         }
     }
+}
+
+/// Sums side by side in a product or a step: one running sum per lane, the lanes added in a
+/// fixed order at the end (a single running sum made each pass wait on its additions).
+const LANES: usize = 4;
+
+/// `aᵀb`, in [`LANES`] running sums.
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    let mut acc = [0.0; LANES];
+    let (a4, b4) = (a.chunks_exact(LANES), b.chunks_exact(LANES));
+    let tail: f64 = a4.remainder().iter().zip(b4.remainder()).map(|(x, y)| x * y).sum();
+    for (x, y) in a4.zip(b4) {
+        for l in 0..LANES {
+            acc[l] += x[l] * y[l];
+        }
+    }
+    (acc[0] + acc[1]) + (acc[2] + acc[3]) + tail
+}
+
+/// The conjugate-gradient step: `y += α p`, `r −= α H p`, `z = r / diag`; returns `rᵀz` and
+/// `Σ r² / D` (each in [`LANES`] running sums).
+fn step(
+    alpha: f64,
+    (y, r, z): (&mut [f64], &mut [f64], &mut [f64]),
+    (p, hp): (&[f64], &[f64]),
+    (inv_diag, inv_dsum): (&[f64], &[f64]),
+) -> (f64, f64) {
+    let (mut rz, mut rd) = ([0.0; LANES], [0.0; LANES]);
+    let whole = y.len() / LANES * LANES;
+    let one = |k: usize, l: usize, y: &mut [f64], r: &mut [f64], z: &mut [f64], rz: &mut [f64; LANES], rd: &mut [f64; LANES]| {
+        y[k] += alpha * p[k];
+        r[k] -= alpha * hp[k];
+        z[k] = r[k] * inv_diag[k];
+        rz[l] += r[k] * z[k];
+        rd[l] += r[k] * r[k] * inv_dsum[k];
+    };
+    for b in (0..whole).step_by(LANES) {
+        for l in 0..LANES {
+            one(b + l, l, y, r, z, &mut rz, &mut rd);
+        }
+    }
+    for k in whole..y.len() {
+        one(k, k - whole, y, r, z, &mut rz, &mut rd);
+    }
+    ((rz[0] + rz[1]) + (rz[2] + rz[3]), (rd[0] + rd[1]) + (rd[2] + rd[3]))
 }

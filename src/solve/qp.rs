@@ -100,7 +100,15 @@ pub fn solve_monotone_qp_with(
                 return Err(crate::memory::over_budget("the active-set iteration", peak, &budget));
             }
             predicted_peak = Some(peak);
-            match super::active_set::solve(&reduced, hint.as_deref(), settings) {
+            let outcome = super::active_set::Operands::take(&mut reduced)
+                .and_then(|operands| super::active_set::solve(&reduced, operands, hint.as_deref(), settings));
+            if !matches!(&outcome, Ok(a) if a.outcome.status == SolveStatus::Solved) {
+                // the route taking over needs the triplets the iteration freed
+                let again = reduce(qp, &free);
+                (reduced.p, reduced.a_row, reduced.a_col, reduced.a_val) =
+                    (again.p, again.a_row, again.a_col, again.a_val);
+            }
+            match outcome {
                 Ok(a) if a.outcome.status == SolveStatus::Solved => {
                     inner_iterations = a.cg_iterations;
                     Some(a.outcome)
@@ -317,6 +325,42 @@ mod tests {
         let diff = plain.x.iter().zip(&with.x).fold(0.0f64, |a, (x, y)| a.max((x - y).abs()));
         assert!(diff < 1e-12, "{diff:e}");
         assert!(edges.iter().all(|&(i, j)| with.x[j] - with.x[i] >= 0.5e-6));
+    }
+
+    /// The active-set route handing over (here for a free variable without a data term): the
+    /// structured solver then works on the triplets rebuilt after the iteration's operands
+    /// took them, and gives the bits the structured route gives alone.
+    #[test]
+    fn a_hand_over_from_the_active_set_solves_the_rebuilt_problem() {
+        let (nx, ny) = (30, 20);
+        let n = nx * ny;
+        let (p, edges) = grid_qp(nx, ny);
+        let h: Vec<f64> = (0..n).map(|i| ((i % nx) as f64 * 0.3).sin() + (i / nx) as f64 * 0.01).collect();
+        let q: Vec<f64> = h.iter().map(|v| -v).collect();
+        let mut fixed = vec![None; n];
+        fixed[0] = Some(-1.0);
+        fixed[n - 1] = Some(2.0);
+        let mut data = vec![1.0; n];
+        data[n / 2] = 0.0;
+        let qp = MonotoneQp {
+            p: &p,
+            q: &q,
+            fixed: &fixed,
+            edges: &edges,
+            margin: 1e-6,
+            hint: None,
+            bounds: &[],
+            data: Some(&data),
+            factor: None,
+            condition: None,
+        };
+        let run = |method| solve_monotone_qp(&qp, &QpSettings { method, ..QpSettings::default() }).unwrap();
+        let (handed, direct) = (run(Method::ActiveSet), run(Method::Structured));
+        assert!(handed.fallback.as_deref().is_some_and(|f| f.contains("data term")), "{:?}", handed.fallback);
+        assert_eq!(handed.method, Method::Structured);
+        assert_eq!(handed.x, direct.x);
+        assert_eq!(handed.iterations, direct.iterations);
+        assert!(edges.iter().all(|&(i, j)| handed.x[j] - handed.x[i] >= 0.5e-6));
     }
 
     type Chain = (Sparse, [f64; 4], [Option<f64>; 4], [(usize, usize); 3]);

@@ -73,8 +73,10 @@ pub(super) struct ActiveSetOutcome {
 }
 
 /// Bytes the iteration allocates beside the reduced QP, at most, for `n` variables, `m` rows
-/// and `p_entries` stored entries of P's upper triangle: P in compressed rows (both triangles,
-/// 12 bytes an entry, before its repeated rows are merged), the rows (32 bytes each) with
+/// and `p_entries` stored entries of P's upper triangle: P's row classes (12 bytes an entry
+/// of both triangles when no row repeats, as on a mesh) and the index that makes them (where
+/// each column starts, each row's triplets in later columns: 4 bytes an entry and 32 a
+/// variable), the rows (32 bytes each) with
 /// their flags and multipliers, and per variable its row class and the classes' hash (36
 /// bytes when no row repeats), the clusters (labels, offsets, anchors, their adjacency), the
 /// conjugate gradients' eight vectors and unknown map, the forest (order, parents, depths)
@@ -86,28 +88,50 @@ pub(super) struct ActiveSetOutcome {
 #[must_use]
 pub(crate) fn predicted_bytes(n: usize, m: usize, p_entries: usize) -> u64 {
     let (n, m, p) = (n as u64, m as u64, p_entries as u64);
-    let csr = 12 * (2 * p) + 8 * (n + 1);
+    let csr = 12 * (2 * p) + 4 * p + 32 * (n + 1);
     let per_variable = 36 + 24 + 72 + 76 + 70 + 28 + 4 + 15 + 36;
     let per_row = 32 + 10 + 32 + 16 + 96 + 17;
     csr + per_variable * n + per_row * m
 }
 
-/// Runs the iteration from `hint` (or the data's target); needs a data term at every
-/// variable (the gap bound and the conjugate gradients' start).
+/// P and the constraint rows in the iteration's own forms ([`RowClasses`], [`Row`]).
+pub(super) struct Operands {
+    p: RowClasses,
+    rows: Vec<Row>,
+}
+
+impl Operands {
+    /// Made from the reduced QP's triplets, which they replace: P's upper triangle and A's
+    /// entries are freed as soon as converted (at 128³ the triplets alone are 0.9 GB), so a
+    /// caller that hands the problem over afterwards rebuilds them. Needs the assembled
+    /// energy with a data term at every variable (the gap bound and the conjugate
+    /// gradients' start).
+    pub(super) fn take(r: &mut ReducedQp) -> std::result::Result<Operands, NumericalError> {
+        if !r.gap_bound || r.factor.is_some() {
+            return Err("the active-set iteration needs the assembled energy with a data term everywhere".into());
+        }
+        if r.n >= NONE as usize {
+            return Err("too many variables for the active-set iteration".into());
+        }
+        let rows = rows_of(r)?;
+        (r.a_row, r.a_col, r.a_val) = (Vec::new(), Vec::new(), Vec::new());
+        let p = RowClasses::from_upper(r.n, &r.p)?;
+        r.p = Vec::new();
+        Ok(Operands { p, rows })
+    }
+}
+
+/// Runs the iteration from `hint` (or the data's target) on the reduced QP `r` whose P and
+/// rows `operands` hold.
 pub(super) fn solve(
     r: &ReducedQp,
+    operands: Operands,
     hint: Option<&[f64]>,
     settings: &QpSettings,
 ) -> std::result::Result<ActiveSetOutcome, NumericalError> {
-    if !r.gap_bound || r.factor.is_some() {
-        return Err("the active-set iteration needs the assembled energy with a data term everywhere".into());
-    }
-    if r.n >= NONE as usize {
-        return Err("too many variables for the active-set iteration".into());
-    }
     let n = r.n;
-    let rows = rows_of(r)?;
-    let obj = Objective { p: RowClasses::from_upper(n, &r.p)?, q: &r.q, d: &r.d, q_free: &r.q_free };
+    let Operands { p, rows } = operands;
+    let obj = Objective { p, q: &r.q, d: &r.d, q_free: &r.q_free };
     if std::env::var_os("TOPOSMOOTH_TRACE_ACTIVE").is_some() {
         eprintln!("active set: {n} variables, {} rows, P in {} row classes", rows.len(), obj.p.classes());
     }

@@ -159,7 +159,13 @@ fn step(
 ) -> (f64, f64) {
     let (mut rz, mut rd) = ([0.0; LANES], [0.0; LANES]);
     let whole = y.len() / LANES * LANES;
-    let one = |k: usize, l: usize, y: &mut [f64], r: &mut [f64], z: &mut [f64], rz: &mut [f64; LANES], rd: &mut [f64; LANES]| {
+    let one = |k: usize,
+               l: usize,
+               y: &mut [f64],
+               r: &mut [f64],
+               z: &mut [f64],
+               rz: &mut [f64; LANES],
+               rd: &mut [f64; LANES]| {
         y[k] += alpha * p[k];
         r[k] -= alpha * hp[k];
         z[k] = r[k] * inv_diag[k];

@@ -32,77 +32,78 @@ pub(super) struct RowClasses {
 }
 
 impl RowClasses {
-    /// From P's upper triangle as triplets: compressed rows first (a row's entries in the
-    /// order the triplets give them), then compacted in place, each row either matching an
-    /// earlier class or appending its own. Errs when a column offset does not fit in 32 bits.
+    /// From P's upper triangle as triplets sorted by column, then row (as the reduced QP
+    /// stores them; errs otherwise, or when a column offset does not fit in 32 bits). Row by
+    /// row, without P's compressed rows: row `i`'s entries are column `i`'s triplets (columns
+    /// up to `i`) then its own triplets in later columns, in increasing column order; each row
+    /// either matches an earlier class or appends its own.
     pub(super) fn from_upper(n: usize, p: &[(usize, usize, f64)]) -> Result<RowClasses, &'static str> {
-        if n > i32::MAX as usize {
+        if n > i32::MAX as usize || p.len() > u32::MAX as usize {
             return Err("too many variables for the active-set iteration");
         }
-        let mut start = vec![0usize; n + 1];
-        for &(i, j, v) in p {
-            if v != 0.0 {
-                start[i + 1] += 1;
-                if i != j {
-                    start[j + 1] += 1;
-                }
+        if p.windows(2).any(|w| (w[0].1, w[0].0) > (w[1].1, w[1].0)) || p.iter().any(|&(i, j, _)| i > j || j >= n) {
+            return Err("P's triplets are not an upper triangle sorted by column");
+        }
+        // where each column's triplets start; per row its triplets in later columns
+        let mut column = vec![0usize; n + 1];
+        let mut later = vec![0usize; n + 1];
+        for &(i, j, _) in p {
+            column[j + 1] += 1;
+            if i != j {
+                later[i + 1] += 1;
             }
         }
         for k in 0..n {
-            start[k + 1] += start[k];
+            column[k + 1] += column[k];
+            later[k + 1] += later[k];
         }
-        let nnz = start[n];
-        let (mut offset, mut value) = (vec![0i32; nnz], vec![0.0; nnz]);
-        let mut at = start.clone();
-        for &(i, j, v) in p {
-            if v != 0.0 {
-                // |j − i| < n ≤ i32::MAX
-                offset[at[i]] = (j as i64 - i as i64) as i32;
-                value[at[i]] = v;
+        let mut in_row = vec![0u32; later[n]];
+        let mut at = later.clone();
+        for (t, &(i, j, _)) in p.iter().enumerate() {
+            if i != j {
+                in_row[at[i]] = t as u32;
                 at[i] += 1;
-                if i != j {
-                    offset[at[j]] = (i as i64 - j as i64) as i32;
-                    value[at[j]] = v;
-                    at[j] += 1;
-                }
             }
         }
         drop(at);
-        // compaction: the write position never passes the row being read, and row i's
-        // `start[i + 1]` is read before anything at index i + 1 can be written
         let mut class = vec![0u32; n];
+        let mut start = vec![0usize];
+        let (mut offset, mut value): (Vec<i32>, Vec<f64>) = (Vec::new(), Vec::new());
         let mut seen: HashMap<u64, u32> = HashMap::new();
-        let mut classes = 0usize;
-        let mut lo = start[0];
+        let (mut row_offset, mut row_value): (Vec<i32>, Vec<f64>) = (Vec::new(), Vec::new());
         for (i, class_i) in class.iter_mut().enumerate() {
-            let hi = start[i + 1];
-            let key = row_hash(&offset[lo..hi], &value[lo..hi]);
+            row_offset.clear();
+            row_value.clear();
+            // |j − i| < n ≤ i32::MAX
+            let lower = p[column[i]..column[i + 1]].iter().map(|&(r, _, v)| ((r as i64 - i as i64) as i32, v));
+            let upper = in_row[later[i]..later[i + 1]].iter().map(|&t| {
+                let (_, c, v) = p[t as usize];
+                ((c as i64 - i as i64) as i32, v)
+            });
+            for (o, v) in lower.chain(upper).filter(|e| e.1 != 0.0) {
+                row_offset.push(o);
+                row_value.push(v);
+            }
+            let key = row_hash(&row_offset, &row_value);
             let found = seen.get(&key).copied().filter(|&c| {
                 let (a, b) = (start[c as usize], start[c as usize + 1]);
-                b - a == hi - lo
-                    && offset[a..b] == offset[lo..hi]
-                    && value[a..b].iter().zip(&value[lo..hi]).all(|(x, y)| x.to_bits() == y.to_bits())
+                offset[a..b] == row_offset[..]
+                    && value[a..b].iter().zip(&row_value).all(|(x, y)| x.to_bits() == y.to_bits())
             });
             *class_i = match found {
                 Some(c) => c,
                 None => {
-                    let w = start[classes];
-                    offset.copy_within(lo..hi, w);
-                    value.copy_within(lo..hi, w);
-                    start[classes + 1] = w + (hi - lo);
-                    seen.entry(key).or_insert(classes as u32);
-                    classes += 1;
-                    (classes - 1) as u32
+                    let c = start.len() - 1;
+                    offset.extend_from_slice(&row_offset);
+                    value.extend_from_slice(&row_value);
+                    start.push(offset.len());
+                    seen.entry(key).or_insert(c as u32);
+                    c as u32
                 }
             };
-            lo = hi;
         }
-        start.truncate(classes + 1);
         start.shrink_to_fit();
-        let used = start[classes];
-        offset.truncate(used);
         offset.shrink_to_fit();
-        value.truncate(used);
         value.shrink_to_fit();
         let diagonal =
             start.windows(2).map(|w| (w[0]..w[1]).filter(|&e| offset[e] == 0).fold(0.0, |a, e| a + value[e])).collect();
@@ -211,6 +212,8 @@ mod tests {
             }
         }
         p.push((0, 4, 0.0));
+        assert!(RowClasses::from_upper(n, &p).is_err(), "triplets out of column order");
+        p.sort_by_key(|&(i, j, _)| (j, i));
         let rc = RowClasses::from_upper(n, &p).unwrap();
         // rows 0, 1, n−2, n−1 differ; rows 2 and 3 are the same stencil (the explicit zero
         // of row 0 is dropped)

@@ -32,6 +32,7 @@ pub use cotan::{
 pub use factor::{edge_factor, polyharmonic_factor, Factor};
 pub use gradient::{gradient_factor, gradient_operator};
 pub use harmonic::{dirichlet_solve, dirichlet_solve_with, Dirichlet};
+pub(crate) use polyharmonic::polyharmonic_products;
 pub use polyharmonic::{polyharmonic, Energy};
 pub use series::{series_mass, series_stiffness};
 pub use sparse::{plus_diagonal, quadratic_form, quadratic_form_without_diagonal, scaled_plus_diagonal, Sparse};

@@ -104,24 +104,33 @@ impl std::str::FromStr for Energy {
 /// If `scale.len() != energy.terms.len()`, `m.len() != K.nrows()`, or a sharp index is out of
 /// range (callers validate first).
 pub fn polyharmonic(k: &Sparse, m: &[f64], energy: &Energy, scale: &[f64]) -> Sparse {
+    with_pattern_of(polyharmonic_products(k, m, energy, scale), k)
+}
+
+/// [`polyharmonic`] without K's own pattern added: the products' structural pattern alone. On
+/// a volume K's exactly zero entries (the cube diagonals of its tetrahedra) lie outside the
+/// bilaplacian's 25-point stencil, and adding them copies the whole matrix (two of 0.8 GB at
+/// 128³ side by side); a route that needs no constrained pair in P's pattern (the active set)
+/// takes this one.
+pub(crate) fn polyharmonic_products(k: &Sparse, m: &[f64], energy: &Energy, scale: &[f64]) -> Sparse {
     assert_eq!(scale.len(), energy.terms.len());
     let n = k.nrows();
     assert_eq!(m.len(), n);
     // The products run on K's non-zero entries only; the result keeps K's whole pattern (every
     // edge of the domain), where a monotone QP's constrained pairs lie.
     let k_full = k;
-    let k = &*without_zeros(k_full);
+    let mut k_nz = without_zeros(k_full);
     let mut sharp = vec![false; n];
     for &v in &energy.sharp {
         sharp[v] = true;
     }
     let d: Vec<f64> = (0..n).map(|i| if sharp[i] { 0.0 } else { 1.0 / m[i] }).collect();
-    let k_cut = if energy.sharp.is_empty() { Cow::Borrowed(k) } else { Cow::Owned(cut_edges(k, &sharp)) };
     let minv: Vec<f64> = m.iter().map(|x| 1.0 / x).collect();
     let mut all = Vec::new();
     let mut single: Option<Sparse> = None;
     let active = energy.terms.iter().zip(scale).filter(|(t, s)| t.1 * **s != 0.0).count();
-    for (&(order, w), &s) in energy.terms.iter().zip(scale) {
+    let last = energy.terms.iter().zip(scale).rposition(|(t, s)| t.1 * *s != 0.0);
+    for (t, (&(order, w), &s)) in energy.terms.iter().zip(scale).enumerate() {
         let c = w * s;
         if c == 0.0 {
             continue;
@@ -129,13 +138,23 @@ pub fn polyharmonic(k: &Sparse, m: &[f64], energy: &Energy, scale: &[f64]) -> Sp
         let q = match order {
             1 => k_full.clone(),
             _ => {
+                let k = k_nz.as_ref();
                 let g = scale_rows(k, &d); // D K
+                let k_cut = if energy.sharp.is_empty() { Cow::Borrowed(k) } else { Cow::Owned(cut_edges(k, &sharp)) };
                 let inner = match order {
                     2 => scale_rows_owned(g, m),                                       // M G
                     3 => matmul(&k_cut, &g),                                           // K′ G
                     _ => matmul(&k_cut, &scale_rows_owned(matmul(&k_cut, &g), &minv)), // K′ M⁻¹ K′ G
                 };
-                let gt = scale_cols_owned(k.clone(), &d); // K D = Gᵀ (K symmetric)
+                drop(k_cut);
+                // K D = Gᵀ (K symmetric); the last term scales K's own copy (a volume's K
+                // without its zeros is one: 0.2 GB at 128³ not held twice)
+                let k_owned = if Some(t) == last {
+                    std::mem::replace(&mut k_nz, Cow::Borrowed(k_full)).into_owned()
+                } else {
+                    k_nz.as_ref().clone()
+                };
+                let gt = scale_cols_owned(k_owned, &d);
                 matmul(&gt, &inner)
             }
         };
@@ -145,7 +164,7 @@ pub fn polyharmonic(k: &Sparse, m: &[f64], energy: &Energy, scale: &[f64]) -> Sp
             all.extend(triplets(&q).into_iter().map(|t| Triplet::new(t.row, t.col, c * t.val)));
         }
     }
-    with_pattern_of(single.unwrap_or_else(|| from_triplets(n, n, &all)), k_full)
+    single.unwrap_or_else(|| from_triplets(n, n, &all))
 }
 
 /// `K` without the edges at sharp vertices, diagonal recomputed so that rows sum to zero.

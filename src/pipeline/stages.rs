@@ -13,7 +13,8 @@ use crate::domain::{sos_sort, Domain};
 use crate::error::{Error, Result};
 use crate::linalg::Analyses;
 use crate::operators::{
-    plus_diagonal, polyharmonic, polyharmonic_factor, quadratic_form_without_diagonal, Factor, Sparse,
+    plus_diagonal, polyharmonic, polyharmonic_factor, polyharmonic_products, quadratic_form_without_diagonal, Factor,
+    Sparse,
 };
 use crate::solve::{
     condition_estimate, meet_margin, repair, Bound, Formulation, MarginSummary, Method, QpSolution, RepairSummary,
@@ -227,7 +228,13 @@ pub(super) fn build_operators<D: Smoothable>(
         .iter()
         .map(|&(order, _)| settings.smooth_weight.unwrap_or(ell.powi(2 * order as i32)))
         .collect();
-    let q_energy = polyharmonic(k, m, &settings.energy, &weights);
+    // the interior-point routes analyse P's pattern as the normal matrix's, which must hold
+    // every constrained pair (every edge); the active set needs only P's non-zero products
+    let q_energy = if settings.qp.method == Method::ActiveSet {
+        polyharmonic_products(k, m, &settings.energy, &weights)
+    } else {
+        polyharmonic(k, m, &settings.energy, &weights)
+    };
     let gd = settings.data_weight;
     let data_diag: Vec<f64> = m.iter().map(|mi| gd * mi).collect();
     let p = plus_diagonal(q_energy, &data_diag);

@@ -140,6 +140,13 @@ impl ReducedQp {
 
 /// Eliminates the fixed variables: `P_FF`, `q_F + P_FX x_X`, one row per constraint row.
 pub(super) fn reduce(qp: &MonotoneQp<'_>, free: &[usize]) -> ReducedQp {
+    reduce_with(qp, free, true).0
+}
+
+/// [`reduce`], with P's triplets and A's entries left empty unless `triplets` (a route that
+/// makes its own forms of them from `qp`: the active set; at 128³ they are 0.9 GB), and the
+/// number of entries in P's reduced upper triangle.
+pub(super) fn reduce_with(qp: &MonotoneQp<'_>, free: &[usize], triplets: bool) -> (ReducedQp, usize) {
     let n = qp.q.len();
     let mut slot = vec![usize::MAX; n];
     for (k, &i) in free.iter().enumerate() {
@@ -149,7 +156,8 @@ pub(super) fn reduce(qp: &MonotoneQp<'_>, free: &[usize]) -> ReducedQp {
     let mut q: Vec<f64> = free.iter().map(|&i| qp.q[i]).collect();
     let (cp, ri, val) = (qp.p.symbolic().col_ptr(), qp.p.symbolic().row_idx(), qp.p.val());
     // the upper triangle of a symmetric pattern: half the off-diagonal entries and the diagonal
-    let mut p = Vec::with_capacity(cp[n] / 2 + n);
+    let mut p = Vec::with_capacity(if triplets { cp[n] / 2 + n } else { 0 });
+    let (mut upper, mut diag) = (0usize, Vec::with_capacity(if triplets { 0 } else { free.len() }));
     let mut constant = 0.0;
     for j in 0..n {
         for k in cp[j]..cp[j + 1] {
@@ -158,13 +166,20 @@ pub(super) fn reduce(qp: &MonotoneQp<'_>, free: &[usize]) -> ReducedQp {
                 (usize::MAX, usize::MAX) => constant += 0.5 * xfix(i) * val[k] * xfix(j),
                 (usize::MAX, _) => {}
                 (si, usize::MAX) => q[si] += val[k] * xfix(j),
-                (si, sj) if si <= sj => p.push((si, sj, val[k])),
+                (si, sj) if si <= sj => {
+                    upper += 1;
+                    if triplets {
+                        p.push((si, sj, val[k]));
+                    } else if si == sj {
+                        diag.push(val[k]);
+                    }
+                }
                 _ => {}
             }
         }
     }
     let nf = free.len();
-    let diag: f64 = p.iter().filter(|t| t.0 == t.1).map(|t| t.2).sum();
+    let diag: f64 = if triplets { p.iter().filter(|t| t.0 == t.1).map(|t| t.2).sum() } else { diag.iter().sum() };
     let scale = (diag / nf as f64).max(f64::MIN_POSITIVE);
     p.iter_mut().for_each(|t| t.2 /= scale);
     q.iter_mut().for_each(|v| *v /= scale);
@@ -188,16 +203,19 @@ pub(super) fn reduce(qp: &MonotoneQp<'_>, free: &[usize]) -> ReducedQp {
     };
     let rows = constraint_rows(qp);
     r.b.reserve_exact(rows.len());
+    let entries = if triplets { 2 * rows.len() } else { 0 };
     for v in [&mut r.a_row, &mut r.a_col] {
-        v.reserve_exact(2 * rows.len());
+        v.reserve_exact(entries);
     }
-    r.a_val.reserve_exact(2 * rows.len());
+    r.a_val.reserve_exact(entries);
     for row in rows {
         let at = r.b.len();
         let mut push = |col: usize, v: f64| {
-            r.a_row.push(at);
-            r.a_col.push(col);
-            r.a_val.push(v);
+            if triplets {
+                r.a_row.push(at);
+                r.a_col.push(col);
+                r.a_val.push(v);
+            }
         };
         // f_j − f_i ≥ ε  ⇔  f_i − f_j ≤ −ε
         match row {
@@ -226,7 +244,7 @@ pub(super) fn reduce(qp: &MonotoneQp<'_>, free: &[usize]) -> ReducedQp {
             }
         }
     }
-    r
+    (r, upper)
 }
 
 /// Divides the objective of `r` by a further `by` (its `scale` becomes `scale · by`).

@@ -2,7 +2,7 @@
 //! assembled or the factored form, Clarabel as its fallback or on its own.
 
 use super::newton::Prepared;
-use super::problem::{constraint_rows, reduce, reduce_factor, rescale, MonotoneQp, ReducedQp};
+use super::problem::{constraint_rows, reduce, reduce_factor, reduce_with, rescale, MonotoneQp, ReducedQp};
 use super::settings::{Formulation, Method, QpSettings, DOUBLE_DOUBLE_ABOVE, FACTORED_ABOVE};
 use super::status::{QpSolution, SolveStatus};
 use crate::error::Result;
@@ -51,7 +51,12 @@ pub fn solve_monotone_qp_with(
             predicted_peak: None,
         });
     }
-    let mut reduced = reduce(qp, &free);
+    // the active set makes its own forms of P and the rows from the problem: the reduced QP
+    // is made without its triplets for it (rebuilt should another route take over)
+    let light = settings.method == Method::ActiveSet
+        && settings.formulation != Formulation::Factored
+        && qp.condition.is_some_and(|c| settings.formulation == Formulation::Assembled || c <= FACTORED_ABOVE);
+    let (mut reduced, upper_entries) = reduce_with(qp, &free, !light);
     let condition = qp.condition.or_else(|| super::condition::estimate(&reduced));
     let wants_factored = match (settings.method, settings.formulation) {
         (Method::ClarabelAuxiliary, _) | (_, Formulation::Factored) => true,
@@ -94,20 +99,14 @@ pub fn solve_monotone_qp_with(
             // the iteration's peak beside what the process holds: past the budget it is
             // refused, not started (the interior-point route would need more still)
             let budget = crate::memory::Budget::of(settings.memory_limit);
-            let extra = super::active_set::predicted_bytes(reduced.n, reduced.m(), reduced.p.len());
+            let extra = super::active_set::predicted_bytes(reduced.n, reduced.m(), upper_entries);
             let peak = budget.in_use() + extra + budget.kernel_reserve();
             if peak > budget.bytes {
                 return Err(crate::memory::over_budget("the active-set iteration", peak, &budget));
             }
             predicted_peak = Some(peak);
-            let outcome = super::active_set::Operands::take(&mut reduced)
+            let outcome = super::active_set::Operands::new(qp, &free, &reduced)
                 .and_then(|operands| super::active_set::solve(&reduced, operands, hint.as_deref(), settings));
-            if !matches!(&outcome, Ok(a) if a.outcome.status == SolveStatus::Solved) {
-                // the route taking over needs the triplets the iteration freed
-                let again = reduce(qp, &free);
-                (reduced.p, reduced.a_row, reduced.a_col, reduced.a_val) =
-                    (again.p, again.a_row, again.a_col, again.a_val);
-            }
             match outcome {
                 Ok(a) if a.outcome.status == SolveStatus::Solved => {
                     inner_iterations = a.cg_iterations;
@@ -134,6 +133,10 @@ pub fn solve_monotone_qp_with(
         }
         _ => None,
     };
+    if attempt.is_none() && light {
+        // the route taking over needs the triplets
+        reduced = reduce(qp, &free);
+    }
     let (out, method) = match (attempt, settings.method) {
         (Some(out), _) => (out, Method::ActiveSet),
         (None, Method::Auto | Method::Structured | Method::ActiveSet) => {
@@ -328,8 +331,8 @@ mod tests {
     }
 
     /// The active-set route handing over (here for a free variable without a data term): the
-    /// structured solver then works on the triplets rebuilt after the iteration's operands
-    /// took them, and gives the bits the structured route gives alone.
+    /// structured solver then works on the reduced QP rebuilt with the triplets the active
+    /// set's went without, and gives the bits the structured route gives alone.
     #[test]
     fn a_hand_over_from_the_active_set_solves_the_rebuilt_problem() {
         let (nx, ny) = (30, 20);
@@ -352,7 +355,8 @@ mod tests {
             bounds: &[],
             data: Some(&data),
             factor: None,
-            condition: None,
+            // known: the active set's reduced QP is made without triplets
+            condition: Some(1.0),
         };
         let run = |method| solve_monotone_qp(&qp, &QpSettings { method, ..QpSettings::default() }).unwrap();
         let (handed, direct) = (run(Method::ActiveSet), run(Method::Structured));

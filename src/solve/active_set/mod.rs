@@ -27,7 +27,7 @@ mod objective;
 mod operator;
 mod rows;
 
-use super::problem::ReducedQp;
+use super::problem::{MonotoneQp, ReducedQp};
 use super::settings::QpSettings;
 use super::status::{Outcome, SolveStatus};
 use crate::error::NumericalError;
@@ -72,23 +72,21 @@ pub(super) struct ActiveSetOutcome {
     pub(super) cg_iterations: usize,
 }
 
-/// Bytes the iteration allocates beside the reduced QP, at most, for `n` variables, `m` rows
-/// and `p_entries` stored entries of P's upper triangle: P's row classes (12 bytes an entry
-/// of both triangles when no row repeats, as on a mesh) and the index that makes them (where
-/// each column starts, each row's triplets in later columns: 4 bytes an entry and 32 a
-/// variable), the rows (32 bytes each) with
-/// their flags and multipliers, and per variable its row class and the classes' hash (36
-/// bytes when no row repeats), the clusters (labels, offsets, anchors, their adjacency), the
-/// conjugate gradients' eight vectors and unknown map, the forest (order, parents, depths)
-/// and the join's tables, the flow's nodes (a variable's, its cluster's source and sink: 36
-/// bytes); per row the
-/// cluster and forest adjacency and the flow network (two arcs of 16 bytes, doubled by the
-/// growth of its vectors, and the arc list). Counted as if every phase's storage were live at
-/// once, so an upper bound of the iteration's own peak.
+/// Bytes the iteration allocates beside the reduced QP (made without its triplets), at most,
+/// for `n` variables, `m` rows and `p_entries` stored entries of P's upper triangle: P's row
+/// classes (12 bytes an entry of both triangles when no row repeats, as on a mesh) and the
+/// cursors that make them (8 bytes a variable), the rows (32 bytes each) with their flags and
+/// multipliers, and per variable its row class and the classes' hash (36 bytes when no row
+/// repeats), the clusters (labels, offsets, anchors, their adjacency), the conjugate
+/// gradients' eight vectors and unknown map, the forest (order, parents, depths) and the
+/// join's tables, the flow's nodes (a variable's, its cluster's source and sink: 36 bytes);
+/// per row the cluster and forest adjacency and the flow network (two arcs of 16 bytes,
+/// doubled by the growth of its vectors, and the arc list). Counted as if every phase's
+/// storage were live at once, so an upper bound of the iteration's own peak.
 #[must_use]
 pub(crate) fn predicted_bytes(n: usize, m: usize, p_entries: usize) -> u64 {
     let (n, m, p) = (n as u64, m as u64, p_entries as u64);
-    let csr = 12 * (2 * p) + 4 * p + 32 * (n + 1);
+    let csr = 12 * (2 * p) + 8 * (n + 1);
     let per_variable = 36 + 24 + 72 + 76 + 70 + 28 + 4 + 15 + 36;
     let per_row = 32 + 10 + 32 + 16 + 96 + 17;
     csr + per_variable * n + per_row * m
@@ -101,22 +99,28 @@ pub(super) struct Operands {
 }
 
 impl Operands {
-    /// Made from the reduced QP's triplets, which they replace: P's upper triangle and A's
-    /// entries are freed as soon as converted (at 128³ the triplets alone are 0.9 GB), so a
-    /// caller that hands the problem over afterwards rebuilds them. Needs the assembled
-    /// energy with a data term at every variable (the gap bound and the conjugate
+    /// Made from the problem itself for its reduced QP `r` (reduced over `free`, made without
+    /// triplets: `problem::reduce_with`): P's row classes from P's columns, the rows from the
+    /// constraint rows, as the reduced QP's triplets and rows would give them. Needs the
+    /// assembled energy with a data term at every variable (the gap bound and the conjugate
     /// gradients' start).
-    pub(super) fn take(r: &mut ReducedQp) -> std::result::Result<Operands, NumericalError> {
+    pub(super) fn new(
+        qp: &MonotoneQp<'_>,
+        free: &[usize],
+        r: &ReducedQp,
+    ) -> std::result::Result<Operands, NumericalError> {
         if !r.gap_bound || r.factor.is_some() {
             return Err("the active-set iteration needs the assembled energy with a data term everywhere".into());
         }
         if r.n >= NONE as usize {
             return Err("too many variables for the active-set iteration".into());
         }
-        let rows = rows_of(r)?;
-        (r.a_row, r.a_col, r.a_val) = (Vec::new(), Vec::new(), Vec::new());
-        let p = RowClasses::from_upper(r.n, &r.p)?;
-        r.p = Vec::new();
+        let mut slot = vec![usize::MAX; qp.q.len()];
+        for (k, &v) in free.iter().enumerate() {
+            slot[v] = k;
+        }
+        let rows = rows_of(qp, &slot);
+        let p = RowClasses::from_columns(qp.p, free, &slot, r.scale)?;
         Ok(Operands { p, rows })
     }
 }

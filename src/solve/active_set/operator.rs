@@ -10,6 +10,7 @@
 //! the order compressed rows would hold them, so the products are those of the compressed
 //! rows bit for bit; on a mesh, where rows rarely repeat, each row is its own class.
 
+use crate::operators::Sparse;
 use std::collections::HashMap;
 
 /// Rows of one class a product sums side by side.
@@ -33,12 +34,11 @@ pub(super) struct RowClasses {
 
 impl RowClasses {
     /// From P's upper triangle as triplets sorted by column, then row (as the reduced QP
-    /// stores them; errs otherwise, or when a column offset does not fit in 32 bits). Row by
-    /// row, without P's compressed rows: row `i`'s entries are column `i`'s triplets (columns
-    /// up to `i`) then its own triplets in later columns, in increasing column order; each row
-    /// either matches an earlier class or appends its own.
+    /// stores them; errs otherwise): row `i`'s entries are column `i`'s triplets (columns up to
+    /// `i`) then its own triplets in later columns, in increasing column order.
+    #[cfg(test)]
     pub(super) fn from_upper(n: usize, p: &[(usize, usize, f64)]) -> Result<RowClasses, &'static str> {
-        if n > i32::MAX as usize || p.len() > u32::MAX as usize {
+        if p.len() > u32::MAX as usize {
             return Err("too many variables for the active-set iteration");
         }
         if p.windows(2).any(|w| (w[0].1, w[0].0) > (w[1].1, w[1].0)) || p.iter().any(|&(i, j, _)| i > j || j >= n) {
@@ -66,6 +66,73 @@ impl RowClasses {
             }
         }
         drop(at);
+        Self::from_rows(n, |i, entry| {
+            for &(r, _, v) in &p[column[i]..column[i + 1]] {
+                entry(r, v);
+            }
+            for &t in &in_row[later[i]..later[i + 1]] {
+                let (_, c, v) = p[t as usize];
+                entry(c, v);
+            }
+            Ok(())
+        })
+    }
+
+    /// From P as stored whole (both triangles, a symmetric pattern, rows sorted in each
+    /// column), restricted to the free variables (`slot[v]` is `v`'s index among them,
+    /// `usize::MAX` when fixed) and divided by `scale`: the reduced QP's P without its
+    /// triplets, each entry taken from the upper triangle (`P_ij` with `i ≤ j` from column `j`)
+    /// as the triplets take them, so the same bits. Row `u`'s entries below the diagonal are
+    /// column `u`'s, those above are in the columns its own entries below the diagonal name
+    /// (the pattern is symmetric), each found at that column's cursor as rows advance.
+    pub(super) fn from_columns(
+        p: &Sparse,
+        free: &[usize],
+        slot: &[usize],
+        scale: f64,
+    ) -> Result<RowClasses, &'static str> {
+        let (cp, ri, val) = (p.symbolic().col_ptr(), p.symbolic().row_idx(), p.val());
+        let mut cursor: Vec<usize> = cp[..p.ncols()].to_vec();
+        Self::from_rows(free.len(), |u, entry| {
+            let j = free[u];
+            let column = cp[j]..cp[j + 1];
+            for k in column.clone() {
+                let s = slot[ri[k]];
+                if s != usize::MAX && s <= u {
+                    entry(s, val[k] / scale);
+                }
+            }
+            for k in column {
+                let c = ri[k];
+                let s = slot[c];
+                if s == usize::MAX || s <= u {
+                    continue;
+                }
+                // column c's entry at row j: its rows before j are fixed or passed already
+                let at = &mut cursor[c];
+                while *at < cp[c + 1] && ri[*at] < j {
+                    *at += 1;
+                }
+                if *at == cp[c + 1] || ri[*at] != j {
+                    return Err("P's pattern is not symmetric");
+                }
+                entry(s, val[*at] / scale);
+                *at += 1;
+            }
+            Ok(())
+        })
+    }
+
+    /// Row by row: `row(i, entry)` calls `entry(column, value)` for row `i`'s entries in
+    /// increasing column order; exact zeros are dropped, and each row either matches an
+    /// earlier class or appends its own. Errs when a column offset does not fit in 32 bits.
+    fn from_rows(
+        n: usize,
+        mut row: impl FnMut(usize, &mut dyn FnMut(usize, f64)) -> Result<(), &'static str>,
+    ) -> Result<RowClasses, &'static str> {
+        if n > i32::MAX as usize {
+            return Err("too many variables for the active-set iteration");
+        }
         let mut class = vec![0u32; n];
         let mut start = vec![0usize];
         let (mut offset, mut value): (Vec<i32>, Vec<f64>) = (Vec::new(), Vec::new());
@@ -74,16 +141,13 @@ impl RowClasses {
         for (i, class_i) in class.iter_mut().enumerate() {
             row_offset.clear();
             row_value.clear();
-            // |j − i| < n ≤ i32::MAX
-            let lower = p[column[i]..column[i + 1]].iter().map(|&(r, _, v)| ((r as i64 - i as i64) as i32, v));
-            let upper = in_row[later[i]..later[i + 1]].iter().map(|&t| {
-                let (_, c, v) = p[t as usize];
-                ((c as i64 - i as i64) as i32, v)
-            });
-            for (o, v) in lower.chain(upper).filter(|e| e.1 != 0.0) {
-                row_offset.push(o);
-                row_value.push(v);
-            }
+            row(i, &mut |c, v| {
+                if v != 0.0 {
+                    // |c − i| < n ≤ i32::MAX
+                    row_offset.push((c as i64 - i as i64) as i32);
+                    row_value.push(v);
+                }
+            })?;
             let key = row_hash(&row_offset, &row_value);
             let found = seen.get(&key).copied().filter(|&c| {
                 let (a, b) = (start[c as usize], start[c as usize + 1]);
@@ -238,5 +302,55 @@ mod tests {
             assert_eq!(sorted, written, "row {i}");
             assert_eq!(rc.diagonal(i), dense[i][i], "row {i}'s diagonal");
         }
+    }
+
+    /// From P stored whole, with variable 1 fixed and a scale: the classes and products of the
+    /// reduced upper triangle's triplets, bit for bit, though the stored lower triangle differs
+    /// from the upper one in its last bits; an entry whose mirror is missing is refused.
+    #[test]
+    fn columns_give_the_reduced_triplets_rows() {
+        let n = 7;
+        let mut t = Vec::new();
+        for i in 0..n {
+            t.push(faer::sparse::Triplet::new(i, i, 2.5 + 0.1 * i as f64));
+            for (j, v) in [(i + 1, -1.0 / 3.0), (i + 2, 0.25)] {
+                if j < n {
+                    t.push(faer::sparse::Triplet::new(i, j, v));
+                    // the lower triangle one ulp off: only the upper one may be read
+                    t.push(faer::sparse::Triplet::new(j, i, f64::from_bits(v.to_bits() + 1)));
+                }
+            }
+        }
+        let p = Sparse::try_new_from_triplets(n, n, &t).unwrap();
+        let free: Vec<usize> = (0..n).filter(|&v| v != 1).collect();
+        let mut slot = vec![usize::MAX; n];
+        free.iter().enumerate().for_each(|(k, &v)| slot[v] = k);
+        let scale = 1.7;
+        let (cp, ri, val) = (p.symbolic().col_ptr(), p.symbolic().row_idx(), p.val());
+        let mut upper = Vec::new();
+        for &j in &free {
+            for k in cp[j]..cp[j + 1] {
+                if slot[ri[k]] != usize::MAX && ri[k] <= j {
+                    upper.push((slot[ri[k]], slot[j], val[k] / scale));
+                }
+            }
+        }
+        let (a, b) = (
+            RowClasses::from_upper(free.len(), &upper).unwrap(),
+            RowClasses::from_columns(&p, &free, &slot, scale).unwrap(),
+        );
+        assert_eq!(a.classes(), b.classes());
+        let x: Vec<f64> = (0..free.len()).map(|i| (i as f64 * 0.9).cos()).collect();
+        let (mut ya, mut yb) = (vec![0.0; free.len()], vec![0.0; free.len()]);
+        a.apply(&x, &mut ya);
+        b.apply(&x, &mut yb);
+        assert_eq!(ya, yb);
+        for i in 0..free.len() {
+            assert_eq!(a.row(i).collect::<Vec<_>>(), b.row(i).collect::<Vec<_>>(), "row {i}");
+        }
+        // an entry below the diagonal whose mirror is missing
+        t.push(faer::sparse::Triplet::new(5, 0, 1.0));
+        let lopsided = Sparse::try_new_from_triplets(n, n, &t).unwrap();
+        assert!(RowClasses::from_columns(&lopsided, &free, &slot, scale).is_err());
     }
 }

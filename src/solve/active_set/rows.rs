@@ -1,7 +1,6 @@
 //! The reduced QP's constraint rows as the active-set iteration reads them.
 
-use super::super::problem::ReducedQp;
-use crate::error::NumericalError;
+use super::super::problem::{constraint_rows, MonotoneQp, Row as QpRow};
 
 /// One constraint row of the reduced QP.
 #[derive(Clone, Copy)]
@@ -27,34 +26,21 @@ impl Row {
     }
 }
 
-pub(super) fn rows_of(r: &ReducedQp) -> std::result::Result<Vec<Row>, NumericalError> {
-    let mut rows = Vec::with_capacity(r.m());
-    let mut k = 0;
-    while k < r.a_row.len() {
-        let at = r.a_row[k];
-        let two = k + 1 < r.a_row.len() && r.a_row[k + 1] == at;
-        if two {
-            let (i, j) = (r.a_col[k], r.a_col[k + 1]);
-            match (r.a_val[k], r.a_val[k + 1]) {
-                (a, b) if a == 1.0 && b == -1.0 => rows.push(Row::Pair(i, j, r.b[at])),
-                (a, b) if a == -1.0 && b == 1.0 => rows.push(Row::Pair(j, i, r.b[at])),
-                _ => return Err("a row is not a difference of two variables".into()),
-            }
-            k += 2;
-        } else {
-            let a = r.a_val[k];
-            if a != 1.0 && a != -1.0 {
-                return Err("a bound row has a coefficient other than ±1".into());
-            }
-            rows.push(Row::Bound(r.a_col[k], a, r.b[at]));
-            k += 1;
-        }
-        if rows.len() != at + 1 {
-            return Err("the rows are not stored in order".into());
-        }
-    }
-    if rows.len() != r.m() {
-        return Err("a row has no entry".into());
-    }
-    Ok(rows)
+/// The reduced QP's rows (as `problem::reduce` writes them: fixed values substituted, in the
+/// order of [`constraint_rows`]), `slot[v]` being `v`'s index among the free variables.
+pub(super) fn rows_of(qp: &MonotoneQp<'_>, slot: &[usize]) -> Vec<Row> {
+    let eps = qp.margin;
+    constraint_rows(qp)
+        .into_iter()
+        .map(|row| match row {
+            // f_j − f_i ≥ ε  ⇔  f_i − f_j ≤ −ε
+            QpRow::Pair(i, j) => match (qp.fixed[i], qp.fixed[j]) {
+                (None, None) => Row::Pair(slot[i], slot[j], -eps),
+                (Some(fi), _) => Row::Bound(slot[j], -1.0, -eps - fi),
+                (None, Some(fj)) => Row::Bound(slot[i], 1.0, fj - eps),
+            },
+            QpRow::Upper(v, c) => Row::Bound(slot[v], 1.0, c),
+            QpRow::Lower(v, c) => Row::Bound(slot[v], -1.0, -c),
+        })
+        .collect()
 }

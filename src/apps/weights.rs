@@ -19,7 +19,7 @@ use crate::constraints::{choose_margin, constraint_edges, margin_cap, max_margin
 use crate::domain::sos_sort;
 use crate::error::{Error, Result};
 use crate::linalg::Analyses;
-use crate::operators::{dirichlet_solve, polyharmonic, Energy, Sparse};
+use crate::operators::{dirichlet_solve, Energy, Sparse};
 use crate::pipeline::Smoothable;
 use crate::representative::harmonic_order::ordered_harmonic;
 use crate::solve::{repair, solve_bounded_partition, solve_monotone_qp_with, MonotoneQp, QpSettings, SolveStatus};
@@ -378,7 +378,7 @@ pub fn weights_prescribed<D: Smoothable + Sync>(
     let t = Instant::now();
     let k = domain.stiffness();
     let m = domain.mass();
-    let energy = polyharmonic(&k, &m, &Energy::order(settings.order), &[1.0]);
+    let energy = crate::pipeline::energy_on_edges(domain, &k, &m, &Energy::order(settings.order), &[1.0]);
     let fill = domain.own_fill_stiffness().unwrap_or_else(|| k.clone());
     let ops = Operators { energy, fill, stiffness: k };
     let operator_seconds = t.elapsed().as_secs_f64();

@@ -35,6 +35,8 @@ pub use harmonic::{dirichlet_solve, dirichlet_solve_with, Dirichlet};
 pub(crate) use polyharmonic::polyharmonic_products;
 pub use polyharmonic::{polyharmonic, Energy};
 pub use series::{series_mass, series_stiffness};
+pub(crate) use sparse::with_pattern_of;
 pub use sparse::{plus_diagonal, quadratic_form, quadratic_form_without_diagonal, scaled_plus_diagonal, Sparse};
 pub use tet::{positive_tet_stiffness, tet_gradient_factor, tet_gradient_operator, tet_lumped_mass, tet_stiffness};
+pub(crate) use volume::volume_edge_pattern;
 pub use volume::{volume_mass, volume_stiffness};

@@ -6,8 +6,9 @@ use crate::error::{Error, Result};
 use crate::linalg::Analyses;
 use crate::operators::{
     cotan_stiffness, dirichlet_solve, edge_factor, gradient_factor, grid_mass, grid_stiffness, lumped_mass,
-    positive_cotan_stiffness, positive_tet_stiffness, series_mass, series_stiffness, tet_gradient_factor,
-    tet_lumped_mass, tet_stiffness, volume_mass, volume_stiffness, Factor, Sparse,
+    polyharmonic, polyharmonic_products, positive_cotan_stiffness, positive_tet_stiffness, series_mass,
+    series_stiffness, tet_gradient_factor, tet_lumped_mass, tet_stiffness, volume_edge_pattern, volume_mass,
+    volume_stiffness, with_pattern_of, Energy, Factor, Sparse,
 };
 use crate::representative::{flooded_representative, separatrix_representative, series_representative, Repairs};
 use crate::topology::morse_smale::MorseSmale;
@@ -108,6 +109,12 @@ pub trait Smoothable: Domain {
     fn own_fill_stiffness(&self) -> Option<Sparse> {
         None
     }
+    /// The domain's edges (and each vertex itself) as a pattern of zeros where its stiffness
+    /// does not store every edge, else `None`: the interior-point routes analyse the energy's
+    /// pattern as their normal matrix's, which must hold every constrained pair.
+    fn edge_pattern(&self) -> Option<Sparse> {
+        None
+    }
     /// A volume (tetrahedra): direct factorisations of its energies fill in as a 3D nested
     /// dissection does, which sets [`Method::Auto`](crate::solve::Method::Auto)'s choice.
     fn solid(&self) -> bool {
@@ -139,6 +146,22 @@ pub trait Smoothable: Domain {
     {
         let cells = if self.solid() { Cells::Tetrahedra } else { Cells::Triangles };
         surface_representative(self, h, kept, choice, fill, excluded, analyses, cells)
+    }
+}
+
+/// The polyharmonic energy with every edge of the domain in its pattern, where the
+/// interior-point routes need the constrained pairs (a volume's stiffness does not store its
+/// diagonal edges: [`Smoothable::edge_pattern`]).
+pub(crate) fn energy_on_edges<D: Smoothable>(
+    domain: &D,
+    k: &Sparse,
+    m: &[f64],
+    energy: &Energy,
+    scale: &[f64],
+) -> Sparse {
+    match domain.edge_pattern() {
+        Some(edges) => with_pattern_of(polyharmonic_products(k, m, energy, scale), &edges),
+        None => polyharmonic(k, m, energy, scale),
     }
 }
 
@@ -425,6 +448,9 @@ impl Smoothable for Grid3d {
     fn stiffness(&self) -> Sparse {
         volume_stiffness(self)
     }
+    fn edge_pattern(&self) -> Option<Sparse> {
+        Some(volume_edge_pattern(self))
+    }
     fn mass(&self) -> Vec<f64> {
         volume_mass(self)
     }
@@ -452,5 +478,38 @@ impl Smoothable for TetMesh {
     /// gradients (three rows per tetrahedron).
     fn stiffness_factor(&self, k: &Sparse) -> Option<Factor> {
         edge_factor(k).or_else(|| Some(tet_gradient_factor(self.positions(), self.tets())))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A volume's stiffness stores its 7-point stencil only; the energy the interior-point
+    /// routes get holds every edge (each of SPEC's 14 neighbours), the active set's only the
+    /// products' 25-point stencil.
+    #[test]
+    fn a_volume_s_energy_holds_every_edge_for_the_interior_point_routes() {
+        let g = Grid3d::with_geometry([5, 4, 6], [1.0, 1.5, 0.7], [0.0; 3]).unwrap();
+        let (k, m) = (g.stiffness(), g.mass());
+        let energy = Energy::order(2);
+        let holds = |p: &Sparse, v: usize, w: usize| {
+            let (cp, ri) = (p.symbolic().col_ptr(), p.symbolic().row_idx());
+            ri[cp[w]..cp[w + 1]].binary_search(&v).is_ok()
+        };
+        let on_edges = energy_on_edges(&g, &k, &m, &energy, &[1.0]);
+        let products = polyharmonic_products(&k, &m, &energy, &[1.0]);
+        let mut diagonal_missing = 0;
+        for v in 0..g.n_vertices() {
+            for w in g.neighbors(v) {
+                assert!(holds(&on_edges, v, w), "edge ({v}, {w})");
+                diagonal_missing += usize::from(!holds(&products, v, w));
+            }
+        }
+        assert!(diagonal_missing > 0, "the cube diagonals lie outside the 25-point stencil");
+        // the same values where both hold an entry
+        let x: Vec<f64> = (0..g.n_vertices()).map(|i| (i as f64 * 0.37).sin()).collect();
+        let (a, b) = (crate::operators::quadratic_form(&on_edges, &x), crate::operators::quadratic_form(&products, &x));
+        assert!((a - b).abs() <= 1e-12 * a.abs(), "{a} against {b}");
     }
 }

@@ -7,14 +7,13 @@ use super::report::{
     fit_report, EnergyReport, FitInputs, MemoryReport, Report, RunSettings, StageSeconds, ACTIVE_WARNING,
 };
 use super::settings::SmoothSettings;
-use super::smoothable::{RepresentativeKind, Smoothable};
+use super::smoothable::{energy_on_edges, RepresentativeKind, Smoothable};
 use crate::constraints::{activity, choose_margin, constraint_edges, margin_cap, max_margin_or_conflict};
 use crate::domain::{sos_sort, Domain};
 use crate::error::{Error, Result};
 use crate::linalg::Analyses;
 use crate::operators::{
-    plus_diagonal, polyharmonic, polyharmonic_factor, polyharmonic_products, quadratic_form_without_diagonal, Factor,
-    Sparse,
+    plus_diagonal, polyharmonic_factor, polyharmonic_products, quadratic_form_without_diagonal, Factor, Sparse,
 };
 use crate::solve::{
     condition_estimate, meet_margin, repair, Bound, Formulation, MarginSummary, Method, QpSolution, RepairSummary,
@@ -233,7 +232,7 @@ pub(super) fn build_operators<D: Smoothable>(
     let q_energy = if settings.qp.method == Method::ActiveSet {
         polyharmonic_products(k, m, &settings.energy, &weights)
     } else {
-        polyharmonic(k, m, &settings.energy, &weights)
+        energy_on_edges(domain, k, m, &settings.energy, &weights)
     };
     let gd = settings.data_weight;
     let data_diag: Vec<f64> = m.iter().map(|mi| gd * mi).collect();

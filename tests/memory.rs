@@ -75,11 +75,12 @@ fn an_active_set_run_predicted_past_its_budget_is_refused_before_the_solve() {
     let dir = scratch("memory-refused-active-set");
     let out = dir.join("m.vti");
     let mri = dataset("mri_anatomical_33x41x25.nii");
-    let o = toposmooth(&["smooth", &mri, "-o", out.to_str().unwrap(), "--memory-limit", "80M"]);
+    // the run itself peaks at about 55 MiB and is predicted at about 58–63 MiB
+    let o = toposmooth(&["smooth", &mri, "-o", out.to_str().unwrap(), "--memory-limit", "40M"]);
     assert_eq!(o.status.code(), Some(3), "{}", text(&o));
     let stderr = String::from_utf8_lossy(&o.stderr);
     assert!(stderr.contains("not enough memory: the active-set iteration would need about"), "{stderr}");
-    assert!(stderr.contains("over the memory budget of 80 MiB"), "{stderr}");
+    assert!(stderr.contains("over the memory budget of 40 MiB"), "{stderr}");
     assert!(!stderr.contains("hand-over"), "refused, not handed to the interior-point route: {stderr}");
     nothing_left(&dir);
 }

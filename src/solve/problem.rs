@@ -101,7 +101,8 @@ impl ReducedFactor {
 pub struct ReducedQp {
     /// Number of free variables.
     pub n: usize,
-    /// Upper triangle of P as triplets (row ≤ col).
+    /// Upper triangle of P as triplets (row ≤ col), sorted by column then row; empty, as A's
+    /// entries are, when made for the active set (`reduce_with`).
     pub p: Vec<(usize, usize, f64)>,
     /// Linear term.
     pub q: Vec<f64>,

@@ -99,14 +99,24 @@ pub fn solve_monotone_qp_with(
             // the iteration's peak beside what the process holds: past the budget it is
             // refused, not started (the interior-point route would need more still)
             let budget = crate::memory::Budget::of(settings.memory_limit);
-            let extra = super::active_set::predicted_bytes(reduced.n, reduced.m(), upper_entries);
-            let peak = budget.in_use() + extra + budget.kernel_reserve();
-            if peak > budget.bytes {
-                return Err(crate::memory::over_budget("the active-set iteration", peak, &budget));
-            }
-            predicted_peak = Some(peak);
-            let outcome = super::active_set::Operands::new(qp, &free, &reduced)
-                .and_then(|operands| super::active_set::solve(&reduced, operands, hint.as_deref(), settings));
+            let fits = |extra: u64| {
+                let peak = budget.in_use() + extra + budget.kernel_reserve();
+                if peak > budget.bytes {
+                    Err(crate::memory::over_budget("the active-set iteration", peak, &budget))
+                } else {
+                    Ok(peak)
+                }
+            };
+            // its operands first, then the iteration beside them, each checked before it is made
+            let before = fits(super::active_set::operand_bytes(reduced.n, reduced.m(), upper_entries))?;
+            let outcome = match super::active_set::Operands::new(qp, &free, &reduced) {
+                Ok(operands) => {
+                    let beside = fits(super::active_set::iteration_bytes(reduced.n, reduced.m()))?;
+                    predicted_peak = Some(before.max(beside));
+                    super::active_set::solve(&reduced, operands, hint.as_deref(), settings)
+                }
+                Err(why) => Err(why),
+            };
             match outcome {
                 Ok(a) if a.outcome.status == SolveStatus::Solved => {
                     inner_iterations = a.cg_iterations;

@@ -72,24 +72,31 @@ pub(super) struct ActiveSetOutcome {
     pub(super) cg_iterations: usize,
 }
 
-/// Bytes the iteration allocates beside the reduced QP (made without its triplets), at most,
-/// for `n` variables, `m` rows and `p_entries` stored entries of P's upper triangle: P's row
-/// classes (12 bytes an entry of both triangles when no row repeats, as on a mesh) and the
-/// cursors that make them (8 bytes a variable), the rows (32 bytes each) with their flags and
-/// multipliers, and per variable its row class and the classes' hash (36 bytes when no row
-/// repeats), the clusters (labels, offsets, anchors, their adjacency), the conjugate
-/// gradients' eight vectors and unknown map, the forest (order, parents, depths) and the
-/// join's tables, the flow's nodes (a variable's, its cluster's source and sink: 36 bytes);
-/// per row the cluster and forest adjacency and the flow network (two arcs of 16 bytes,
-/// doubled by the growth of its vectors, and the arc list). Counted as if every phase's
-/// storage were live at once, so an upper bound of the iteration's own peak.
+/// Bytes the iteration's operands take, at most, before they are made, for `n` variables, `m`
+/// rows and `p_entries` stored entries of P's upper triangle: the rows (32 bytes each, with the
+/// 24 of the problem's own row list they are made from), the row classes' tables (12 bytes an
+/// entry of both triangles when no row repeats, as on a mesh; a grid's few hundred classes
+/// take next to nothing) and per variable its class, slot and cursor.
 #[must_use]
-pub(crate) fn predicted_bytes(n: usize, m: usize, p_entries: usize) -> u64 {
+pub(crate) fn operand_bytes(n: usize, m: usize, p_entries: usize) -> u64 {
     let (n, m, p) = (n as u64, m as u64, p_entries as u64);
-    let csr = 12 * (2 * p) + 8 * (n + 1);
-    let per_variable = 36 + 24 + 72 + 76 + 70 + 28 + 4 + 15 + 36;
-    let per_row = 32 + 10 + 32 + 16 + 96 + 17;
-    csr + per_variable * n + per_row * m
+    56 * m + 12 * (2 * p) + 20 * (n + 1)
+}
+
+/// Bytes the iteration allocates beside its operands, at most, for `n` variables and `m` rows,
+/// phase by phase (clusters, trees and unknowns never outnumber the variables; the set's pair
+/// rows form a forest, so fewer than the variables): throughout, the point, the gradient, the
+/// rows' flags and multipliers (16 a variable, 10 a row) and the clusters with their trees (60
+/// a variable); the conjugate gradients' vectors and unknown map (100); the flow network when
+/// every cluster is marked and every row is an arc (nodes, terminals, supplies, cut sides:
+/// 198 a variable; arcs with their reverses, doubled by the vectors' growth, and the arc
+/// list: 96 a row); the join's labels, tables and violated list (27 a variable, 33 a row);
+/// the clusters' construction (41). The flow's phase is the largest: 16 + 60 + 8 + 198 per
+/// variable, 10 + 96 per row, rounded up.
+#[must_use]
+pub(crate) fn iteration_bytes(n: usize, m: usize) -> u64 {
+    let (n, m) = (n as u64, m as u64);
+    290 * n + 110 * m
 }
 
 /// P and the constraint rows in the iteration's own forms ([`RowClasses`], [`Row`]).

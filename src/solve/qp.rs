@@ -282,6 +282,20 @@ mod tests {
         (Sparse::try_new_from_triplets(n, n, &t).unwrap(), edges)
     }
 
+    type Wave = (Sparse, Vec<(usize, usize)>, Vec<f64>, Vec<Option<f64>>);
+
+    /// [`grid_qp`] with a linear term of waves along x and a slope along y, the first vertex
+    /// fixed at −1 and the last at 2: its `P`, edges, `q` and fixed values.
+    fn wave_qp(nx: usize, ny: usize) -> Wave {
+        let n = nx * ny;
+        let (p, edges) = grid_qp(nx, ny);
+        let q = (0..n).map(|i| -(((i % nx) as f64 * 0.3).sin() + (i / nx) as f64 * 0.01)).collect();
+        let mut fixed = vec![None; n];
+        fixed[0] = Some(-1.0);
+        fixed[n - 1] = Some(2.0);
+        (p, edges, q, fixed)
+    }
+
     #[test]
     fn a_banded_energy_is_not_prepared_and_a_grid_s_is() {
         // a path's P = K + I is tridiagonal: the solver factorises its normal matrix by the band
@@ -295,12 +309,7 @@ mod tests {
     fn a_prepared_analysis_matches_the_normal_matrix_and_changes_nothing() {
         let (nx, ny) = (60, 50);
         let n = nx * ny;
-        let (p, edges) = grid_qp(nx, ny);
-        let h: Vec<f64> = (0..n).map(|i| ((i % nx) as f64 * 0.3).sin() + (i / nx) as f64 * 0.01).collect();
-        let q: Vec<f64> = h.iter().map(|v| -v).collect();
-        let mut fixed = vec![None; n];
-        fixed[0] = Some(-1.0);
-        fixed[n - 1] = Some(2.0);
+        let (p, edges, q, fixed) = wave_qp(nx, ny);
         // every edge increasing to the right and upwards: a monotone ramp, feasible
         let hint: Vec<f64> = (0..n).map(|i| -1.0 + 3.0 * ((i % nx) + (i / nx)) as f64 / (nx + ny - 2) as f64).collect();
         let qp = MonotoneQp {
@@ -347,12 +356,7 @@ mod tests {
     fn a_hand_over_from_the_active_set_solves_the_rebuilt_problem() {
         let (nx, ny) = (30, 20);
         let n = nx * ny;
-        let (p, edges) = grid_qp(nx, ny);
-        let h: Vec<f64> = (0..n).map(|i| ((i % nx) as f64 * 0.3).sin() + (i / nx) as f64 * 0.01).collect();
-        let q: Vec<f64> = h.iter().map(|v| -v).collect();
-        let mut fixed = vec![None; n];
-        fixed[0] = Some(-1.0);
-        fixed[n - 1] = Some(2.0);
+        let (p, edges, q, fixed) = wave_qp(nx, ny);
         let mut data = vec![1.0; n];
         data[n / 2] = 0.0;
         let qp = MonotoneQp {

@@ -63,7 +63,7 @@ const ND_LEAF: usize = 128;
 /// no fill outside the band and about n·b² flops, where nested dissection of a path ordered
 /// 10⁶ unknowns in 1 s and factorised them with supernodes of a few columns (a series of 10⁶
 /// samples: 0.7 s per interior-point iteration, docs/performance.md).
-const BANDED_MAX: usize = 8;
+pub(crate) const BANDED_MAX: usize = 8;
 
 /// The band of the upper-triangular pattern `a` (the largest distance of an entry from the
 /// diagonal) if it is at most [`BANDED_MAX`]: such a pattern is factorised in its own order, at

@@ -24,7 +24,8 @@ pub(super) struct Banded<T> {
     inv_d: Vec<T>,
     /// The matrix as a band: `a[j·(b + 1) + t]` is the entry `(j − b + t, j)`, `t = b` the diagonal.
     a: Vec<T>,
-    /// Where each stored entry of the pattern goes in `a`.
+    /// Where each stored entry of the pattern goes in `a` (empty when filled through
+    /// [`Banded::band_mut`]).
     slot: Vec<usize>,
 }
 
@@ -37,22 +38,52 @@ impl<T: Real> Banded<T> {
         for j in 0..n {
             for i in pattern.row_idx_of_col(j) {
                 debug_assert!(i <= j && j - i <= b);
-                slot.push(j * (b + 1) + b - (j - i));
+                slot.push(Self::at(b, i, j));
             }
         }
+        Banded { slot, ..Self::of_band(n, b) }
+    }
+
+    /// Storage for `n × n` matrices within `b` places of the diagonal, filled through
+    /// [`Banded::band_mut`] rather than from a pattern's values.
+    pub(super) fn of_band(n: usize, b: usize) -> Banded<T> {
         let zero = T::of(0.0);
-        Banded { n, b, l: vec![zero; n * b], inv_d: vec![zero; n], a: vec![zero; n * (b + 1)], slot }
+        Banded { n, b, l: vec![zero; n * b], inv_d: vec![zero; n], a: vec![zero; n * (b + 1)], slot: Vec::new() }
+    }
+
+    /// Where the entry `(i, j)`, `i ≤ j ≤ i + b`, is in the band of [`Banded::band_mut`].
+    #[inline]
+    pub(super) fn at(b: usize, i: usize, j: usize) -> usize {
+        j * (b + 1) + b - (j - i)
+    }
+
+    /// The band: the entry `(i, j)`, `i ≤ j`, at [`Banded::at`]; its last values are those of
+    /// the last matrix factorised.
+    pub(super) fn band_mut(&mut self) -> &mut [T] {
+        &mut self.a
+    }
+
+    /// The band's half-width `b`.
+    pub(super) fn width(&self) -> usize {
+        self.b
     }
 
     /// Factorises the matrix with the pattern's values `vals` plus `shift` on the diagonal;
     /// `false` if a pivot is not positive (the matrix is not positive definite).
     pub(super) fn factor(&mut self, vals: &[T], shift: T) -> bool {
-        let (n, b) = (self.n, self.b);
         let zero = T::of(0.0);
         self.a.iter_mut().for_each(|v| *v = zero);
         for (&s, &v) in self.slot.iter().zip(vals) {
             self.a[s] = v;
         }
+        self.factor_band(shift)
+    }
+
+    /// Factorises the band as filled (plus `shift` on the diagonal), leaving it as it is;
+    /// `false` if a pivot is not positive.
+    pub(super) fn factor_band(&mut self, shift: T) -> bool {
+        let (n, b) = (self.n, self.b);
+        let zero = T::of(0.0);
         let one = T::of(1.0);
         // row j of L·D, columns j − b .. j, scratch
         let mut ld = vec![zero; b];

@@ -14,7 +14,7 @@
 //! topology and the gap bound of the output as written decides the fit.
 
 use super::banded::Banded;
-use super::newton::{max, Normal, Objective, Prepared, Real, Rows};
+use super::newton::{max, normal_band, Normal, Objective, Prepared, Real, Rows};
 use super::problem::ReducedQp;
 use super::settings::QpSettings;
 use super::status::{Outcome, SolveStatus};
@@ -30,17 +30,61 @@ const CORRECTOR_STEP: f64 = 0.3;
 /// `P` assembled; normal equations in double precision.
 struct Assembled<'r> {
     r: &'r ReducedQp,
-    normal: Normal,
-    /// The normal pattern's analysis; none for a banded pattern, which needs none (made when
-    /// [`Objective::energy_dual`] factorises P alone).
-    analysis: Option<std::sync::Arc<ordering::Analysis>>,
-    /// The factor: faer's Cholesky, or for a banded pattern (a series) the band's own `LDLᵀ`
-    /// ([`Banded`]: faer's simplicial factorisation and solves of a pentadiagonal matrix cost
-    /// several times its n·b² products).
     factor: Factorised,
-    vals: Vec<f64>,
-    /// `P` alone factorised (on the normal matrix's pattern), for [`Objective::energy_dual`].
-    energy: Option<ordering::SpdFactor>,
+    /// `P` alone factorised, for [`Objective::energy_dual`] (made the first time it is asked).
+    energy: Option<Energy>,
+}
+
+/// How the assembled normal matrix is stored and factorised.
+enum Factorised {
+    /// On its sparse pattern, by faer's Cholesky with the pattern's analysis.
+    Spd { normal: Normal, analysis: std::sync::Arc<ordering::Analysis>, factor: ordering::SpdFactor, vals: Vec<f64> },
+    /// A banded matrix (a series), assembled straight into its band and factorised by the
+    /// band's own `LDLᵀ` ([`Banded`]: faer's simplicial factorisation and solves of a
+    /// pentadiagonal matrix cost several times its n·b² products).
+    Banded(Banded<f64>),
+}
+
+impl Factorised {
+    /// Assembles `P + AᵀWA` (`w` empty: P alone) plus `reg` on the diagonal and factorises it;
+    /// `false` if it is not numerically positive definite. Each entry sums P's triplets, then
+    /// the rows' products, in their order, on either storage.
+    fn assemble_and_factor(&mut self, r: &ReducedQp, rows: &Rows, w: &[f64], reg: f64) -> bool {
+        match self {
+            Factorised::Spd { normal, factor, vals, .. } => {
+                vals.iter_mut().for_each(|v| *v = 0.0);
+                for (k, &(_, _, v)) in r.p.iter().enumerate() {
+                    vals[normal.pos_p[k]] += v;
+                }
+                for (k, &wk) in w.iter().enumerate() {
+                    let [p1, p2, p12] = normal.pos_row[k];
+                    let [a1, a2] = rows.vals[k];
+                    vals[p1] += wk * a1 * a1;
+                    if rows.len[k] == 2 {
+                        vals[p2] += wk * a2 * a2;
+                        vals[p12] += wk * a1 * a2;
+                    }
+                }
+                if reg > 0.0 {
+                    for &d in &normal.pos_diag {
+                        vals[d] += reg;
+                    }
+                }
+                factor.factor(SparseColMatRef::new(normal.symbolic.as_ref(), vals)).is_ok()
+            }
+            Factorised::Banded(banded) => {
+                fill_band(banded, r, rows, w, reg);
+                banded.factor_band(0.0)
+            }
+        }
+    }
+
+    fn solve_in_place(&mut self, rhs: &mut [f64]) {
+        match self {
+            Factorised::Spd { factor, .. } => factor.solve_in_place(rhs),
+            Factorised::Banded(banded) => banded.solve_in_place(rhs),
+        }
+    }
 }
 
 impl Objective<f64> for Assembled<'_> {
@@ -56,32 +100,9 @@ impl Objective<f64> for Assembled<'_> {
 
     /// With a growing diagonal shift if the matrix is not numerically positive definite.
     fn factor(&mut self, rows: &Rows, w: &[f64]) -> std::result::Result<(), crate::error::NumericalError> {
-        let (normal, vals) = (&self.normal, &mut self.vals);
         let mut reg = 0.0;
         for attempt in 0..4 {
-            vals.iter_mut().for_each(|v| *v = 0.0);
-            for (k, &(_, _, v)) in self.r.p.iter().enumerate() {
-                vals[normal.pos_p[k]] += v;
-            }
-            for (k, &wk) in w.iter().enumerate() {
-                let [p1, p2, p12] = normal.pos_row[k];
-                let [a1, a2] = rows.vals[k];
-                vals[p1] += wk * a1 * a1;
-                if rows.len[k] == 2 {
-                    vals[p2] += wk * a2 * a2;
-                    vals[p12] += wk * a1 * a2;
-                }
-            }
-            if reg > 0.0 {
-                for &d in &normal.pos_diag {
-                    vals[d] += reg;
-                }
-            }
-            let done = match &mut self.factor {
-                Factorised::Spd(spd) => spd.factor(SparseColMatRef::new(normal.symbolic.as_ref(), vals)).is_ok(),
-                Factorised::Banded(banded) => banded.factor(vals, 0.0),
-            };
-            if done {
+            if self.factor.assemble_and_factor(self.r, rows, w, reg) {
                 return Ok(());
             }
             reg = if attempt == 0 { 1e-12 } else { reg * 1e3 };
@@ -90,10 +111,7 @@ impl Objective<f64> for Assembled<'_> {
     }
 
     fn solve_in_place(&mut self, rhs: &mut [f64]) {
-        match &mut self.factor {
-            Factorised::Spd(spd) => spd.solve_in_place(rhs),
-            Factorised::Banded(banded) => banded.solve_in_place(rhs),
-        }
+        self.factor.solve_in_place(rhs);
     }
 
     fn auxiliary(&self, _: &[f64]) -> Option<Vec<f64>> {
@@ -102,27 +120,67 @@ impl Objective<f64> for Assembled<'_> {
 
     fn energy_dual(&mut self, r: &[f64]) -> Option<f64> {
         if self.energy.is_none() {
-            let mut vals = vec![0.0; self.vals.len()];
-            for (k, &(_, _, v)) in self.r.p.iter().enumerate() {
-                vals[self.normal.pos_p[k]] += v;
-            }
-            if self.analysis.is_none() {
-                self.analysis = Some(std::sync::Arc::new(ordering::analyse(self.normal.symbolic.as_ref()).ok()?));
-            }
-            let mut f = ordering::SpdFactor::new(self.analysis.clone()?).ok()?;
-            f.factor(SparseColMatRef::new(self.normal.symbolic.as_ref(), &vals)).ok()?;
-            self.energy = Some(f);
+            let energy = match &self.factor {
+                Factorised::Spd { normal, analysis, .. } => {
+                    let mut vals = vec![0.0; normal.symbolic.row_idx().len()];
+                    for (k, &(_, _, v)) in self.r.p.iter().enumerate() {
+                        vals[normal.pos_p[k]] += v;
+                    }
+                    let mut f = ordering::SpdFactor::new(analysis.clone()).ok()?;
+                    f.factor(SparseColMatRef::new(normal.symbolic.as_ref(), &vals)).ok()?;
+                    Energy::Spd(f)
+                }
+                Factorised::Banded(b) => {
+                    let mut e = Banded::of_band(self.r.n, b.width());
+                    let no_rows = Rows { cols: Vec::new(), vals: Vec::new(), len: Vec::new() };
+                    fill_band(&mut e, self.r, &no_rows, &[], 0.0);
+                    if !e.factor_band(0.0) {
+                        return None;
+                    }
+                    Energy::Banded(e)
+                }
+            };
+            self.energy = Some(energy);
         }
         let mut y = r.to_vec();
-        self.energy.as_mut()?.solve_in_place(&mut y);
+        match self.energy.as_mut()? {
+            Energy::Spd(f) => f.solve_in_place(&mut y),
+            Energy::Banded(b) => b.solve_in_place(&mut y),
+        }
         Some(0.5 * r.iter().zip(&y).map(|(a, b)| a * b).sum::<f64>())
     }
 }
 
-/// How the assembled normal matrix is factorised.
-enum Factorised {
+/// `P` alone factorised, on the normal matrix's storage.
+enum Energy {
     Spd(ordering::SpdFactor),
     Banded(Banded<f64>),
+}
+
+/// Fills `banded` with `P + AᵀWA` (`w` empty: P alone) plus `reg` on the diagonal: each entry
+/// sums P's triplets, then the rows' products, in their order (as on a sparse pattern).
+fn fill_band(banded: &mut Banded<f64>, r: &ReducedQp, rows: &Rows, w: &[f64], reg: f64) {
+    let b = banded.width();
+    let at = |i: usize, j: usize| Banded::<f64>::at(b, i.min(j), i.max(j));
+    let band = banded.band_mut();
+    band.iter_mut().for_each(|v| *v = 0.0);
+    for &(i, j, v) in &r.p {
+        band[at(i, j)] += v;
+    }
+    for (k, &wk) in w.iter().enumerate() {
+        let [c1, c2] = rows.cols[k];
+        let [a1, a2] = rows.vals[k];
+        band[at(c1, c1)] += wk * a1 * a1;
+        if rows.len[k] == 2 {
+            band[at(c2, c2)] += wk * a2 * a2;
+            band[at(c1, c2)] += wk * a1 * a2;
+        }
+    }
+    if reg > 0.0 {
+        for j in 0..r.n {
+            band[at(j, j)] += reg;
+        }
+    }
 }
 
 /// The largest relative change of the iterate in one step at which the solver may stop (the
@@ -175,38 +233,48 @@ pub(super) fn solve(
                 Some(assembly) => assembly,
                 None => Assembly::new(r)?,
             };
-            // a banded pattern (a series) is factorised by the band's own LDLᵀ: no analysis
-            // (faer's symbolic factorisation of 10⁷ samples took seconds and 300 MB)
-            let (factor, analysis) = match ordering::band(normal.symbolic.as_ref()) {
-                Some(b) => (Factorised::Banded(Banded::new(normal.symbolic.as_ref(), b)), None),
-                None => {
+            let factor = match normal {
+                // a banded pattern (a series) needs no analysis (faer's symbolic factorisation of
+                // 10⁷ samples took seconds and 300 MB)
+                NormalForm::Band(b) => Factorised::Banded(Banded::of_band(r.n, b)),
+                NormalForm::Pattern(normal) => {
                     let analysis = analyses.of(normal.symbolic.as_ref())?;
                     let spare = spare.filter(|(a, _)| std::sync::Arc::ptr_eq(a, &analysis));
-                    let factor = Factorised::Spd(match spare {
+                    let factor = match spare {
                         Some((_, workspace)) => ordering::SpdFactor::with_workspace(analysis.clone(), workspace),
                         None => ordering::SpdFactor::new(analysis.clone())?,
-                    });
-                    (factor, Some(analysis))
+                    };
+                    let vals = vec![0.0f64; normal.symbolic.row_idx().len()];
+                    Factorised::Spd { normal, analysis, factor, vals }
                 }
             };
-            let vals = vec![0.0f64; normal.symbolic.row_idx().len()];
-            let mut objective = Assembled { r, normal, analysis, factor, vals, energy: None };
+            let mut objective = Assembled { r, factor, energy: None };
             run::<f64, _>(r, &rows, &mut objective, hint, settings)
         }
     }
 }
 
-/// The assembled form's constraint rows and normal-matrix pattern, made once for both the
+/// The assembled normal matrix's storage plan: its sparse pattern, or the half-width of its
+/// band.
+enum NormalForm {
+    Pattern(Normal),
+    Band(usize),
+}
+
+/// The assembled form's constraint rows and normal-matrix form, made once for both the
 /// memory prediction and the solve (at 10⁷ samples of a series each took seconds).
 pub(super) struct Assembly {
     rows: Rows,
-    normal: Normal,
+    normal: NormalForm,
 }
 
 impl Assembly {
     fn new(r: &ReducedQp) -> std::result::Result<Assembly, crate::error::NumericalError> {
         let rows = Rows::new(r)?;
-        let normal = Normal::new(r, &rows.cols, &rows.len);
+        let normal = match normal_band(r, &rows) {
+            Some(b) => NormalForm::Band(b),
+            None => NormalForm::Pattern(Normal::new(r, &rows.cols, &rows.len)),
+        };
         Ok(Assembly { rows, normal })
     }
 }
@@ -214,7 +282,7 @@ impl Assembly {
 /// The bytes the structured solver allocates for `r` (the assembled form) beyond what the
 /// caller holds, known before it allocates them: the normal matrix's factor and faer's
 /// scratch (from its analysis, made here and kept in `analyses`, where [`solve`] takes it; a
-/// banded pattern's own factor from its band, with no analysis),
+/// banded matrix's own factor from its band, with no analysis and no pattern),
 /// the normal matrix's values and pattern, the rows, and the iterate's vectors; with the rows
 /// and the pattern made for it, which [`solve`] takes. `None` for the factored form, whose
 /// double-double storage is not predicted yet.
@@ -229,18 +297,24 @@ pub(super) fn predicted_bytes(
         return Ok(None);
     }
     let assembly = Assembly::new(r)?;
-    let (n, m, nnz) = (r.n as u64, r.m() as u64, assembly.normal.symbolic.row_idx().len() as u64);
-    // values and row indices of the normal matrix, its position tables; the rows (two
-    // columns, two values, a length); about 14 vectors of n and 18 of m in the iteration
-    let normal_bytes = 16 * nnz + 8 * (n + 1) + 8 * (r.p.len() as u64 + 4 * m + n);
+    let (n, m) = (r.n as u64, r.m() as u64);
+    // the rows (two columns, two values, a length); about 14 vectors of n and 18 of m in the
+    // iteration
     let row_bytes = 33 * m;
     let vectors = 8 * (14 * n + 18 * m);
-    let factor_bytes = match ordering::band(assembly.normal.symbolic.as_ref()) {
-        // the band's own LDLᵀ: L and the band (n·b and n·(b + 1) values), 1/D, the entries' slots
-        Some(b) => 8 * (n * (2 * b as u64 + 2) + nnz),
-        None => analyses.of(assembly.normal.symbolic.as_ref())?.numeric_bytes(),
+    let matrix_bytes = match &assembly.normal {
+        // the band's own LDLᵀ: the band, L and 1/D (n·(b + 1), n·b and n values)
+        NormalForm::Band(b) => 8 * n * (2 * *b as u64 + 2),
+        NormalForm::Pattern(normal) => {
+            // values and row indices of the normal matrix, its position tables
+            let nnz = normal.symbolic.row_idx().len() as u64;
+            16 * nnz
+                + 8 * (n + 1)
+                + 8 * (r.p.len() as u64 + 4 * m + n)
+                + analyses.of(normal.symbolic.as_ref())?.numeric_bytes()
+        }
     };
-    Ok(Some((factor_bytes + normal_bytes + row_bytes + vectors, assembly)))
+    Ok(Some((matrix_bytes + row_bytes + vectors, assembly)))
 }
 
 /// The primal–dual iterate: `x`, the slacks `s = b − Ax` and the multipliers `z`.
@@ -796,4 +870,109 @@ fn polish_multipliers<T: Real>(
     let comp = slack.iter().zip(z.iter()).fold(zero, |a, (&s, &z)| a + max(s, zero) * z);
     let stat = (0..rho.len()).fold(zero, |a, i| a + (rho[i] * rho[i]).div_by(d[i], inv_d[i]));
     comp + T::of(0.5) * stat
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A reduced QP on a path of `n` variables: a pentadiagonal P (the upper triangle, sorted by
+    /// column), rows on consecutive pairs and a few bounds, or one row spanning `wide` places.
+    fn path_qp(n: usize, wide: Option<usize>) -> ReducedQp {
+        let mut p = Vec::new();
+        for j in 0..n {
+            for i in j.saturating_sub(2)..=j {
+                p.push((i, j, if i == j { 6.0 + 0.1 * (j % 7) as f64 } else { -1.5 + 0.01 * (i + j) as f64 }));
+            }
+        }
+        let (mut a_row, mut a_col, mut a_val) = (Vec::new(), Vec::new(), Vec::new());
+        for k in 0..n - 1 {
+            a_row.extend([k, k]);
+            a_col.extend([k, k + 1]);
+            let s = if (k / 5) % 2 == 0 { 1.0 } else { -1.0 };
+            a_val.extend([s, -s]);
+        }
+        for (k, c) in [(n - 1, 0), (n, n / 2)] {
+            a_row.push(k);
+            a_col.push(c);
+            a_val.push(-1.0);
+        }
+        if let Some(w) = wide {
+            a_row.extend([n + 1, n + 1]);
+            a_col.extend([0, w]);
+            a_val.extend([1.0, -1.0]);
+        }
+        let m = a_row.last().map_or(0, |r| r + 1);
+        ReducedQp {
+            n,
+            p,
+            q: vec![0.0; n],
+            a_row,
+            a_col,
+            a_val,
+            b: vec![0.0; m],
+            d: vec![1.0; n],
+            q_free: vec![0.0; n],
+            gap_bound: true,
+            factor: None,
+            scale: 1.0,
+            constant: 0.0,
+        }
+    }
+
+    #[test]
+    fn a_band_assembled_without_a_pattern_factorises_as_the_pattern_s_values() {
+        let n = 300;
+        let r = path_qp(n, None);
+        let rows = Rows::new(&r).unwrap();
+        assert_eq!(normal_band(&r, &rows), Some(2));
+        let w: Vec<f64> = (0..r.m()).map(|k| 10f64.powf(((k * 37) % 17) as f64 - 8.0)).collect();
+        let rhs: Vec<f64> = (0..n).map(|i| (i as f64 * 0.31).sin()).collect();
+        // the pattern's way: values on the normal pattern, copied into the band by position
+        let normal = Normal::new(&r, &rows.cols, &rows.len);
+        assert_eq!(ordering::band(normal.symbolic.as_ref()), Some(2));
+        let mut vals = vec![0.0; normal.symbolic.row_idx().len()];
+        for (k, &(_, _, v)) in r.p.iter().enumerate() {
+            vals[normal.pos_p[k]] += v;
+        }
+        for (k, &wk) in w.iter().enumerate() {
+            let [p1, p2, p12] = normal.pos_row[k];
+            let [a1, a2] = rows.vals[k];
+            vals[p1] += wk * a1 * a1;
+            if rows.len[k] == 2 {
+                vals[p2] += wk * a2 * a2;
+                vals[p12] += wk * a1 * a2;
+            }
+        }
+        let mut old = Banded::<f64>::new(normal.symbolic.as_ref(), 2);
+        assert!(old.factor(&vals, 0.0));
+        let mut expected = rhs.clone();
+        old.solve_in_place(&mut expected);
+        // straight into the band
+        let mut new = Factorised::Banded(Banded::of_band(n, 2));
+        assert!(new.assemble_and_factor(&r, &rows, &w, 0.0));
+        let mut got = rhs.clone();
+        new.solve_in_place(&mut got);
+        assert!(got.iter().zip(&expected).all(|(a, b)| a.to_bits() == b.to_bits()));
+        // and it solves the matrix: N x = rhs checked through the rows and P
+        let mut nx = vec![0.0; n];
+        for &(i, j, v) in &r.p {
+            nx[i] += v * got[j];
+            if i != j {
+                nx[j] += v * got[i];
+            }
+        }
+        let mut ax = vec![0.0; r.m()];
+        rows.ax(&got, &mut ax);
+        let wax: Vec<f64> = ax.iter().zip(&w).map(|(a, w)| a * w).collect();
+        let mut atwax = vec![0.0; n];
+        rows.atz(&wax, &mut atwax);
+        let err = (0..n).fold(0.0f64, |a, i| a.max((nx[i] + atwax[i] - rhs[i]).abs()));
+        assert!(err < 1e-6, "residual {err:e}");
+        // a row spanning more than the band's limit: the sparse pattern
+        let wide = path_qp(n, Some(ordering::BANDED_MAX + 1));
+        assert_eq!(normal_band(&wide, &Rows::new(&wide).unwrap()), None);
+        let edge = path_qp(n, Some(ordering::BANDED_MAX));
+        assert_eq!(normal_band(&edge, &Rows::new(&edge).unwrap()), Some(ordering::BANDED_MAX));
+    }
 }

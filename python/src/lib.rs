@@ -995,7 +995,7 @@ fn read<'py>(py: Python<'py>, path: Option<String>, options: &Bound<'py, PyDict>
     if let Some(axis) = &field.axis {
         out.set_item("x", PyArray1::from_vec(py, axis.x.clone()))?;
         out.set_item("x_name", &axis.x_name)?;
-        out.set_item("x_text", axis.x_text.clone())?;
+        out.set_item("x_text", axis.x_text.to_vec())?;
         out.set_item("dates", matches!(axis.source, toposmooth::io::series_csv::XSource::Dates(..)))?;
     }
     out.set_item("domain", Py::new(py, domain)?)?;

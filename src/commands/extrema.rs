@@ -64,7 +64,7 @@ fn place(field: &Field, i: usize) -> serde_json::Map<String, serde_json::Value> 
         AnyDomain::Series(s) => {
             m.insert("x".into(), json!(s.x()[i]));
             if let Some(axis) = field.axis.as_ref().filter(|a| matches!(a.source, XSource::Dates(..))) {
-                m.insert("x_text".into(), json!(axis.x_text[i]));
+                m.insert("x_text".into(), json!(axis.x_text.get(i)));
             }
         }
         AnyDomain::Grid(g) => {
@@ -109,7 +109,9 @@ pub fn extrema(args: &ExtremaArgs) -> Result<String> {
 /// Where a vertex is, as the table prints it: the x text, `(row,col)` or `(x,y,z)`.
 fn label(field: &Field, i: usize) -> String {
     match &field.domain {
-        AnyDomain::Series(_) => field.axis.as_ref().map(|a| a.x_text[i].clone()).unwrap_or_else(|| i.to_string()),
+        AnyDomain::Series(_) => {
+            field.axis.as_ref().map(|a| a.x_text.get(i).into_owned()).unwrap_or_else(|| i.to_string())
+        }
         AnyDomain::Grid(g) => {
             let (r, c) = g.row_col(i);
             format!("({r},{c})")

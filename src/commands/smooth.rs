@@ -227,7 +227,7 @@ pub(super) fn smooth_shared(args: &SmoothArgs, shared: Option<&mut Option<Shared
             Masked::Grid(m) => m.used(),
         }),
     };
-    let x_axis = field.axis.as_ref().map(|a| (a.x_name.as_str(), a.x_text.as_slice()));
+    let x_axis = field.axis.as_ref().map(|a| (a.x_name.as_str(), &a.x_text));
     let output = stage_results(&args.output, &field.domain, x_axis, &results)?;
     check_written(&output, &field.domain, &results).map_err(|e| e.in_file(&field.path))?;
     let mut staged = vec![output];
@@ -325,7 +325,7 @@ fn check_explicit_not_filled(field: &Field, selection: &crate::topology::Selecti
 /// A sample or vertex for messages: a series' sample with its x as written.
 fn sample_name(field: &Field, i: usize) -> String {
     match &field.axis {
-        Some(a) => format!("sample {i} ({} = {})", a.x_name, a.x_text[i]),
+        Some(a) => format!("sample {i} ({} = {})", a.x_name, a.x_text.get(i)),
         None => field.domain.describe_vertex(i),
     }
 }

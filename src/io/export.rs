@@ -6,7 +6,7 @@
 use super::grid::stage_grid_csv;
 use super::mesh::{stage_ply, MeshData};
 use super::npz::{read_npz_nd, stage_npy, stage_npy_shaped, stage_npz, stage_npz_shaped};
-use super::series_csv::{read_series_output, stage_series_output, SeriesOutput};
+use super::series_csv::{read_series_output_with, stage_series_output, SeriesColumns, XText};
 use super::vtk::{
     read_any_image, read_dataset, stage_legacy, stage_vti_arrays, stage_vtp, stage_vtp_cells, stage_vtu_cells,
     tet_cells, triangle_cells, AnyImage, Cells, ImageBox, LegacyGeometry, OutArray, PointArray, PolyData, Scalar,
@@ -235,12 +235,7 @@ pub struct Results<'a> {
 ///
 /// # Errors
 /// Usage errors for an extension the domain has no format for; I/O errors naming the file.
-pub fn stage_results(
-    path: &Path,
-    domain: &AnyDomain,
-    x_axis: Option<(&str, &[String])>,
-    r: &Results,
-) -> Result<Staged> {
+pub fn stage_results(path: &Path, domain: &AnyDomain, x_axis: Option<(&str, &XText)>, r: &Results) -> Result<Staged> {
     check_output(path, domain)?;
     let roles = role_codes(r.roles);
     let filled: Option<Vec<f64>> = r.filled.map(|m| m.iter().map(|&b| f64::from(u8::from(b))).collect());
@@ -255,18 +250,16 @@ pub fn stage_results(
     }
     match domain {
         AnyDomain::Series(s) => {
-            let (x_name, x_text) = match x_axis {
-                Some((name, t)) => (name.to_string(), t.to_vec()),
-                None => ("x".to_string(), (0..s.n_vertices()).map(|i| i.to_string()).collect()),
-            };
-            let out = SeriesOutput {
+            let index = XText::Index(s.n_vertices());
+            let (x_name, x_text) = x_axis.unwrap_or(("x", &index));
+            let out = SeriesColumns {
                 x_name,
                 x_text,
-                input: r.input.to_vec(),
-                output: r.smoothed.to_vec(),
-                u: r.representative.to_vec(),
-                roles: r.roles.to_vec(),
-                filled: r.filled.map(<[bool]>::to_vec),
+                input: r.input,
+                output: r.smoothed,
+                u: r.representative,
+                roles: r.roles,
+                filled: r.filled,
             };
             stage_series_output(path, &out)
         }
@@ -679,7 +672,7 @@ pub fn read_results(path: &Path) -> Result<Stored> {
             results_on_mesh(path, mesh.into_domain(), &data)
         }
         _ => {
-            let out = read_series_output(path)?;
+            let out = read_series_output_with(path, false)?;
             let domain = AnyDomain::Series(Series::uniform(out.input.len()));
             Ok(Stored {
                 domain,

@@ -4,7 +4,10 @@
 //! `X,input,output,u,role[,filled]`.
 
 use super::csv_dialect::{sniff, Dialect};
-pub use super::series_output::{read_series_output, stage_series_output, write_series_output, SeriesOutput};
+pub(crate) use super::series_output::read_series_output_with;
+pub use super::series_output::{
+    read_series_output, stage_series_output, write_series_output, SeriesColumns, SeriesOutput,
+};
 pub use super::timestamps::parse_date_days;
 use super::timestamps::parse_stamp;
 use crate::error::{Error, Location, Result};
@@ -22,6 +25,63 @@ pub enum XSource {
     Dates(String, NaiveDate),
 }
 
+/// The x column's text per sample, written back out: the sample index when the series has no
+/// x column (made when asked: at 10⁷ samples a string each held 0.5 GB), else the file's text.
+#[derive(Clone, Debug, PartialEq)]
+pub enum XText {
+    /// `0, 1, …, n − 1`.
+    Index(usize),
+    /// The text of each row.
+    Text(Vec<String>),
+}
+
+impl XText {
+    /// The number of samples.
+    #[must_use]
+    pub fn len(&self) -> usize {
+        match self {
+            XText::Index(n) => *n,
+            XText::Text(t) => t.len(),
+        }
+    }
+
+    /// Whether there is no sample.
+    #[must_use]
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// The text of sample `i`.
+    ///
+    /// # Panics
+    /// If `i` is out of range.
+    #[must_use]
+    pub fn get(&self, i: usize) -> std::borrow::Cow<'_, str> {
+        match self {
+            XText::Index(n) => {
+                assert!(i < *n, "sample {i} of {n}");
+                i.to_string().into()
+            }
+            XText::Text(t) => t[i].as_str().into(),
+        }
+    }
+
+    /// The stored texts, `None` for the index.
+    #[must_use]
+    pub fn as_text(&self) -> Option<&[String]> {
+        match self {
+            XText::Index(_) => None,
+            XText::Text(t) => Some(t),
+        }
+    }
+
+    /// Every sample's text.
+    #[must_use]
+    pub fn to_vec(&self) -> Vec<String> {
+        (0..self.len()).map(|i| self.get(i).into_owned()).collect()
+    }
+}
+
 /// A series read from CSV.
 #[derive(Clone, Debug, PartialEq)]
 pub struct SeriesCsv {
@@ -32,9 +92,9 @@ pub struct SeriesCsv {
     pub values: Vec<f64>,
     /// x coordinates (days for dates, index without an x column).
     pub x: Vec<f64>,
-    /// The x column's original text per row (index without an x column; numbers written
+    /// The x column's original text per row (the index without an x column; numbers written
     /// with a decimal comma get a point), written back out.
-    pub x_text: Vec<String>,
+    pub x_text: XText,
     /// The x column's header, written back out (`x` without a header, a name or an x column).
     pub x_name: String,
     /// Where x came from.
@@ -75,9 +135,9 @@ fn kind(s: &str, dialect: &Dialect) -> Kind {
 }
 
 /// The kind of column `c` of the data rows: the one kind of its non-empty cells, else text.
-fn column_kind(data: &[Row], c: usize, dialect: &Dialect) -> Kind {
+fn column_kind(data: Rows<'_>, c: usize, dialect: &Dialect) -> Kind {
     let mut k = Kind::Empty;
-    for (_, r) in data {
+    for (_, r) in data.iter() {
         match (k, kind(&r[c], dialect)) {
             (_, Kind::Empty) => {}
             (Kind::Empty, x) => k = x,
@@ -97,16 +157,21 @@ fn column_kind(data: &[Row], c: usize, dialect: &Dialect) -> Kind {
 /// than 2 samples.
 pub fn read_series(path: &Path, options: &SeriesCsvOptions) -> Result<SeriesCsv> {
     let err = |msg: String| Error::input(msg).in_file(path);
-    let (rows, dialect) = read_rows(path)?;
-    let ncols = rows[0].1.len();
+    let (table, dialect) = read_rows(path)?;
+    let ncols = table.ncols;
+    let all = Rows { table: &table, first: 0 };
     // a header: a cell that is text where the first non-empty cell below is a number or a date
-    let below = |c: usize| rows[1..].iter().map(|(_, r)| kind(&r[c], &dialect)).find(|k| *k != Kind::Empty);
-    let has_header = rows.len() >= 2
+    let below = |c: usize| all.iter().skip(1).map(|(_, r)| kind(&r[c], &dialect)).find(|k| *k != Kind::Empty);
+    let has_header = table.len() >= 2
         && (0..ncols).any(|c| {
-            kind(&rows[0].1[c], &dialect) == Kind::Text && matches!(below(c), Some(Kind::Number | Kind::Date))
+            kind(table.cell(0, c), &dialect) == Kind::Text && matches!(below(c), Some(Kind::Number | Kind::Date))
         });
-    let names: Vec<String> = if has_header { rows[0].1.clone() } else { (0..ncols).map(|c| c.to_string()).collect() };
-    let data = if has_header { &rows[1..] } else { &rows[..] };
+    let names: Vec<String> = if has_header {
+        (0..ncols).map(|c| table.cell(0, c).to_string()).collect()
+    } else {
+        (0..ncols).map(|c| c.to_string()).collect()
+    };
+    let data = Rows { table: &table, first: usize::from(has_header) };
     if data.is_empty() {
         return Err(err("the file has a header but no data rows".into()));
     }
@@ -148,11 +213,7 @@ pub fn read_series(path: &Path, options: &SeriesCsvOptions) -> Result<SeriesCsv>
     let read = Cells { path, data, dialect };
     let values = read.values(value_col, &names[value_col], options.allow_missing)?;
     let (x, x_text, x_source) = match x_col {
-        None => (
-            (0..values.len()).map(|i| i as f64).collect(),
-            (0..values.len()).map(|i| i.to_string()).collect(),
-            XSource::Index,
-        ),
+        None => ((0..values.len()).map(|i| i as f64).collect(), XText::Index(values.len()), XSource::Index),
         Some(c) => read.x(&names[c], c, kinds[c] == Kind::Date)?,
     };
     if values.len() < 2 {
@@ -165,12 +226,74 @@ pub fn read_series(path: &Path, options: &SeriesCsvOptions) -> Result<SeriesCsv>
     Ok(SeriesCsv { column: names[value_col].clone(), values, x, x_text, x_name, x_source })
 }
 
-/// One CSV row: its line in the file and its cells.
-type Row = (u64, Vec<String>);
+/// The non-empty rows of a CSV file, every row with the same number of cells: the cells'
+/// text one after another, where each ends, and each row's line (at 10⁷ rows a string per cell
+/// and a vector per row held 1.5 GB).
+struct Table {
+    text: String,
+    ends: Vec<usize>,
+    lines: Vec<u64>,
+    ncols: usize,
+}
+
+impl Table {
+    fn len(&self) -> usize {
+        self.lines.len()
+    }
+
+    fn cell(&self, row: usize, c: usize) -> &str {
+        let k = row * self.ncols + c;
+        let start = if k == 0 { 0 } else { self.ends[k - 1] };
+        &self.text[start..self.ends[k]]
+    }
+}
+
+/// The rows of a [`Table`] from `first` on.
+#[derive(Clone, Copy)]
+struct Rows<'a> {
+    table: &'a Table,
+    first: usize,
+}
+
+/// One row of a [`Table`]: its cells by column.
+#[derive(Clone, Copy)]
+struct Row<'a> {
+    table: &'a Table,
+    row: usize,
+}
+
+impl std::ops::Index<usize> for Row<'_> {
+    type Output = str;
+
+    fn index(&self, c: usize) -> &str {
+        self.table.cell(self.row, c)
+    }
+}
+
+impl<'a> Rows<'a> {
+    fn len(&self) -> usize {
+        self.table.len() - self.first
+    }
+
+    fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// The line of row `i` (counted from `first`).
+    fn line(&self, i: usize) -> u64 {
+        self.table.lines[self.first + i]
+    }
+
+    /// Each row with its line.
+    fn iter(&self) -> impl Iterator<Item = (u64, Row<'a>)> + 'a {
+        let table = self.table;
+        (self.first..table.len()).map(move |row| (table.lines[row], Row { table, row }))
+    }
+}
 
 /// The non-empty rows of a CSV file (UTF-8, a byte-order mark dropped), with their lines,
 /// and the file's dialect.
-fn read_rows(path: &Path) -> Result<(Vec<Row>, Dialect)> {
+fn read_rows(path: &Path) -> Result<(Table, Dialect)> {
     let err = |msg: String| Error::input(msg).in_file(path);
     let bytes = std::fs::read(path).map_err(|source| Error::Io { path: path.to_path_buf(), source })?;
     super::content::expect_text(path, &bytes, "CSV text")?;
@@ -183,25 +306,41 @@ fn read_rows(path: &Path) -> Result<(Vec<Row>, Dialect)> {
         .delimiter(dialect.delimiter)
         .trim(csv::Trim::All)
         .from_reader(text.as_bytes());
-    let mut rows: Vec<Row> = Vec::new();
-    for rec in reader.records() {
-        let rec = rec.map_err(|e| err(format!("malformed CSV ({}): {e}", dialect.describe())))?;
+    let mut table = Table { text: String::new(), ends: Vec::new(), lines: Vec::new(), ncols: 0 };
+    let mut rec = csv::StringRecord::new();
+    while reader.read_record(&mut rec).map_err(|e| err(format!("malformed CSV ({}): {e}", dialect.describe())))? {
         let line = rec.position().map(|p| p.line()).unwrap_or(0);
-        if rec.iter().all(|c| c.is_empty()) {
+        if rec.iter().all(str::is_empty) {
             continue;
         }
-        rows.push((line, rec.iter().map(str::to_string).collect()));
+        if table.lines.is_empty() {
+            table.ncols = rec.len();
+        } else if rec.len() != table.ncols {
+            // the reader refuses ragged rows itself; a row of empty cells skipped above is the
+            // only way to get here
+            return Err(err(format!(
+                "malformed CSV ({}): line {line} has {} fields, the first row {}",
+                dialect.describe(),
+                rec.len(),
+                table.ncols
+            )));
+        }
+        for cell in &rec {
+            table.text.push_str(cell);
+            table.ends.push(table.text.len());
+        }
+        table.lines.push(line);
     }
-    if rows.is_empty() {
+    if table.lines.is_empty() {
         return Err(err("the file is empty".into()));
     }
-    Ok((rows, dialect))
+    Ok((table, dialect))
 }
 
 /// The data rows of a file, read column by column.
 struct Cells<'a> {
     path: &'a Path,
-    data: &'a [Row],
+    data: Rows<'a>,
     dialect: Dialect,
 }
 
@@ -215,19 +354,19 @@ impl Cells<'_> {
     fn values(&self, col: usize, name: &str, allow_missing: bool) -> Result<Vec<f64>> {
         let hint = "; --fill-missing fills missing values linearly in x";
         let mut values = Vec::with_capacity(self.data.len());
-        for (line, r) in self.data {
+        for (line, r) in self.data.iter() {
             let cell = &r[col];
             let v = match self.dialect.number(cell) {
                 Some(v) => v,
                 None if cell.trim().is_empty() && allow_missing => f64::NAN,
                 None if cell.trim().is_empty() => {
-                    return Err(self.error(*line, format!("missing value in column `{name}`{hint}")))
+                    return Err(self.error(line, format!("missing value in column `{name}`{hint}")))
                 }
-                None => return Err(self.error(*line, format!("`{cell}` in column `{name}` is not a number"))),
+                None => return Err(self.error(line, format!("`{cell}` in column `{name}` is not a number"))),
             };
             if v.is_infinite() || (v.is_nan() && !allow_missing) {
                 let why = if v.is_nan() { hint } else { "" };
-                return Err(self.error(*line, format!("value {v} in column `{name}` is not finite{why}")));
+                return Err(self.error(line, format!("value {v} in column `{name}` is not finite{why}")));
             }
             values.push(v);
         }
@@ -236,21 +375,21 @@ impl Cells<'_> {
 
     /// The x axis from column `c` (named `name`): dates (days since 1970, aware ones at their
     /// instant) or numbers, strictly increasing, with their text.
-    fn x(&self, name: &str, c: usize, dates: bool) -> Result<(Vec<f64>, Vec<String>, XSource)> {
+    fn x(&self, name: &str, c: usize, dates: bool) -> Result<(Vec<f64>, XText, XSource)> {
         let mut x = Vec::with_capacity(self.data.len());
         let mut text = Vec::with_capacity(self.data.len());
         let mut first_aware: Option<(bool, u64, String)> = None;
-        for (line, r) in self.data {
+        for (line, r) in self.data.iter() {
             let cell = r[c].trim();
             let v = if dates {
                 parse_stamp(cell).map(|s| {
                     match &first_aware {
-                        None => first_aware = Some((s.aware, *line, cell.to_string())),
+                        None => first_aware = Some((s.aware, line, cell.to_string())),
                         Some((aware, at, first)) if *aware != s.aware => {
                             let (with, without) =
                                 if s.aware { ("has a", "has none") } else { ("has no", "has one") };
                             return Err(self.error(
-                                *line,
+                                line,
                                 format!(
                                     "`{cell}` in x column `{name}` {with} UTC offset but `{first}` (line {at}) {without}: \
                                      a column cannot mix times with and without a time zone"
@@ -266,14 +405,14 @@ impl Cells<'_> {
             };
             let v = v.transpose()?.filter(|v| v.is_finite()).ok_or_else(|| {
                 let what = if dates { "date" } else { "finite number" };
-                self.error(*line, format!("`{cell}` in x column `{name}` is not a {what}"))
+                self.error(line, format!("`{cell}` in x column `{name}` is not a {what}"))
             })?;
             x.push(v);
             text.push(if dates || !self.dialect.decimal_comma { cell.to_string() } else { cell.replace(',', ".") });
         }
         if let Some(i) = (1..x.len()).find(|&i| x[i] <= x[i - 1]) {
             return Err(self.error(
-                self.data[i].0,
+                self.data.line(i),
                 format!("x column `{name}` must strictly increase, but `{}` follows `{}`", text[i], text[i - 1]),
             ));
         }
@@ -284,7 +423,7 @@ impl Cells<'_> {
         } else {
             XSource::Numeric(name.to_string())
         };
-        Ok((x, text, source))
+        Ok((x, XText::Text(text), source))
     }
 }
 
@@ -367,7 +506,7 @@ mod tests {
         let s = read_series(&p, &SeriesCsvOptions { x_column: Some("depth".into()), ..Default::default() }).unwrap();
         assert_eq!(
             (s.x.clone(), s.x_text.clone(), s.x_name.as_str()),
-            (vec![0.5, 1.5, 3.0], vec!["0.5".to_string(), "1.5".into(), "3".into()], "depth")
+            (vec![0.5, 1.5, 3.0], XText::Text(vec!["0.5".to_string(), "1.5".into(), "3".into()]), "depth")
         );
         let p = tmp("tab.tsv", "time\tv\n1\t3\n2\t1\n4\t2\n");
         let s = read_series(&p, &opts).unwrap();
@@ -391,7 +530,7 @@ mod tests {
         for w in s.x.windows(2) {
             assert!((w[1] - w[0] - 1.0 / 24.0).abs() < 1e-9, "{:?}", s.x);
         }
-        assert_eq!(s.x_text[2], "2015-10-25 02:00:00+01:00");
+        assert_eq!(s.x_text.get(2), "2015-10-25 02:00:00+01:00");
         let p = tmp("z.csv", "t,v\n2015-01-01T00:00:00Z,1\n2015-01-01T12:00:00Z,2\n2015-01-02T00:00:00Z,1\n");
         let s = read_series(&p, &opts).unwrap();
         assert_eq!(s.x[1] - s.x[0], 0.5);

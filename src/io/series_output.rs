@@ -2,6 +2,7 @@
 //! `X,input,output,u,role`, X the input's x column name (`x` when it has none), plus a last
 //! column `filled` when missing samples were filled; and reading it back for `verify`.
 
+use super::series_csv::XText;
 use crate::error::{Error, Location, Result};
 use crate::topology::Role;
 use std::path::Path;
@@ -12,7 +13,7 @@ pub struct SeriesOutput {
     /// The x column's header.
     pub x_name: String,
     /// x as text (dates stay dates).
-    pub x_text: Vec<String>,
+    pub x_text: XText,
     /// The input values actually smoothed (after filling).
     pub input: Vec<f64>,
     /// The certified output.
@@ -28,28 +29,64 @@ pub struct SeriesOutput {
 /// The columns after X.
 const COLUMNS: [&str; 4] = ["input", "output", "u", "role"];
 
+/// The columns of [`SeriesOutput`] as written, borrowed from the run's results (at 10⁷
+/// samples copies of them held 1.5 GB).
+#[derive(Clone, Copy, Debug)]
+pub struct SeriesColumns<'a> {
+    /// The x column's header.
+    pub x_name: &'a str,
+    /// x as text.
+    pub x_text: &'a XText,
+    /// The input values actually smoothed (after filling).
+    pub input: &'a [f64],
+    /// The certified output.
+    pub output: &'a [f64],
+    /// The representative function.
+    pub u: &'a [f64],
+    /// Role per sample.
+    pub roles: &'a [Role],
+    /// Samples filled by `--fill-missing` (true), when any were.
+    pub filled: Option<&'a [bool]>,
+}
+
+impl SeriesOutput {
+    /// Its columns, borrowed.
+    #[must_use]
+    pub fn columns(&self) -> SeriesColumns<'_> {
+        SeriesColumns {
+            x_name: &self.x_name,
+            x_text: &self.x_text,
+            input: &self.input,
+            output: &self.output,
+            u: &self.u,
+            roles: &self.roles,
+            filled: self.filled.as_deref(),
+        }
+    }
+}
+
 /// Writes `X,input,output,u,role[,filled]` atomically, doubles in shortest round-trip form.
 pub fn write_series_output(path: &Path, out: &SeriesOutput) -> Result<()> {
-    stage_series_output(path, out)?.commit()
+    stage_series_output(path, &out.columns())?.commit()
 }
 
 /// Stages the file of [`write_series_output`] (see [`super::Staged`]).
-pub fn stage_series_output(path: &Path, out: &SeriesOutput) -> Result<super::Staged> {
-    let filled = out.filled.as_ref().filter(|f| f.iter().any(|&b| b));
+pub fn stage_series_output(path: &Path, out: &SeriesColumns<'_>) -> Result<super::Staged> {
+    let filled = out.filled.filter(|f| f.iter().any(|&b| b));
     super::stage(path, |w| {
-        writeln!(
-            w,
-            "{},{}{}",
-            csv_cell(&out.x_name),
-            COLUMNS.join(","),
-            if filled.is_some() { ",filled" } else { "" }
-        )?;
+        writeln!(w, "{},{}{}", csv_cell(out.x_name), COLUMNS.join(","), if filled.is_some() { ",filled" } else { "" })?;
         // one line at a time into a reused buffer: no string per number or cell
         let mut line = String::new();
+        let text = out.x_text.as_text();
         for i in 0..out.input.len() {
             use std::fmt::Write as _;
             line.clear();
-            line.push_str(&csv_cell(&out.x_text[i]));
+            match text {
+                Some(t) => line.push_str(&csv_cell(&t[i])),
+                None => {
+                    let _ = write!(line, "{i}");
+                }
+            }
             let _ = write!(line, ",{:?},{:?},{:?},{}", out.input[i], out.output[i], out.u[i], out.roles[i].label());
             if let Some(f) = filled {
                 line.push_str(if f[i] { ",1" } else { ",0" });
@@ -88,6 +125,12 @@ fn positions(header: &csv::StringRecord) -> Option<(Option<usize>, [usize; 4], O
 /// Input errors naming the file and line: missing columns, unparsable numbers, unknown roles,
 /// a `filled` cell that is not 0 or 1.
 pub fn read_series_output(path: &Path) -> Result<SeriesOutput> {
+    read_series_output_with(path, true)
+}
+
+/// [`read_series_output`]; without `with_x` the x column's text is not kept (`x_text` is the
+/// index): the read-back check of a written file compares the values only.
+pub(crate) fn read_series_output_with(path: &Path, with_x: bool) -> Result<SeriesOutput> {
     let err = |msg: String| Error::input(msg).in_file(path);
     let bytes = std::fs::read(path).map_err(|source| Error::Io { path: path.to_path_buf(), source })?;
     super::content::expect_text(path, &bytes, "a series CSV (X,input,output,u,role)")?;
@@ -100,8 +143,16 @@ pub fn read_series_output(path: &Path) -> Result<SeriesOutput> {
         ))
     })?;
     let x_name = cx.and_then(|c| header.get(c)).unwrap_or("x").to_string();
-    let mut out =
-        SeriesOutput { x_name, x_text: vec![], input: vec![], output: vec![], u: vec![], roles: vec![], filled: None };
+    let mut out = SeriesOutput {
+        x_name,
+        x_text: XText::Text(Vec::new()),
+        input: vec![],
+        output: vec![],
+        u: vec![],
+        roles: vec![],
+        filled: None,
+    };
+    let mut x_text = Vec::new();
     let mut filled = Vec::new();
     let mut rec = csv::StringRecord::new();
     while reader.read_record(&mut rec).map_err(|e| err(format!("malformed CSV: {e}")))? {
@@ -119,7 +170,9 @@ pub fn read_series_output(path: &Path) -> Result<SeriesOutput> {
             Role::from_label(role)
                 .ok_or_else(|| bad(format!("unknown role `{role}` (min, max, fixed, end or empty)")))?,
         );
-        out.x_text.push(cx.and_then(|c| rec.get(c)).unwrap_or("").to_string());
+        if with_x {
+            x_text.push(cx.and_then(|c| rec.get(c)).unwrap_or("").to_string());
+        }
         if let Some(c) = cf {
             filled.push(match rec.get(c).unwrap_or("") {
                 "1" => true,
@@ -132,6 +185,7 @@ pub fn read_series_output(path: &Path) -> Result<SeriesOutput> {
         return Err(err(format!("a series needs at least 2 samples, found {}", out.input.len())));
     }
     out.filled = cf.map(|_| filled);
+    out.x_text = if with_x { XText::Text(x_text) } else { XText::Index(out.input.len()) };
     Ok(out)
 }
 
@@ -148,7 +202,7 @@ mod tests {
     fn sample(x_name: &str, filled: Option<Vec<bool>>) -> SeriesOutput {
         SeriesOutput {
             x_name: x_name.into(),
-            x_text: vec!["2010-01-01".into(), "2010-01-04".into(), "a,b".into()],
+            x_text: XText::Text(vec!["2010-01-01".into(), "2010-01-04".into(), "a,b".into()]),
             input: vec![0.1, 1.0 / 3.0, -7e-300],
             output: vec![0.1, 0.2 + 0.1, -7e-300],
             u: vec![0.1, 0.5, -1.0],
@@ -182,11 +236,27 @@ mod tests {
     }
 
     #[test]
+    fn an_index_axis_is_written_as_numbers_and_read_back_as_text() {
+        let p = dir().join("index.csv");
+        let out = SeriesOutput { x_text: XText::Index(3), ..sample("x", None) };
+        write_series_output(&p, &out).unwrap();
+        let text = std::fs::read_to_string(&p).unwrap();
+        assert!(text.starts_with("x,input,output,u,role\n0,0.1,0.1,0.1,min\n1,"), "{text}");
+        assert!(text.contains("\n2,-7e-300,"), "{text}");
+        let back = read_series_output(&p).unwrap();
+        assert_eq!(back.x_text, XText::Text(vec!["0".into(), "1".into(), "2".into()]));
+        assert_eq!(back.x_text.to_vec(), out.x_text.to_vec());
+        // the read-back check keeps the values only
+        let values = read_series_output_with(&p, false).unwrap();
+        assert_eq!((values.x_text, values.output), (XText::Index(3), out.output));
+    }
+
+    #[test]
     fn older_and_bad_files() {
         let p = dir().join("old.csv");
         std::fs::write(&p, "input,output,u,role\n0,0,0,min\n1,1,1,max\n").unwrap();
         let back = read_series_output(&p).unwrap();
-        assert_eq!((back.x_name.as_str(), back.x_text.clone()), ("x", vec![String::new(), String::new()]));
+        assert_eq!((back.x_name.as_str(), back.x_text.clone()), ("x", XText::Text(vec![String::new(), String::new()])));
         std::fs::write(&p, "t,input,output,u,role,filled\n0,0,0,0,min,0\n1,1,1,1,max,2\n").unwrap();
         let e = read_series_output(&p).unwrap_err().to_string();
         assert!(e.contains("old.csv") && e.contains("line 3") && e.contains("not 0 or 1"), "{e}");

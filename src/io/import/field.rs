@@ -199,7 +199,7 @@ pub struct SeriesAxis {
     /// x coordinates (days for dates).
     pub x: Vec<f64>,
     /// The x column's text per row, written back out.
-    pub x_text: Vec<String>,
+    pub x_text: crate::io::series_csv::XText,
     /// The x column's header, written back out.
     pub x_name: String,
     /// Where x came from.

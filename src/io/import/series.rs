@@ -58,7 +58,7 @@ pub(super) fn numpy_series(
     let data = SeriesCsv {
         column: name,
         values,
-        x_text: (0..n).map(|i| i.to_string()).collect(),
+        x_text: crate::io::series_csv::XText::Index(n),
         x,
         x_name: "x".into(),
         x_source: crate::io::series_csv::XSource::Index,

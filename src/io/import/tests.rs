@@ -58,7 +58,7 @@ fn a_csv_series_with_dates_is_a_series_in_days_and_a_column_can_be_chosen() {
     assert_eq!((f.description.as_str(), f.values[0]), ("eur_per_usd", 0.8466));
     let axis = f.axis.as_ref().unwrap();
     assert!(matches!(axis.source, crate::io::series_csv::XSource::Dates(..)));
-    assert_eq!((axis.x_text[0].as_str(), axis.x[1] - axis.x[0]), ("1999-01-04", 1.0), "days between dates");
+    assert_eq!((axis.x_text.get(0).as_ref(), axis.x[1] - axis.x[0]), ("1999-01-04", 1.0), "days between dates");
     // another column by name, the same by index
     let weather = dataset("seattle_weather_daily_2012_2015.csv");
     let by_name = opened(&weather, &ReadOptions { column: Some("temp_max".into()), ..Default::default() });

@@ -28,7 +28,13 @@ pub(super) fn solve(r: &ReducedQp, settings: &QpSettings) -> Result<Outcome> {
         a
     };
     let p = CscMatrix::new_from_triplets(r.n, r.n, pi, pj, pv);
-    let a = CscMatrix::new_from_triplets(r.m(), r.n, r.a_row.clone(), r.a_col.clone(), r.a_val.clone());
+    let (mut ai, mut aj, mut av) = (Vec::new(), Vec::new(), Vec::new());
+    for (row, col, v) in r.rows.entries() {
+        ai.push(row);
+        aj.push(col);
+        av.push(v);
+    }
+    let a = CscMatrix::new_from_triplets(r.m(), r.n, ai, aj, av);
     let cones = [NonnegativeConeT(r.m())];
     let (x, z, status, iterations) = run(&p, &r.q, &a, &r.b, &cones, settings)?;
     Ok(Outcome { x, z, y: None, status, iterations })
@@ -74,10 +80,10 @@ fn solve_auxiliary(r: &ReducedQp, factor: &ReducedFactor, settings: &QpSettings)
         aj.push(nf + t);
         av.push(-1.0);
     }
-    for (k, &row) in r.a_row.iter().enumerate() {
+    for (row, col, v) in r.rows.entries() {
         ai.push(rows + row);
-        aj.push(r.a_col[k]);
-        av.push(r.a_val[k]);
+        aj.push(col);
+        av.push(v);
     }
     let mut b: Vec<f64> = factor.g.iter().map(|g| -g).collect();
     b.extend_from_slice(&r.b);

@@ -218,18 +218,18 @@ pub(super) fn solve(
     match &r.factor {
         Some(factor) => {
             drop(spare);
-            let rows = Rows::new(r)?;
+            let rows = &r.rows;
             let objective = super::factored::Normal::new(r, factor, &rows.cols, &rows.len)?;
             if factor.double_iteration {
                 let mut objective = super::factored::Rounded::new(objective, r.n, r.m());
-                run::<f64, _>(r, &rows, &mut objective, hint, settings)
+                run::<f64, _>(r, rows, &mut objective, hint, settings)
             } else {
                 let mut objective = objective;
-                run::<faer::fx128, _>(r, &rows, &mut objective, hint, settings)
+                run::<faer::fx128, _>(r, rows, &mut objective, hint, settings)
             }
         }
         None => {
-            let Assembly { rows, normal } = match assembly {
+            let Assembly { normal } = match assembly {
                 Some(assembly) => assembly,
                 None => Assembly::new(r)?,
             };
@@ -249,7 +249,7 @@ pub(super) fn solve(
                 }
             };
             let mut objective = Assembled { r, factor, energy: None };
-            run::<f64, _>(r, &rows, &mut objective, hint, settings)
+            run::<f64, _>(r, &r.rows, &mut objective, hint, settings)
         }
     }
 }
@@ -261,21 +261,23 @@ enum NormalForm {
     Band(usize),
 }
 
-/// The assembled form's constraint rows and normal-matrix form, made once for both the
-/// memory prediction and the solve (at 10⁷ samples of a series each took seconds).
+/// The assembled form's normal-matrix form, made once for both the memory prediction and the
+/// solve (at 10⁷ samples of a series its pattern took seconds).
 pub(super) struct Assembly {
-    rows: Rows,
     normal: NormalForm,
 }
 
 impl Assembly {
     fn new(r: &ReducedQp) -> std::result::Result<Assembly, crate::error::NumericalError> {
-        let rows = Rows::new(r)?;
-        let normal = match normal_band(r, &rows) {
+        let rows = &r.rows;
+        if rows.len.len() != r.m() {
+            return Err("the reduced QP was made without its rows".into());
+        }
+        let normal = match normal_band(r, rows) {
             Some(b) => NormalForm::Band(b),
             None => NormalForm::Pattern(Normal::new(r, &rows.cols, &rows.len)),
         };
-        Ok(Assembly { rows, normal })
+        Ok(Assembly { normal })
     }
 }
 
@@ -298,9 +300,7 @@ pub(super) fn predicted_bytes(
     }
     let assembly = Assembly::new(r)?;
     let (n, m) = (r.n as u64, r.m() as u64);
-    // the rows (two columns, two values, a length); about 14 vectors of n and 18 of m in the
-    // iteration
-    let row_bytes = 33 * m;
+    // about 14 vectors of n and 18 of m in the iteration (the rows are the reduced QP's)
     let vectors = 8 * (14 * n + 18 * m);
     let matrix_bytes = match &assembly.normal {
         // the band's own LDLᵀ: the band, L and 1/D (n·(b + 1), n·b and n values)
@@ -314,7 +314,7 @@ pub(super) fn predicted_bytes(
                 + analyses.of(normal.symbolic.as_ref())?.numeric_bytes()
         }
     };
-    Ok(Some((matrix_bytes + row_bytes + vectors, assembly)))
+    Ok(Some((matrix_bytes + vectors, assembly)))
 }
 
 /// The primal–dual iterate: `x`, the slacks `s = b − Ax` and the multipliers `z`.
@@ -824,14 +824,7 @@ impl<T: Real> Newton<T> {
 /// The normal matrix's pattern [`solve`] analyses for `r`.
 #[cfg(test)]
 pub(crate) fn normal_pattern(r: &ReducedQp) -> faer::sparse::SymbolicSparseColMat<usize> {
-    let mut row_cols = vec![[0usize; 2]; r.m()];
-    let mut row_len = vec![0u8; r.m()];
-    for k in 0..r.a_row.len() {
-        let row = r.a_row[k];
-        row_cols[row][row_len[row] as usize] = r.a_col[k];
-        row_len[row] += 1;
-    }
-    Normal::new(r, &row_cols, &row_len).symbolic
+    Normal::new(r, &r.rows.cols, &r.rows.len).symbolic
 }
 
 /// Coordinate descent on the gap bound `Σ max(s, 0) z + ½ Σ ρ²/d` over the multipliers
@@ -885,31 +878,28 @@ mod tests {
                 p.push((i, j, if i == j { 6.0 + 0.1 * (j % 7) as f64 } else { -1.5 + 0.01 * (i + j) as f64 }));
             }
         }
-        let (mut a_row, mut a_col, mut a_val) = (Vec::new(), Vec::new(), Vec::new());
+        let mut rows = Rows::default();
+        let mut push = |cols: [usize; 2], vals: [f64; 2], len: u8| {
+            rows.cols.push(cols);
+            rows.vals.push(vals);
+            rows.len.push(len);
+        };
         for k in 0..n - 1 {
-            a_row.extend([k, k]);
-            a_col.extend([k, k + 1]);
             let s = if (k / 5) % 2 == 0 { 1.0 } else { -1.0 };
-            a_val.extend([s, -s]);
+            push([k, k + 1], [s, -s], 2);
         }
-        for (k, c) in [(n - 1, 0), (n, n / 2)] {
-            a_row.push(k);
-            a_col.push(c);
-            a_val.push(-1.0);
+        for c in [0, n / 2] {
+            push([c, c], [-1.0, 0.0], 1);
         }
         if let Some(w) = wide {
-            a_row.extend([n + 1, n + 1]);
-            a_col.extend([0, w]);
-            a_val.extend([1.0, -1.0]);
+            push([0, w], [1.0, -1.0], 2);
         }
-        let m = a_row.last().map_or(0, |r| r + 1);
+        let m = rows.len.len();
         ReducedQp {
             n,
             p,
             q: vec![0.0; n],
-            a_row,
-            a_col,
-            a_val,
+            rows,
             b: vec![0.0; m],
             d: vec![1.0; n],
             q_free: vec![0.0; n],
@@ -924,8 +914,8 @@ mod tests {
     fn a_band_assembled_without_a_pattern_factorises_as_the_pattern_s_values() {
         let n = 300;
         let r = path_qp(n, None);
-        let rows = Rows::new(&r).unwrap();
-        assert_eq!(normal_band(&r, &rows), Some(2));
+        let rows = &r.rows;
+        assert_eq!(normal_band(&r, rows), Some(2));
         let w: Vec<f64> = (0..r.m()).map(|k| 10f64.powf(((k * 37) % 17) as f64 - 8.0)).collect();
         let rhs: Vec<f64> = (0..n).map(|i| (i as f64 * 0.31).sin()).collect();
         // the pattern's way: values on the normal pattern, copied into the band by position
@@ -950,7 +940,7 @@ mod tests {
         old.solve_in_place(&mut expected);
         // straight into the band
         let mut new = Factorised::Banded(Banded::of_band(n, 2));
-        assert!(new.assemble_and_factor(&r, &rows, &w, 0.0));
+        assert!(new.assemble_and_factor(&r, rows, &w, 0.0));
         let mut got = rhs.clone();
         new.solve_in_place(&mut got);
         assert!(got.iter().zip(&expected).all(|(a, b)| a.to_bits() == b.to_bits()));
@@ -971,8 +961,8 @@ mod tests {
         assert!(err < 1e-6, "residual {err:e}");
         // a row spanning more than the band's limit: the sparse pattern
         let wide = path_qp(n, Some(ordering::BANDED_MAX + 1));
-        assert_eq!(normal_band(&wide, &Rows::new(&wide).unwrap()), None);
+        assert_eq!(normal_band(&wide, &wide.rows), None);
         let edge = path_qp(n, Some(ordering::BANDED_MAX));
-        assert_eq!(normal_band(&edge, &Rows::new(&edge).unwrap()), Some(ordering::BANDED_MAX));
+        assert_eq!(normal_band(&edge, &edge.rows), Some(ordering::BANDED_MAX));
     }
 }

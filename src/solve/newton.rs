@@ -3,6 +3,7 @@
 //! objective's interface and the arithmetic itself (`f64` or double-double).
 
 use super::problem::ReducedQp;
+pub(super) use super::problem::Rows;
 use crate::linalg as ordering;
 use faer::sparse::{SymbolicSparseColMat, SymbolicSparseColMatRef};
 
@@ -192,31 +193,7 @@ pub(super) fn max<T: Real>(a: T, b: T) -> T {
     }
 }
 
-/// The constraint rows of a reduced QP: one or two entries each.
-pub(super) struct Rows {
-    pub(super) cols: Vec<[usize; 2]>,
-    pub(super) vals: Vec<[f64; 2]>,
-    pub(super) len: Vec<u8>,
-}
-
 impl Rows {
-    /// The rows of `r`; `Err` if one has more than two entries.
-    pub(super) fn new(r: &ReducedQp) -> std::result::Result<Rows, crate::error::NumericalError> {
-        let m = r.m();
-        let mut rows = Rows { cols: vec![[0; 2]; m], vals: vec![[0.0; 2]; m], len: vec![0; m] };
-        for k in 0..r.a_row.len() {
-            let row = r.a_row[k];
-            let l = rows.len[row] as usize;
-            if l >= 2 {
-                return Err(crate::error::NumericalError(format!("row {row} has more than two entries")));
-            }
-            rows.cols[row][l] = r.a_col[k];
-            rows.vals[row][l] = r.a_val[k];
-            rows.len[row] += 1;
-        }
-        Ok(rows)
-    }
-
     /// `out = A x`.
     pub(super) fn ax<T: Real>(&self, x: &[T], out: &mut [T]) {
         for (k, o) in out.iter_mut().enumerate() {

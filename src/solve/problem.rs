@@ -106,12 +106,8 @@ pub struct ReducedQp {
     pub p: Vec<(usize, usize, f64)>,
     /// Linear term.
     pub q: Vec<f64>,
-    /// Row index of each entry of A (non-decreasing).
-    pub a_row: Vec<usize>,
-    /// Column of each entry of A.
-    pub a_col: Vec<usize>,
-    /// Value of each entry of A.
-    pub a_val: Vec<f64>,
+    /// The rows of A (none, as P's triplets, when made for the active set: `reduce_with`).
+    pub rows: Rows,
     /// Right-hand side, one per row.
     pub b: Vec<f64>,
     /// The data diagonal on the free variables (zeros without a data term).
@@ -130,6 +126,38 @@ pub struct ReducedQp {
     /// `½ x_Xᵀ P_XX x_X` (scaled): the objective of the fixed part, so that `φ(x) + constant`
     /// is `½ fᵀPf + qᵀf` of the whole vector (less the fixed part's linear term).
     pub constant: f64,
+}
+
+/// The constraint rows of a reduced QP: one or two entries each (at 10⁷ rows, triplets of A
+/// beside these were 0.5 GB).
+#[derive(Clone, Debug, Default)]
+pub struct Rows {
+    /// The columns of each row's entries (the second unused for a row of one entry).
+    pub cols: Vec<[usize; 2]>,
+    /// Their values.
+    pub vals: Vec<[f64; 2]>,
+    /// The number of entries, 1 or 2.
+    pub len: Vec<u8>,
+}
+
+impl Rows {
+    fn with_capacity(m: usize) -> Rows {
+        Rows { cols: Vec::with_capacity(m), vals: Vec::with_capacity(m), len: Vec::with_capacity(m) }
+    }
+
+    fn push(&mut self, entries: &[(usize, f64)]) {
+        let (c1, v1) = entries[0];
+        let (c2, v2) = entries.get(1).copied().unwrap_or((c1, 0.0));
+        self.cols.push([c1, c2]);
+        self.vals.push([v1, v2]);
+        self.len.push(entries.len() as u8);
+    }
+
+    /// Every entry as `(row, column, value)`, row by row.
+    pub fn entries(&self) -> impl Iterator<Item = (usize, usize, f64)> + '_ {
+        (0..self.len.len())
+            .flat_map(move |k| (0..self.len[k] as usize).map(move |l| (k, self.cols[k][l], self.vals[k][l])))
+    }
 }
 
 impl ReducedQp {
@@ -191,9 +219,7 @@ pub(super) fn reduce_with(qp: &MonotoneQp<'_>, free: &[usize], triplets: bool) -
         n: nf,
         p,
         q,
-        a_row: vec![],
-        a_col: vec![],
-        a_val: vec![],
+        rows: Rows::default(),
         b: vec![],
         d,
         q_free,
@@ -204,43 +230,37 @@ pub(super) fn reduce_with(qp: &MonotoneQp<'_>, free: &[usize], triplets: bool) -
     };
     let rows = constraint_rows(qp);
     r.b.reserve_exact(rows.len());
-    let entries = if triplets { 2 * rows.len() } else { 0 };
-    for v in [&mut r.a_row, &mut r.a_col] {
-        v.reserve_exact(entries);
+    if triplets {
+        r.rows = Rows::with_capacity(rows.len());
     }
-    r.a_val.reserve_exact(entries);
     for row in rows {
-        let at = r.b.len();
-        let mut push = |col: usize, v: f64| {
+        let mut push = |entries: &[(usize, f64)]| {
             if triplets {
-                r.a_row.push(at);
-                r.a_col.push(col);
-                r.a_val.push(v);
+                r.rows.push(entries);
             }
         };
         // f_j − f_i ≥ ε  ⇔  f_i − f_j ≤ −ε
         match row {
             Row::Pair(i, j) => match (qp.fixed[i], qp.fixed[j]) {
                 (None, None) => {
-                    push(slot[i], 1.0);
-                    push(slot[j], -1.0);
+                    push(&[(slot[i], 1.0), (slot[j], -1.0)]);
                     r.b.push(-qp.margin);
                 }
                 (Some(fi), _) => {
-                    push(slot[j], -1.0);
+                    push(&[(slot[j], -1.0)]);
                     r.b.push(-qp.margin - fi);
                 }
                 (None, Some(fj)) => {
-                    push(slot[i], 1.0);
+                    push(&[(slot[i], 1.0)]);
                     r.b.push(fj - qp.margin);
                 }
             },
             Row::Upper(v, c) => {
-                push(slot[v], 1.0);
+                push(&[(slot[v], 1.0)]);
                 r.b.push(c);
             }
             Row::Lower(v, c) => {
-                push(slot[v], -1.0);
+                push(&[(slot[v], -1.0)]);
                 r.b.push(-c);
             }
         }

@@ -132,9 +132,14 @@ pub fn read_series_output(path: &Path) -> Result<SeriesOutput> {
 /// index): the read-back check of a written file compares the values only.
 pub(crate) fn read_series_output_with(path: &Path, with_x: bool) -> Result<SeriesOutput> {
     let err = |msg: String| Error::input(msg).in_file(path);
-    let bytes = std::fs::read(path).map_err(|source| Error::Io { path: path.to_path_buf(), source })?;
-    super::content::expect_text(path, &bytes, "a series CSV (X,input,output,u,role)")?;
-    let mut reader = csv::ReaderBuilder::new().has_headers(true).trim(csv::Trim::All).from_reader(bytes.as_slice());
+    super::content::expect_text(path, &super::content::head(path)?, "a series CSV (X,input,output,u,role)")?;
+    // streamed: the written file is read back after every run (at 10⁷ samples a copy of it in
+    // memory was 0.7 GB of fresh pages)
+    let file = std::fs::File::open(path).map_err(|source| Error::Io { path: path.to_path_buf(), source })?;
+    let mut reader = csv::ReaderBuilder::new()
+        .has_headers(true)
+        .trim(csv::Trim::All)
+        .from_reader(std::io::BufReader::with_capacity(1 << 20, file));
     let header = reader.headers().map_err(|e| err(format!("malformed CSV: {e}")))?.clone();
     let (cx, [ci, co, cu, cr], cf) = positions(&header).ok_or_else(|| {
         err(format!(

@@ -12,7 +12,6 @@
 //! pivot is inverted once, and the factorisation and both solves multiply.
 
 use super::newton::Real;
-use faer::sparse::SymbolicSparseColMatRef;
 
 /// The factor: `L` unit lower triangular with `b` entries left of the diagonal per row, `D`.
 pub(super) struct Banded<T> {
@@ -24,31 +23,14 @@ pub(super) struct Banded<T> {
     inv_d: Vec<T>,
     /// The matrix as a band: `a[j·(b + 1) + t]` is the entry `(j − b + t, j)`, `t = b` the diagonal.
     a: Vec<T>,
-    /// Where each stored entry of the pattern goes in `a` (empty when filled through
-    /// [`Banded::band_mut`]).
-    slot: Vec<usize>,
 }
 
 impl<T: Real> Banded<T> {
-    /// Storage for matrices of the upper-triangular `pattern`, whose entries lie within `b`
-    /// places of the diagonal.
-    pub(super) fn new(pattern: SymbolicSparseColMatRef<'_, usize>, b: usize) -> Banded<T> {
-        let n = pattern.ncols();
-        let mut slot = Vec::with_capacity(pattern.row_idx().len());
-        for j in 0..n {
-            for i in pattern.row_idx_of_col(j) {
-                debug_assert!(i <= j && j - i <= b);
-                slot.push(Self::at(b, i, j));
-            }
-        }
-        Banded { slot, ..Self::of_band(n, b) }
-    }
-
     /// Storage for `n × n` matrices within `b` places of the diagonal, filled through
-    /// [`Banded::band_mut`] rather than from a pattern's values.
+    /// [`Banded::band_mut`].
     pub(super) fn of_band(n: usize, b: usize) -> Banded<T> {
         let zero = T::of(0.0);
-        Banded { n, b, l: vec![zero; n * b], inv_d: vec![zero; n], a: vec![zero; n * (b + 1)], slot: Vec::new() }
+        Banded { n, b, l: vec![zero; n * b], inv_d: vec![zero; n], a: vec![zero; n * (b + 1)] }
     }
 
     /// Where the entry `(i, j)`, `i ≤ j ≤ i + b`, is in the band of [`Banded::band_mut`].
@@ -66,17 +48,6 @@ impl<T: Real> Banded<T> {
     /// The band's half-width `b`.
     pub(super) fn width(&self) -> usize {
         self.b
-    }
-
-    /// Factorises the matrix with the pattern's values `vals` plus `shift` on the diagonal;
-    /// `false` if a pivot is not positive (the matrix is not positive definite).
-    pub(super) fn factor(&mut self, vals: &[T], shift: T) -> bool {
-        let zero = T::of(0.0);
-        self.a.iter_mut().for_each(|v| *v = zero);
-        for (&s, &v) in self.slot.iter().zip(vals) {
-            self.a[s] = v;
-        }
-        self.factor_band(shift)
     }
 
     /// Factorises the band as filled (plus `shift` on the diagonal), leaving it as it is;
@@ -172,26 +143,39 @@ mod tests {
         y
     }
 
+    /// The factor of the pattern's values `v` plus `shift`, through the band.
+    fn factor<T: Real>(f: &mut Banded<T>, p: &faer::sparse::SymbolicSparseColMat<usize>, v: &[T], shift: T) -> bool {
+        let b = f.width();
+        let band = f.band_mut();
+        band.iter_mut().for_each(|a| *a = T::of(0.0));
+        for j in 0..p.ncols() {
+            for (&i, &a) in p.row_idx()[p.col_ptr()[j]..p.col_ptr()[j + 1]].iter().zip(&v[p.col_ptr()[j]..]) {
+                band[Banded::<T>::at(b, i, j)] = a;
+            }
+        }
+        f.factor_band(shift)
+    }
+
     #[test]
     fn the_banded_factor_solves_in_double_and_in_double_double() {
         let n = 500;
         let (p, v) = path(n);
         let x: Vec<f64> = (0..n).map(|i| (i as f64 * 0.37).sin() + 0.001 * i as f64).collect();
         let rhs = multiply(&p, &v, &x);
-        let mut f = Banded::<f64>::new(p.as_ref(), 2);
-        assert!(f.factor(&v, 0.0));
+        let mut f = Banded::<f64>::of_band(n, 2);
+        assert!(factor(&mut f, &p, &v, 0.0));
         let mut y = rhs.clone();
         f.solve_in_place(&mut y);
         let err = y.iter().zip(&x).fold(0.0f64, |a, (y, x)| a.max((y - x).abs()));
         assert!(err < 1e-9, "double: {err:e}");
         let vq: Vec<fx128> = v.iter().map(|&a| fx128::from(a)).collect();
-        let mut fq = Banded::<fx128>::new(p.as_ref(), 2);
-        assert!(fq.factor(&vq, fx128::from(0.0)));
+        let mut fq = Banded::<fx128>::of_band(n, 2);
+        assert!(factor(&mut fq, &p, &vq, fx128::from(0.0)));
         let mut yq: Vec<fx128> = rhs.iter().map(|&a| fx128::from(a)).collect();
         fq.solve_in_place(&mut yq);
         let err = yq.iter().zip(&x).fold(0.0f64, |a, (y, x)| a.max((y.to_f64() - x).abs()));
         assert!(err < 1e-12, "double-double: {err:e}");
         // an indefinite matrix is refused: a negative shift past the smallest eigenvalue
-        assert!(!f.factor(&v, -20.0));
+        assert!(!factor(&mut f, &p, &v, -20.0));
     }
 }

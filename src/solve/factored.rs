@@ -19,7 +19,7 @@
 //! [`Rounded`] runs the iteration itself in double, with this gradient and this solve.
 
 use super::banded::Banded;
-use super::newton::{Normal as Pattern, Objective, Rows};
+use super::newton::{normal_band, Normal as Pattern, Objective, Rows};
 use super::problem::{ReducedFactor, ReducedQp};
 use crate::linalg;
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
@@ -49,8 +49,9 @@ pub(super) struct Normal<'r> {
     f: &'r ReducedFactor,
     d: Vec<fx128>,
     q: Vec<fx128>,
-    pattern: Pattern,
-    /// `F_FᵀF_F + diag(d)` on the pattern.
+    /// The normal matrix's sparse pattern (`None` when it is banded).
+    pattern: Option<Pattern>,
+    /// `F_FᵀF_F + diag(d)` on the pattern, or in the band.
     base: Vec<fx128>,
     /// The normal matrix of the last factorisation, and rounded to double.
     vals: Vec<fx128>,
@@ -61,8 +62,9 @@ pub(super) struct Normal<'r> {
     /// Whether `spd` holds the last normal matrix (its rounding is positive definite).
     spd_ok: bool,
     exact: Option<Exact>,
-    /// A banded pattern (a series): factorised in double-double from the start
-    /// ([`Banded`]: about n·b² products, below a few refinement steps').
+    /// A banded normal matrix (a series): assembled in its band and factorised in
+    /// double-double from the start ([`Banded`]: about n·b² products, below a few refinement
+    /// steps').
     banded: Option<Banded<fx128>>,
     t: std::cell::RefCell<Vec<fx128>>,
 }
@@ -77,27 +79,50 @@ impl<'r> Normal<'r> {
     pub(super) fn new(
         r: &'r ReducedQp,
         f: &'r ReducedFactor,
-        row_cols: &[[usize; 2]],
-        row_len: &[u8],
     ) -> std::result::Result<Normal<'r>, crate::error::NumericalError> {
-        let pattern = Pattern::new(r, row_cols, row_len);
-        let (cp, ri) = (pattern.symbolic.col_ptr(), pattern.symbolic.row_idx());
-        let find = |i: usize, j: usize| {
-            ri[cp[j]..cp[j + 1]]
-                .binary_search(&i)
-                .map(|p| cp[j] + p)
-                .map_err(|_| format!("the factor couples variables {i} and {j}, which the assembled energy does not"))
-        };
-        let mut base = vec![fx128::from(0.0); ri.len()];
-        // the rows of F: (column, double-double entry)
-        let mut rows: Vec<Vec<(usize, fx128)>> = vec![Vec::new(); f.f.nrows()];
+        let zero = fx128::from(0.0);
+        // the rows of F (column, double-double entry), each in column order: one counting pass
+        // over its columns (a vector per row held 0.1 kB each)
         let (fcp, fri) = (f.f.symbolic().col_ptr(), f.f.symbolic().row_idx());
+        let mut start = vec![0usize; f.f.nrows() + 1];
+        for &i in fri {
+            start[i + 1] += 1;
+        }
+        for i in 0..f.f.nrows() {
+            start[i + 1] += start[i];
+        }
+        let mut fill = start.clone();
+        let mut entries = vec![(0usize, zero); fri.len()];
         for j in 0..f.f.ncols() {
             for p in fcp[j]..fcp[j + 1] {
-                rows[fri[p]].push((j, f.entry(p)));
+                entries[fill[fri[p]]] = (j, f.entry(p));
+                fill[fri[p]] += 1;
             }
         }
-        for row in &rows {
+        drop(fill);
+        // a banded normal matrix (a series) straight in its band, as the assembled form's
+        let band = normal_band(r, &r.rows);
+        let pattern = match band {
+            Some(_) => None,
+            None => Some(Pattern::new(r, &r.rows.cols, &r.rows.len)),
+        };
+        let find = |i: usize, j: usize| -> std::result::Result<usize, String> {
+            let outside = || format!("the factor couples variables {i} and {j}, which the assembled energy does not");
+            match (&pattern, band) {
+                (Some(pattern), _) => {
+                    let (cp, ri) = (pattern.symbolic.col_ptr(), pattern.symbolic.row_idx());
+                    ri[cp[j]..cp[j + 1]].binary_search(&i).map(|p| cp[j] + p).map_err(|_| outside())
+                }
+                (None, Some(b)) if j - i <= b => Ok(Banded::<fx128>::at(b, i, j)),
+                _ => Err(outside()),
+            }
+        };
+        let len = match (&pattern, band) {
+            (Some(pattern), _) => pattern.symbolic.row_idx().len(),
+            (None, b) => r.n * (b.unwrap_or(0) + 1),
+        };
+        let mut base = vec![zero; len];
+        for row in start.windows(2).map(|w| &entries[w[0]..w[1]]) {
             for &(i, a) in row {
                 for &(j, b) in row {
                     if i <= j {
@@ -107,20 +132,23 @@ impl<'r> Normal<'r> {
             }
         }
         for (j, &d) in r.d.iter().enumerate() {
-            base[pattern.pos_diag[j]] += fx128::from(d);
+            base[find(j, j)?] += fx128::from(d);
         }
-        let banded = linalg::band(pattern.symbolic.as_ref()).map(|b| Banded::new(pattern.symbolic.as_ref(), b));
+        drop(entries);
+        let banded = band.map(|b| Banded::of_band(r.n, b));
         // the double factor and its rounded matrix only where refinement may use them
-        let spd = match banded {
-            Some(_) => None,
-            None => Some(linalg::SpdFactor::new(std::sync::Arc::new(linalg::analyse(pattern.symbolic.as_ref())?))?),
+        let spd = match &pattern {
+            None => None,
+            Some(pattern) => {
+                Some(linalg::SpdFactor::new(std::sync::Arc::new(linalg::analyse(pattern.symbolic.as_ref())?))?)
+            }
         };
         let rounded = if spd.is_some() { vec![0.0; base.len()] } else { Vec::new() };
         Ok(Normal {
             f,
             d: r.d.iter().map(|&v| fx128::from(v)).collect(),
             q: r.q_free.iter().map(|&v| fx128::from(v)).collect(),
-            vals: base.clone(),
+            vals: if banded.is_some() { Vec::new() } else { base.clone() },
             rounded,
             base,
             pattern,
@@ -128,7 +156,7 @@ impl<'r> Normal<'r> {
             spd_ok: false,
             exact: None,
             banded,
-            t: std::cell::RefCell::new(vec![fx128::from(0.0); f.f.nrows()]),
+            t: std::cell::RefCell::new(vec![zero; f.f.nrows()]),
         })
     }
 
@@ -149,8 +177,11 @@ impl<'r> Normal<'r> {
 
     /// Factorises the last normal matrix in double-double (once refinement has stalled).
     fn factor_exact(&mut self) -> std::result::Result<(), crate::error::NumericalError> {
+        let Some(pattern) = self.pattern.as_ref() else {
+            return Err("a banded normal matrix has no sparse pattern to factorise".into());
+        };
         if self.exact.is_none() {
-            let symbolic = linalg::analyse_simplicial(self.pattern.symbolic.as_ref())?;
+            let symbolic = linalg::analyse_simplicial(pattern.symbolic.as_ref())?;
             let mem = MemBuffer::try_new(StackReq::any_of(&[
                 symbolic.factorize_numeric_llt_scratch::<fx128>(Par::Seq, Spec::default()),
                 symbolic.solve_in_place_scratch::<fx128>(1, Par::Seq),
@@ -163,11 +194,11 @@ impl<'r> Normal<'r> {
         for reg in SHIFTS {
             let mut vals = self.vals.clone();
             if reg > 0.0 {
-                for &d in &self.pattern.pos_diag {
+                for &d in &pattern.pos_diag {
                     vals[d] += fx128::from(reg);
                 }
             }
-            let a = SparseColMatRef::new(self.pattern.symbolic.as_ref(), &vals);
+            let a = SparseColMatRef::new(pattern.symbolic.as_ref(), &vals);
             let ok = e
                 .symbolic
                 .factorize_numeric_llt(
@@ -222,24 +253,40 @@ impl Objective<fx128> for Normal<'_> {
     /// `F_FᵀF_F + diag(d) + Aᵀ diag(w) A` in double-double, and its rounding factorised in
     /// double (or in double-double once refinement has stalled).
     fn factor(&mut self, rows: &Rows, w: &[fx128]) -> std::result::Result<(), crate::error::NumericalError> {
+        if let Some(banded) = &mut self.banded {
+            let b = banded.width();
+            let at = |i: usize, j: usize| Banded::<fx128>::at(b, i.min(j), i.max(j));
+            let band = banded.band_mut();
+            band.copy_from_slice(&self.base);
+            for (k, &wk) in w.iter().enumerate() {
+                let [c1, c2] = rows.cols[k];
+                let [a1, a2] = rows.vals[k];
+                band[at(c1, c1)] += wk * fx128::from(a1 * a1);
+                if rows.len[k] == 2 {
+                    band[at(c2, c2)] += wk * fx128::from(a2 * a2);
+                    band[at(c1, c2)] += wk * fx128::from(a1 * a2);
+                }
+            }
+            // the same regularisation as the general factorisation's, if it must
+            for reg in SHIFTS {
+                if banded.factor_band(fx128::from(reg)) {
+                    return Ok(());
+                }
+            }
+            return Err("the double-double normal matrix is not positive definite".into());
+        }
+        let Some(pattern) = self.pattern.as_ref() else {
+            return Err("the normal matrix has neither a band nor a sparse pattern".into());
+        };
         self.vals.copy_from_slice(&self.base);
         for (k, &wk) in w.iter().enumerate() {
-            let [p1, p2, p12] = self.pattern.pos_row[k];
+            let [p1, p2, p12] = pattern.pos_row[k];
             let [a1, a2] = rows.vals[k];
             self.vals[p1] += wk * fx128::from(a1 * a1);
             if rows.len[k] == 2 {
                 self.vals[p2] += wk * fx128::from(a2 * a2);
                 self.vals[p12] += wk * fx128::from(a1 * a2);
             }
-        }
-        if let Some(banded) = &mut self.banded {
-            // the same regularisation as the general factorisation's, if it must
-            for reg in SHIFTS {
-                if banded.factor(&self.vals, fx128::from(reg)) {
-                    return Ok(());
-                }
-            }
-            return Err("the double-double normal matrix is not positive definite".into());
         }
         if self.exact.is_some() {
             return self.factor_exact();
@@ -250,7 +297,7 @@ impl Objective<fx128> for Normal<'_> {
         let Some(spd) = self.spd.as_mut() else {
             return self.factor_exact();
         };
-        let a = SparseColMatRef::new(self.pattern.symbolic.as_ref(), &self.rounded);
+        let a = SparseColMatRef::new(pattern.symbolic.as_ref(), &self.rounded);
         self.spd_ok = spd.factor(a).is_ok();
         if !self.spd_ok {
             return self.factor_exact();
@@ -264,7 +311,9 @@ impl Objective<fx128> for Normal<'_> {
             return;
         }
         let n = rhs.len();
-        if let (None, true, Some(spd)) = (&self.exact, self.spd_ok, self.spd.as_mut()) {
+        if let (None, true, Some(spd), Some(pattern)) =
+            (&self.exact, self.spd_ok, self.spd.as_mut(), self.pattern.as_ref())
+        {
             let norm = |v: &[fx128]| v.iter().fold(0.0f64, |a, x| a.max((x.0 + x.1).abs()));
             let target = REFINED * norm(rhs);
             let mut x = vec![fx128::from(0.0); n];
@@ -280,7 +329,7 @@ impl Objective<fx128> for Normal<'_> {
                 for (xi, &di) in x.iter_mut().zip(&d) {
                     *xi += fx128::from(di);
                 }
-                Self::multiply(&self.pattern, &self.vals, &x, &mut nx);
+                Self::multiply(pattern, &self.vals, &x, &mut nx);
                 for i in 0..n {
                     r[i] = rhs[i] - nx[i];
                 }

@@ -219,7 +219,7 @@ pub(super) fn solve(
         Some(factor) => {
             drop(spare);
             let rows = &r.rows;
-            let objective = super::factored::Normal::new(r, factor, &rows.cols, &rows.len)?;
+            let objective = super::factored::Normal::new(r, factor)?;
             if factor.double_iteration {
                 let mut objective = super::factored::Rounded::new(objective, r.n, r.m());
                 run::<f64, _>(r, rows, &mut objective, hint, settings)
@@ -934,8 +934,14 @@ mod tests {
                 vals[p12] += wk * a1 * a2;
             }
         }
-        let mut old = Banded::<f64>::new(normal.symbolic.as_ref(), 2);
-        assert!(old.factor(&vals, 0.0));
+        let mut old = Banded::<f64>::of_band(n, 2);
+        let (cp, ri) = (normal.symbolic.col_ptr(), normal.symbolic.row_idx());
+        for j in 0..n {
+            for p in cp[j]..cp[j + 1] {
+                old.band_mut()[Banded::<f64>::at(2, ri[p], j)] = vals[p];
+            }
+        }
+        assert!(old.factor_band(0.0));
         let mut expected = rhs.clone();
         old.solve_in_place(&mut expected);
         // straight into the band

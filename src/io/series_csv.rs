@@ -6,7 +6,7 @@
 use super::csv_dialect::{sniff, Dialect};
 pub(crate) use super::series_output::read_series_output_with;
 pub use super::series_output::{
-    read_series_output, stage_series_output, write_series_output, SeriesColumns, SeriesOutput,
+    read_series_output, stage_series_output, write_series_output, SeriesColumns, SeriesOutput, XText,
 };
 pub use super::timestamps::parse_date_days;
 use super::timestamps::parse_stamp;
@@ -23,63 +23,6 @@ pub enum XSource {
     Numeric(String),
     /// A date column, turned into days since the first date.
     Dates(String, NaiveDate),
-}
-
-/// The x column's text per sample, written back out: the sample index when the series has no
-/// x column (made when asked: at 10⁷ samples a string each held 0.5 GB), else the file's text.
-#[derive(Clone, Debug, PartialEq)]
-pub enum XText {
-    /// `0, 1, …, n − 1`.
-    Index(usize),
-    /// The text of each row.
-    Text(Vec<String>),
-}
-
-impl XText {
-    /// The number of samples.
-    #[must_use]
-    pub fn len(&self) -> usize {
-        match self {
-            XText::Index(n) => *n,
-            XText::Text(t) => t.len(),
-        }
-    }
-
-    /// Whether there is no sample.
-    #[must_use]
-    pub fn is_empty(&self) -> bool {
-        self.len() == 0
-    }
-
-    /// The text of sample `i`.
-    ///
-    /// # Panics
-    /// If `i` is out of range.
-    #[must_use]
-    pub fn get(&self, i: usize) -> std::borrow::Cow<'_, str> {
-        match self {
-            XText::Index(n) => {
-                assert!(i < *n, "sample {i} of {n}");
-                i.to_string().into()
-            }
-            XText::Text(t) => t[i].as_str().into(),
-        }
-    }
-
-    /// The stored texts, `None` for the index.
-    #[must_use]
-    pub fn as_text(&self) -> Option<&[String]> {
-        match self {
-            XText::Index(_) => None,
-            XText::Text(t) => Some(t),
-        }
-    }
-
-    /// Every sample's text.
-    #[must_use]
-    pub fn to_vec(&self) -> Vec<String> {
-        (0..self.len()).map(|i| self.get(i).into_owned()).collect()
-    }
 }
 
 /// A series read from CSV.

@@ -35,48 +35,66 @@ impl Factor {
     }
 
     fn from_dd(m: &Dd) -> Factor {
-        let mut col_ptr = vec![0usize];
-        let (mut row_idx, mut val, mut lo) = (Vec::new(), Vec::new(), Vec::new());
-        for col in &m.cols {
-            for &(i, v) in col {
-                row_idx.push(i);
-                let hi = v.0 + v.1;
-                val.push(hi);
-                lo.push((v - fx128::from(hi)).0);
-            }
-            col_ptr.push(row_idx.len());
+        let mut row_idx = Vec::with_capacity(m.entries.len());
+        let (mut val, mut lo) = (Vec::with_capacity(m.entries.len()), Vec::with_capacity(m.entries.len()));
+        for &(i, v) in &m.entries {
+            row_idx.push(i);
+            let hi = v.0 + v.1;
+            val.push(hi);
+            lo.push((v - fx128::from(hi)).0);
         }
-        let symbolic = faer::sparse::SymbolicSparseColMat::new_checked(m.nrows, m.cols.len(), col_ptr, None, row_idx);
+        let symbolic =
+            faer::sparse::SymbolicSparseColMat::new_checked(m.nrows, m.ncols(), m.col_ptr.clone(), None, row_idx);
         Factor { matrix: Sparse::new(symbolic, val), lo }
     }
 }
 
-/// Compressed columns with double-double values, rows sorted.
+/// Compressed columns with double-double values, rows sorted: the entries of column `j` are
+/// `entries[col_ptr[j]..col_ptr[j + 1]]` (one array, not a vector per column: at 3·10⁶
+/// samples those were millions of allocations).
 struct Dd {
     nrows: usize,
-    cols: Vec<Vec<(usize, fx128)>>,
+    col_ptr: Vec<usize>,
+    entries: Vec<(usize, fx128)>,
 }
 
 impl Dd {
+    fn ncols(&self) -> usize {
+        self.col_ptr.len() - 1
+    }
+
+    fn col(&self, j: usize) -> &[(usize, fx128)] {
+        &self.entries[self.col_ptr[j]..self.col_ptr[j + 1]]
+    }
+
+    /// The matrix of `ncols` columns whose column `j` is `column(j)`.
+    fn from_columns<I: Iterator<Item = (usize, fx128)>>(
+        nrows: usize,
+        ncols: usize,
+        mut column: impl FnMut(usize) -> I,
+    ) -> Dd {
+        let mut col_ptr = Vec::with_capacity(ncols + 1);
+        col_ptr.push(0);
+        let mut entries = Vec::new();
+        for j in 0..ncols {
+            entries.extend(column(j));
+            col_ptr.push(entries.len());
+        }
+        entries.shrink_to_fit();
+        Dd { nrows, col_ptr, entries }
+    }
+
     fn of(a: &Sparse) -> Dd {
         let (cp, ri, v) = (a.symbolic().col_ptr(), a.symbolic().row_idx(), a.val());
-        Dd {
-            nrows: a.nrows(),
-            cols: (0..a.ncols()).map(|j| (cp[j]..cp[j + 1]).map(|p| (ri[p], fx128::from(v[p]))).collect()).collect(),
-        }
+        Dd::from_columns(a.nrows(), a.ncols(), |j| (cp[j]..cp[j + 1]).map(|p| (ri[p], fx128::from(v[p]))))
     }
 
     /// `diag(d) · self`, exact zeros dropped.
     fn scale_rows(&self, d: &[fx128]) -> Dd {
         let zero = fx128::from(0.0);
-        Dd {
-            nrows: self.nrows,
-            cols: self
-                .cols
-                .iter()
-                .map(|c| c.iter().map(|&(i, v)| (i, d[i] * v)).filter(|&(_, v)| v != zero).collect())
-                .collect(),
-        }
+        Dd::from_columns(self.nrows, self.ncols(), |j| {
+            self.col(j).iter().map(|&(i, v)| (i, d[i] * v)).filter(move |&(_, v)| v != zero)
+        })
     }
 
     /// `self · b`.
@@ -85,30 +103,30 @@ impl Dd {
         let mut acc = vec![zero; self.nrows];
         let mut seen = vec![false; self.nrows];
         let mut rows = Vec::new();
-        let cols = b
-            .cols
-            .iter()
-            .map(|bc| {
-                rows.clear();
-                for &(k, bkj) in bc {
-                    for &(i, aik) in &self.cols[k] {
-                        if !seen[i] {
-                            seen[i] = true;
-                            rows.push(i);
-                        }
-                        acc[i] += aik * bkj;
+        let mut col_ptr = Vec::with_capacity(b.ncols() + 1);
+        col_ptr.push(0);
+        let mut entries = Vec::new();
+        for j in 0..b.ncols() {
+            rows.clear();
+            for &(k, bkj) in b.col(j) {
+                for &(i, aik) in self.col(k) {
+                    if !seen[i] {
+                        seen[i] = true;
+                        rows.push(i);
                     }
+                    acc[i] += aik * bkj;
                 }
-                rows.sort_unstable();
-                let col: Vec<(usize, fx128)> = rows.iter().map(|&i| (i, acc[i])).filter(|&(_, v)| v != zero).collect();
-                for &i in &rows {
-                    acc[i] = zero;
-                    seen[i] = false;
-                }
-                col
-            })
-            .collect();
-        Dd { nrows: self.nrows, cols }
+            }
+            rows.sort_unstable();
+            entries.extend(rows.iter().map(|&i| (i, acc[i])).filter(|&(_, v)| v != zero));
+            for &i in &rows {
+                acc[i] = zero;
+                seen[i] = false;
+            }
+            col_ptr.push(entries.len());
+        }
+        entries.shrink_to_fit();
+        Dd { nrows: self.nrows, col_ptr, entries }
     }
 
     /// The rows with `keep[row]`, renumbered in order.
@@ -121,36 +139,37 @@ impl Dd {
                 n += 1;
             }
         }
-        Dd {
-            nrows: n,
-            cols: self
-                .cols
-                .iter()
-                .map(|c| c.iter().filter(|e| keep[e.0]).map(|&(i, v)| (slot[i], v)).collect())
-                .collect(),
-        }
+        Dd::from_columns(n, self.ncols(), |j| self.col(j).iter().filter(|e| keep[e.0]).map(|&(i, v)| (slot[i], v)))
     }
 
     /// Without its empty rows.
     fn without_empty_rows(&self) -> Dd {
         let mut used = vec![false; self.nrows];
-        for c in &self.cols {
-            for &(i, _) in c {
-                used[i] = true;
-            }
+        for &(i, _) in &self.entries {
+            used[i] = true;
         }
         self.select_rows(&used)
     }
 
-    /// The columns of each row.
-    fn row_supports(&self) -> Vec<Vec<usize>> {
-        let mut rows = vec![Vec::new(); self.nrows];
-        for (j, c) in self.cols.iter().enumerate() {
-            for &(i, _) in c {
-                rows[i].push(j);
+    /// The columns of each row: `(start, columns)` with row `i`'s columns at
+    /// `columns[start[i]..start[i + 1]]`, in increasing order.
+    fn row_supports(&self) -> (Vec<usize>, Vec<usize>) {
+        let mut start = vec![0usize; self.nrows + 1];
+        for &(i, _) in &self.entries {
+            start[i + 1] += 1;
+        }
+        for i in 0..self.nrows {
+            start[i + 1] += start[i];
+        }
+        let mut fill = start.clone();
+        let mut columns = vec![0usize; self.entries.len()];
+        for j in 0..self.ncols() {
+            for &(i, _) in self.col(j) {
+                columns[fill[i]] = j;
+                fill[i] += 1;
             }
         }
-        rows
+        (start, columns)
     }
 }
 
@@ -179,7 +198,7 @@ pub fn edge_factor(k: &Sparse) -> Option<Factor> {
         }
     }
     // each column's rows are in increasing order by construction
-    Some(Factor::from_dd(&Dd { nrows: row, cols }))
+    Some(Factor::from_dd(&Dd::from_columns(row, cols.len(), |j| cols[j].iter().copied())))
 }
 
 /// `F` with `FᵀF = Q` for the energy [`super::polyharmonic`] assembles from the same arguments,
@@ -210,7 +229,8 @@ pub fn polyharmonic_factor(k: &Sparse, k_factor: &Factor, m: &[f64], energy: &En
     let root_d: Vec<fx128> = (0..n).map(|i| if sharp[i] { zero } else { root_minv[i] }).collect();
     let kd = Dd::of(k);
     let f1 = factor_dd(k_factor);
-    let edge_rows = f1.row_supports().iter().all(|r| r.len() <= 2);
+    let (support_start, support) = f1.row_supports();
+    let edge_rows = support_start.windows(2).all(|w| w[1] - w[0] <= 2);
     let cut_factor = || -> Option<Dd> {
         if energy.sharp.is_empty() {
             return Some(factor_dd(k_factor));
@@ -218,10 +238,12 @@ pub fn polyharmonic_factor(k: &Sparse, k_factor: &Factor, m: &[f64], energy: &En
         if !edge_rows {
             return None;
         }
-        let keep: Vec<bool> = f1.row_supports().iter().map(|r| r.iter().all(|&v| !sharp[v])).collect();
+        let keep: Vec<bool> =
+            support_start.windows(2).map(|w| support[w[0]..w[1]].iter().all(|&v| !sharp[v])).collect();
         Some(f1.select_rows(&keep))
     };
-    let mut rows: Vec<Vec<(usize, fx128)>> = vec![Vec::new(); n];
+    // each term's rows, stacked: column j holds every term's entries of column j in turn
+    let mut terms: Vec<(Dd, fx128, usize)> = Vec::new();
     let mut base = 0;
     for (&(order, w), &s) in energy.terms.iter().zip(scale) {
         let c = w * s;
@@ -241,18 +263,16 @@ pub fn polyharmonic_factor(k: &Sparse, k_factor: &Factor, m: &[f64], energy: &En
         }
         .without_empty_rows();
         let root = (fx128::from(w) * fx128::from(s)).sqrt();
-        for (j, col) in f.cols.iter().enumerate() {
-            rows[j].extend(col.iter().map(|&(i, v)| (base + i, root * v)));
-        }
-        base += f.nrows;
+        let rows = f.nrows;
+        terms.push((f, root, base));
+        base += rows;
     }
-    Some(Factor::from_dd(&Dd { nrows: base, cols: rows }))
+    Some(Factor::from_dd(&Dd::from_columns(base, n, |j| {
+        terms.iter().flat_map(move |(f, root, at)| f.col(j).iter().map(move |&(i, v)| (at + i, *root * v)))
+    })))
 }
 
 fn factor_dd(f: &Factor) -> Dd {
     let (cp, ri) = (f.matrix.symbolic().col_ptr(), f.matrix.symbolic().row_idx());
-    Dd {
-        nrows: f.matrix.nrows(),
-        cols: (0..f.matrix.ncols()).map(|j| (cp[j]..cp[j + 1]).map(|p| (ri[p], f.entry(p))).collect()).collect(),
-    }
+    Dd::from_columns(f.matrix.nrows(), f.matrix.ncols(), |j| (cp[j]..cp[j + 1]).map(|p| (ri[p], f.entry(p))))
 }

@@ -6,7 +6,8 @@
 use super::grid::stage_grid_csv;
 use super::mesh::{stage_ply, MeshData};
 use super::npz::{read_npz_nd, stage_npy, stage_npy_shaped, stage_npz, stage_npz_shaped};
-use super::series_csv::{read_series_output_with, stage_series_output, SeriesColumns, XText};
+use super::series_csv::{stage_series_output, SeriesColumns, XText};
+use super::series_output::read_series_output_with;
 use super::vtk::{
     read_any_image, read_dataset, stage_legacy, stage_vti_arrays, stage_vtp, stage_vtp_cells, stage_vtu_cells,
     tet_cells, triangle_cells, AnyImage, Cells, ImageBox, LegacyGeometry, OutArray, PointArray, PolyData, Scalar,

@@ -4,7 +4,6 @@
 //! `X,input,output,u,role[,filled]`.
 
 use super::csv_dialect::{sniff, Dialect};
-pub(crate) use super::series_output::read_series_output_with;
 pub use super::series_output::{
     read_series_output, stage_series_output, write_series_output, SeriesColumns, SeriesOutput, XText,
 };

@@ -30,6 +30,7 @@ pub use report::{EnergyReport, FitReport, MemoryReport, Report, RunSettings, Sta
 pub use settings::{
     default_smooth_length, SmoothSettings, SMOOTH_LENGTH_EDGES, SMOOTH_LENGTH_FRACTION, SMOOTH_LENGTH_KEPT_SPACING,
 };
+#[cfg(feature = "serde")]
 pub(crate) use smoothable::energy_on_edges;
 pub use smoothable::{Representative, RepresentativeChoice, RepresentativeKind, Smoothable};
 use stages::{build_operators, order_representative, output_of, Operators, Ordered, Problem, Run};

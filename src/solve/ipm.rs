@@ -20,6 +20,7 @@ use super::settings::QpSettings;
 use super::status::{Outcome, SolveStatus};
 use crate::linalg as ordering;
 use faer::sparse::SparseColMatRef;
+use std::borrow::Cow;
 
 /// Centrality correctors per iteration at most: each costs one solve and saves iterations,
 /// each a factorisation (docs/performance.md, "constants").
@@ -414,17 +415,17 @@ impl Progress {
 }
 
 /// The constants of the stopping tests.
-struct Targets<T> {
+struct Targets<'r, T: Clone> {
     tol: f64,
     /// Without a data term: the mean complementarity 10× below the feasibility tolerance (the
     /// objective is flat along many directions; with the correctors μ ≤ tol was reached while
     /// sᵀz was still 5× larger than without them).
     tol_mu: f64,
     gap_tolerance: f64,
-    d: Vec<T>,
-    /// `1 / d`, for [`Real::div_by`].
-    inv_d: Vec<T>,
-    q_free: Vec<T>,
+    d: Cow<'r, [T]>,
+    /// `1 / d`, for [`Real::div_by`] (`d` itself where it uses none).
+    inv_d: Cow<'r, [T]>,
+    q_free: Cow<'r, [T]>,
     d_sum: f64,
 }
 
@@ -440,7 +441,7 @@ fn run<T: Real, O: Objective<T>>(
     let (n, m) = (r.n, r.m());
     let zero = T::of(0.0);
     let of = T::of;
-    let b: Vec<T> = r.b.iter().map(|&v| of(v)).collect();
+    let b = T::lift(&r.b);
     let x: Vec<T> = match hint {
         Some(h) => h.iter().map(|&v| of(v)).collect(),
         None => vec![zero; n],
@@ -471,9 +472,9 @@ fn run<T: Real, O: Objective<T>>(
         tol: settings.tolerance,
         tol_mu: 0.1 * settings.tolerance,
         gap_tolerance: settings.gap_tolerance,
-        d: r.d.iter().map(|&v| of(v)).collect(),
-        inv_d: r.d.iter().map(|&v| of(1.0) / of(v)).collect(),
-        q_free: r.q_free.iter().map(|&v| of(v)).collect(),
+        d: T::lift(&r.d),
+        inv_d: if T::RECIPROCALS { Cow::Owned(r.d.iter().map(|&v| of(1.0) / of(v)).collect()) } else { T::lift(&r.d) },
+        q_free: T::lift(&r.q_free),
         d_sum: r.d.iter().sum(),
     };
     let mut res = Residuals {
@@ -486,11 +487,12 @@ fn run<T: Real, O: Objective<T>>(
         dres: 0.0,
         phi: 0.0,
     };
-    let mut tmp_n = vec![zero; n];
     let mut w = vec![zero; m];
-    let (one, mut inv_s) = (of(1.0), vec![zero; m]);
+    // the slacks' reciprocals only where the arithmetic uses them
+    let (one, mut inv_s) = (of(1.0), if T::RECIPROCALS { vec![zero; m] } else { Vec::new() });
+    // the correctors' second direction is free between two steps: the residuals' scratch and
+    // the polished multipliers with their ρ live there (at 10⁷ rows, 0.24 GB not allocated)
     let mut newton = Newton::new(n, m);
-    let (mut polished, mut rho) = if r.gap_bound { (vec![zero; m], vec![zero; n]) } else { (Vec::new(), Vec::new()) };
     let mut last = (f64::INFINITY, f64::INFINITY, f64::INFINITY);
     let mut last_step = f64::INFINITY;
     let mut progress = Progress { best_gap: f64::INFINITY, best_at: 0, first: None };
@@ -498,7 +500,7 @@ fn run<T: Real, O: Objective<T>>(
         if crate::progress::cancelled() {
             return Err(crate::error::NumericalError(format!("cancelled at iteration {it}")));
         }
-        residuals(r, rows, objective, &point, &b, (bnorm, qnorm), &mut res, &mut tmp_n);
+        residuals(r, rows, objective, &point, &b, (bnorm, qnorm), &mut res, &mut newton.dx2);
         last = (res.pres, res.dres, res.mu);
         if !(res.pres.is_finite() && res.dres.is_finite() && res.mu.is_finite()) {
             return Err(crate::error::NumericalError(format!("non-finite iterate at iteration {it}")));
@@ -507,7 +509,7 @@ fn run<T: Real, O: Objective<T>>(
         let small_step = last_step <= STEP_TOLERANCE * (1.0 + xmax);
         let at = At { it: &point, res: &res, small_step, iteration: it };
         let (verdict, reported_z) = if r.gap_bound {
-            verdict_with_data(rows, &at, &targets, &mut progress, (&mut polished, &mut rho))
+            verdict_with_data(rows, &at, &targets, &mut progress, (&mut newton.dz2, &mut newton.dx2))
         } else {
             (verdict_without_data(r, objective, &at, &targets, &mut progress), None)
         };
@@ -517,9 +519,15 @@ fn run<T: Real, O: Objective<T>>(
             }
             Verdict::Go(fallback) => fallback,
         };
-        for k in 0..m {
-            inv_s[k] = one / point.s[k];
-            w[k] = point.z[k].div_by(point.s[k], inv_s[k]);
+        if T::RECIPROCALS {
+            for k in 0..m {
+                inv_s[k] = one / point.s[k];
+                w[k] = point.z[k].div_by(point.s[k], inv_s[k]);
+            }
+        } else {
+            for k in 0..m {
+                w[k] = point.z[k].div_by(point.s[k], point.s[k]);
+            }
         }
         if let Err(e) = objective.factor(rows, &w) {
             return match fallback_status {
@@ -527,7 +535,8 @@ fn run<T: Real, O: Objective<T>>(
                 None => Err(e),
             };
         }
-        let alpha = newton.step(rows, objective, &point, &res, (&w, &inv_s));
+        let inv = if T::RECIPROCALS { &inv_s[..] } else { &point.s[..] };
+        let alpha = newton.step(rows, objective, &point, &res, (&w, inv));
         if alpha < 1e-12 {
             return Err(crate::error::NumericalError(format!("step length {alpha:e} at iteration {it}")));
         }

@@ -153,15 +153,24 @@ pub(super) trait Real:
     + std::ops::Neg<Output = Self>
     + std::ops::AddAssign
 {
+    /// Whether [`Real::div_by`] uses its reciprocal (else the iteration keeps none: any
+    /// vector of the right length stands in for it).
+    const RECIPROCALS: bool;
     fn of(x: f64) -> Self;
     fn to_f64(self) -> f64;
     /// `self / den`, given `inv = 1 / den`: a division in double, a product with the
     /// reciprocal in double-double (a division there costs about ten products, and the
     /// iteration divides by the same slacks and data diagonal many times per step).
     fn div_by(self, den: Self, inv: Self) -> Self;
+    /// `v` in this arithmetic: borrowed in double (a copy of a vector of 10⁷ rows is 80 MB).
+    fn lift(v: &[f64]) -> std::borrow::Cow<'_, [Self]>;
 }
 
 impl Real for f64 {
+    const RECIPROCALS: bool = false;
+    fn lift(v: &[f64]) -> std::borrow::Cow<'_, [Self]> {
+        std::borrow::Cow::Borrowed(v)
+    }
     fn of(x: f64) -> Self {
         x
     }
@@ -174,6 +183,10 @@ impl Real for f64 {
 }
 
 impl Real for faer::fx128 {
+    const RECIPROCALS: bool = true;
+    fn lift(v: &[f64]) -> std::borrow::Cow<'_, [Self]> {
+        std::borrow::Cow::Owned(v.iter().map(|&x| faer::fx128::from(x)).collect())
+    }
     fn of(x: f64) -> Self {
         faer::fx128::from(x)
     }

@@ -53,24 +53,7 @@ impl Factorised {
     fn assemble_and_factor(&mut self, r: &ReducedQp, rows: &Rows, w: &[f64], reg: f64) -> bool {
         match self {
             Factorised::Spd { normal, factor, vals, .. } => {
-                vals.iter_mut().for_each(|v| *v = 0.0);
-                for (k, &(_, _, v)) in r.p.iter().enumerate() {
-                    vals[normal.pos_p[k]] += v;
-                }
-                for (k, &wk) in w.iter().enumerate() {
-                    let [p1, p2, p12] = normal.pos_row[k];
-                    let [a1, a2] = rows.vals[k];
-                    vals[p1] += wk * a1 * a1;
-                    if rows.len[k] == 2 {
-                        vals[p2] += wk * a2 * a2;
-                        vals[p12] += wk * a1 * a2;
-                    }
-                }
-                if reg > 0.0 {
-                    for &d in &normal.pos_diag {
-                        vals[d] += reg;
-                    }
-                }
+                fill_pattern(normal, vals, r, rows, w, reg);
                 factor.factor(SparseColMatRef::new(normal.symbolic.as_ref(), vals)).is_ok()
             }
             Factorised::Banded(banded) => {
@@ -121,19 +104,17 @@ impl Objective<f64> for Assembled<'_> {
 
     fn energy_dual(&mut self, r: &[f64]) -> Option<f64> {
         if self.energy.is_none() {
+            let no_rows = Rows::default();
             let energy = match &self.factor {
                 Factorised::Spd { normal, analysis, .. } => {
                     let mut vals = vec![0.0; normal.symbolic.row_idx().len()];
-                    for (k, &(_, _, v)) in self.r.p.iter().enumerate() {
-                        vals[normal.pos_p[k]] += v;
-                    }
+                    fill_pattern(normal, &mut vals, self.r, &no_rows, &[], 0.0);
                     let mut f = ordering::SpdFactor::new(analysis.clone()).ok()?;
                     f.factor(SparseColMatRef::new(normal.symbolic.as_ref(), &vals)).ok()?;
                     Energy::Spd(f)
                 }
                 Factorised::Banded(b) => {
                     let mut e = Banded::of_band(self.r.n, b.width());
-                    let no_rows = Rows { cols: Vec::new(), vals: Vec::new(), len: Vec::new() };
                     fill_band(&mut e, self.r, &no_rows, &[], 0.0);
                     if !e.factor_band(0.0) {
                         return None;
@@ -156,6 +137,29 @@ impl Objective<f64> for Assembled<'_> {
 enum Energy {
     Spd(ordering::SpdFactor),
     Banded(Banded<f64>),
+}
+
+/// Fills `vals` on the normal matrix's pattern with `P + AᵀWA` plus `reg` on the diagonal: each
+/// entry sums P's triplets, then the rows' products, in their order.
+fn fill_pattern(normal: &Normal, vals: &mut [f64], r: &ReducedQp, rows: &Rows, w: &[f64], reg: f64) {
+    vals.iter_mut().for_each(|v| *v = 0.0);
+    for (k, &(_, _, v)) in r.p.iter().enumerate() {
+        vals[normal.pos_p[k]] += v;
+    }
+    for (k, &wk) in w.iter().enumerate() {
+        let [p1, p2, p12] = normal.pos_row[k];
+        let [a1, a2] = rows.vals[k];
+        vals[p1] += wk * a1 * a1;
+        if rows.len[k] == 2 {
+            vals[p2] += wk * a2 * a2;
+            vals[p12] += wk * a1 * a2;
+        }
+    }
+    if reg > 0.0 {
+        for &d in &normal.pos_diag {
+            vals[d] += reg;
+        }
+    }
 }
 
 /// Fills `banded` with `P + AᵀWA` (`w` empty: P alone) plus `reg` on the diagonal: each entry
@@ -931,18 +935,7 @@ mod tests {
         let normal = Normal::new(&r, &rows.cols, &rows.len);
         assert_eq!(ordering::band(normal.symbolic.as_ref()), Some(2));
         let mut vals = vec![0.0; normal.symbolic.row_idx().len()];
-        for (k, &(_, _, v)) in r.p.iter().enumerate() {
-            vals[normal.pos_p[k]] += v;
-        }
-        for (k, &wk) in w.iter().enumerate() {
-            let [p1, p2, p12] = normal.pos_row[k];
-            let [a1, a2] = rows.vals[k];
-            vals[p1] += wk * a1 * a1;
-            if rows.len[k] == 2 {
-                vals[p2] += wk * a2 * a2;
-                vals[p12] += wk * a1 * a2;
-            }
-        }
+        fill_pattern(&normal, &mut vals, &r, rows, &w, 0.0);
         let mut old = Banded::<f64>::of_band(n, 2);
         let (cp, ri) = (normal.symbolic.col_ptr(), normal.symbolic.row_idx());
         for j in 0..n {

@@ -766,7 +766,7 @@ const SHORT_ROWS_PER: usize = 1000;
 /// five rows out of 10⁵–10⁶ (the flooded representative's 1000² bench: 46 iterations, most
 /// with σ of 0.1–0.6); the step at which 1 % of the rows cross aims the corrector at a small
 /// σμ, which its own step (to the boundary) and the centrality correctors then approach:
-/// 1000² 46 → 33 iterations, 300² 25 → 20, 150 × 100 18 → 14, the Kármán street 26 → 24, the
+/// 1000² 46 → 33 iterations, 300² 25 → 20, 150 × 100 18 → 14, the Kármán street 26 → 23, the
 /// 10⁶-sample series 11 → 10, spot 7 → 6 (docs/performance.md, "constants").
 const PREDICTOR_CROSSING: f64 = 1e-2;
 

@@ -24,6 +24,7 @@ use faer::{Conj, Par, Side, Spec};
 mod analyses;
 mod cost;
 mod dissection;
+pub mod double_double;
 pub(crate) mod two_way;
 
 pub use analyses::{solve_spd, Analyses, SpdSolver};

@@ -24,8 +24,9 @@ pub struct Factor {
 
 impl Factor {
     /// Stored entry `p` (an index into `matrix`'s values) in double-double.
-    pub fn entry(&self, p: usize) -> fx128 {
-        fx128::from(self.matrix.val()[p]) + fx128::from(self.lo[p])
+    #[inline]
+    pub fn entry(&self, p: usize) -> crate::linalg::double_double::Dd {
+        crate::linalg::double_double::Dd { hi: self.matrix.val()[p], lo: self.lo[p] }
     }
 
     /// A factor whose entries are doubles.
@@ -274,5 +275,7 @@ pub fn polyharmonic_factor(k: &Sparse, k_factor: &Factor, m: &[f64], energy: &En
 
 fn factor_dd(f: &Factor) -> Dd {
     let (cp, ri) = (f.matrix.symbolic().col_ptr(), f.matrix.symbolic().row_idx());
-    Dd::from_columns(f.matrix.nrows(), f.matrix.ncols(), |j| (cp[j]..cp[j + 1]).map(|p| (ri[p], f.entry(p))))
+    Dd::from_columns(f.matrix.nrows(), f.matrix.ncols(), |j| {
+        (cp[j]..cp[j + 1]).map(|p| (ri[p], crate::linalg::double_double::to_fx128(f.entry(p))))
+    })
 }

@@ -110,7 +110,7 @@ impl<T: Real> Banded<T> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use faer::fx128;
+    use crate::linalg::double_double::Dd;
 
     /// A pentadiagonal, diagonally dominant (so positive definite) matrix in upper-triangular
     /// storage.
@@ -168,10 +168,10 @@ mod tests {
         f.solve_in_place(&mut y);
         let err = y.iter().zip(&x).fold(0.0f64, |a, (y, x)| a.max((y - x).abs()));
         assert!(err < 1e-9, "double: {err:e}");
-        let vq: Vec<fx128> = v.iter().map(|&a| fx128::from(a)).collect();
-        let mut fq = Banded::<fx128>::of_band(n, 2);
-        assert!(factor(&mut fq, &p, &vq, fx128::from(0.0)));
-        let mut yq: Vec<fx128> = rhs.iter().map(|&a| fx128::from(a)).collect();
+        let vq: Vec<Dd> = v.iter().map(|&a| Dd::from(a)).collect();
+        let mut fq = Banded::<Dd>::of_band(n, 2);
+        assert!(factor(&mut fq, &p, &vq, Dd::from(0.0)));
+        let mut yq: Vec<Dd> = rhs.iter().map(|&a| Dd::from(a)).collect();
         fq.solve_in_place(&mut yq);
         let err = yq.iter().zip(&x).fold(0.0f64, |a, (y, x)| a.max((y.to_f64() - x).abs()));
         assert!(err < 1e-12, "double-double: {err:e}");

@@ -1,5 +1,5 @@
 //! The normal equations of the factored formulation `P = FᵀF + diag(d)` in double-double
-//! arithmetic (faer's `fx128`).
+//! arithmetic ([`Dd`]; faer's `fx128` for its simplicial factorisation).
 //!
 //! An assembled `P` of condition κ carries rounding errors of `10⁻¹⁶ κ` relative to its
 //! smallest eigenvalues, so its gradient `P x + q` is noise once κ nears 10¹⁶ and the gap bound
@@ -22,6 +22,7 @@ use super::banded::Banded;
 use super::newton::{normal_band, Normal as Pattern, Objective, Rows};
 use super::problem::{ReducedFactor, ReducedQp};
 use crate::linalg;
+use crate::linalg::double_double::{from_fx128, to_fx128, Dd};
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::fx128;
 use faer::sparse::linalg::cholesky::{LltRef, SymbolicCholesky};
@@ -47,14 +48,14 @@ struct Exact {
 /// The factored objective and its normal matrix, in double-double.
 pub(super) struct Normal<'r> {
     f: &'r ReducedFactor,
-    d: Vec<fx128>,
-    q: Vec<fx128>,
+    d: Vec<Dd>,
+    q: Vec<Dd>,
     /// The normal matrix's sparse pattern (`None` when it is banded).
     pattern: Option<Pattern>,
     /// `F_FᵀF_F + diag(d)` on the pattern, or in the band.
-    base: Vec<fx128>,
+    base: Vec<Dd>,
     /// The normal matrix of the last factorisation, and rounded to double.
-    vals: Vec<fx128>,
+    vals: Vec<Dd>,
     rounded: Vec<f64>,
     /// Its double-precision Cholesky factor (`None` for a banded pattern, factorised in
     /// double-double only).
@@ -65,8 +66,8 @@ pub(super) struct Normal<'r> {
     /// A banded normal matrix (a series): assembled in its band and factorised in
     /// double-double from the start ([`Banded`]: about n·b² products, below a few refinement
     /// steps').
-    banded: Option<Banded<fx128>>,
-    t: std::cell::RefCell<Vec<fx128>>,
+    banded: Option<Banded<Dd>>,
+    t: std::cell::RefCell<Vec<Dd>>,
 }
 
 impl<'r> Normal<'r> {
@@ -80,7 +81,7 @@ impl<'r> Normal<'r> {
         r: &'r ReducedQp,
         f: &'r ReducedFactor,
     ) -> std::result::Result<Normal<'r>, crate::error::NumericalError> {
-        let zero = fx128::from(0.0);
+        let zero = Dd::from(0.0);
         // the rows of F (column, double-double entry), each in column order: one counting pass
         // over its columns (a vector per row held 0.1 kB each)
         let (fcp, fri) = (f.f.symbolic().col_ptr(), f.f.symbolic().row_idx());
@@ -113,7 +114,7 @@ impl<'r> Normal<'r> {
                     let (cp, ri) = (pattern.symbolic.col_ptr(), pattern.symbolic.row_idx());
                     ri[cp[j]..cp[j + 1]].binary_search(&i).map(|p| cp[j] + p).map_err(|_| outside())
                 }
-                (None, Some(b)) if j - i <= b => Ok(Banded::<fx128>::at(b, i, j)),
+                (None, Some(b)) if j - i <= b => Ok(Banded::<Dd>::at(b, i, j)),
                 _ => Err(outside()),
             }
         };
@@ -132,7 +133,7 @@ impl<'r> Normal<'r> {
             }
         }
         for (j, &d) in r.d.iter().enumerate() {
-            base[find(j, j)?] += fx128::from(d);
+            base[find(j, j)?] += Dd::from(d);
         }
         drop(entries);
         let banded = band.map(|b| Banded::of_band(r.n, b));
@@ -146,8 +147,8 @@ impl<'r> Normal<'r> {
         let rounded = if spd.is_some() { vec![0.0; base.len()] } else { Vec::new() };
         Ok(Normal {
             f,
-            d: r.d.iter().map(|&v| fx128::from(v)).collect(),
-            q: r.q_free.iter().map(|&v| fx128::from(v)).collect(),
+            d: r.d.iter().map(|&v| Dd::from(v)).collect(),
+            q: r.q_free.iter().map(|&v| Dd::from(v)).collect(),
             vals: if banded.is_some() { Vec::new() } else { base.clone() },
             rounded,
             base,
@@ -162,8 +163,8 @@ impl<'r> Normal<'r> {
 
     /// `y = N x` for the normal matrix `vals` on `pattern` (upper triangle stored), in
     /// double-double.
-    fn multiply(pattern: &Pattern, vals: &[fx128], x: &[fx128], y: &mut [fx128]) {
-        y.iter_mut().for_each(|v| *v = fx128::from(0.0));
+    fn multiply(pattern: &Pattern, vals: &[Dd], x: &[Dd], y: &mut [Dd]) {
+        y.iter_mut().for_each(|v| *v = Dd::from(0.0));
         let (cp, ri) = (pattern.symbolic.col_ptr(), pattern.symbolic.row_idx());
         for (j, &xj) in x.iter().enumerate() {
             for (&i, &a) in ri[cp[j]..cp[j + 1]].iter().zip(&vals[cp[j]..cp[j + 1]]) {
@@ -192,7 +193,7 @@ impl<'r> Normal<'r> {
         }
         let e = self.exact.as_mut().expect("made above");
         for reg in SHIFTS {
-            let mut vals = self.vals.clone();
+            let mut vals: Vec<fx128> = self.vals.iter().map(|&v| to_fx128(v)).collect();
             if reg > 0.0 {
                 for &d in &pattern.pos_diag {
                     vals[d] += fx128::from(reg);
@@ -219,10 +220,10 @@ impl<'r> Normal<'r> {
     }
 
     /// `t = F x + g`.
-    fn auxiliary_into(&self, x: &[fx128], t: &mut [fx128]) {
+    fn auxiliary_into(&self, x: &[Dd], t: &mut [Dd]) {
         let f = &self.f.f;
         for (t, &g) in t.iter_mut().zip(&self.f.g) {
-            *t = fx128::from(g);
+            *t = Dd::from(g);
         }
         let (cp, ri) = (f.symbolic().col_ptr(), f.symbolic().row_idx());
         for (j, &xj) in x.iter().enumerate() {
@@ -233,9 +234,9 @@ impl<'r> Normal<'r> {
     }
 }
 
-impl Objective<fx128> for Normal<'_> {
+impl Objective<Dd> for Normal<'_> {
     /// `Fᵀ(F x + g) + d∘x + q_d`.
-    fn gradient(&mut self, x: &[fx128], out: &mut [fx128]) {
+    fn gradient(&mut self, x: &[Dd], out: &mut [Dd]) {
         let mut t = std::mem::take(&mut *self.t.borrow_mut());
         self.auxiliary_into(x, &mut t);
         let f = &self.f.f;
@@ -252,24 +253,24 @@ impl Objective<fx128> for Normal<'_> {
 
     /// `F_FᵀF_F + diag(d) + Aᵀ diag(w) A` in double-double, and its rounding factorised in
     /// double (or in double-double once refinement has stalled).
-    fn factor(&mut self, rows: &Rows, w: &[fx128]) -> std::result::Result<(), crate::error::NumericalError> {
+    fn factor(&mut self, rows: &Rows, w: &[Dd]) -> std::result::Result<(), crate::error::NumericalError> {
         if let Some(banded) = &mut self.banded {
             let b = banded.width();
-            let at = |i: usize, j: usize| Banded::<fx128>::at(b, i.min(j), i.max(j));
+            let at = |i: usize, j: usize| Banded::<Dd>::at(b, i.min(j), i.max(j));
             let band = banded.band_mut();
             band.copy_from_slice(&self.base);
             for (k, &wk) in w.iter().enumerate() {
                 let [c1, c2] = rows.cols[k];
                 let [a1, a2] = rows.vals[k];
-                band[at(c1, c1)] += wk * fx128::from(a1 * a1);
+                band[at(c1, c1)] += wk * Dd::from(a1 * a1);
                 if rows.len[k] == 2 {
-                    band[at(c2, c2)] += wk * fx128::from(a2 * a2);
-                    band[at(c1, c2)] += wk * fx128::from(a1 * a2);
+                    band[at(c2, c2)] += wk * Dd::from(a2 * a2);
+                    band[at(c1, c2)] += wk * Dd::from(a1 * a2);
                 }
             }
             // the same regularisation as the general factorisation's, if it must
             for reg in SHIFTS {
-                if banded.factor_band(fx128::from(reg)) {
+                if banded.factor_band(Dd::from(reg)) {
                     return Ok(());
                 }
             }
@@ -282,17 +283,17 @@ impl Objective<fx128> for Normal<'_> {
         for (k, &wk) in w.iter().enumerate() {
             let [p1, p2, p12] = pattern.pos_row[k];
             let [a1, a2] = rows.vals[k];
-            self.vals[p1] += wk * fx128::from(a1 * a1);
+            self.vals[p1] += wk * Dd::from(a1 * a1);
             if rows.len[k] == 2 {
-                self.vals[p2] += wk * fx128::from(a2 * a2);
-                self.vals[p12] += wk * fx128::from(a1 * a2);
+                self.vals[p2] += wk * Dd::from(a2 * a2);
+                self.vals[p12] += wk * Dd::from(a1 * a2);
             }
         }
         if self.exact.is_some() {
             return self.factor_exact();
         }
         for (r, v) in self.rounded.iter_mut().zip(&self.vals) {
-            *r = v.0 + v.1;
+            *r = v.to_f64();
         }
         let Some(spd) = self.spd.as_mut() else {
             return self.factor_exact();
@@ -305,7 +306,7 @@ impl Objective<fx128> for Normal<'_> {
         Ok(())
     }
 
-    fn solve_in_place(&mut self, rhs: &mut [fx128]) {
+    fn solve_in_place(&mut self, rhs: &mut [Dd]) {
         if let Some(banded) = &self.banded {
             banded.solve_in_place(rhs);
             return;
@@ -314,20 +315,20 @@ impl Objective<fx128> for Normal<'_> {
         if let (None, true, Some(spd), Some(pattern)) =
             (&self.exact, self.spd_ok, self.spd.as_mut(), self.pattern.as_ref())
         {
-            let norm = |v: &[fx128]| v.iter().fold(0.0f64, |a, x| a.max((x.0 + x.1).abs()));
+            let norm = |v: &[Dd]| v.iter().fold(0.0f64, |a, x| a.max(x.to_f64().abs()));
             let target = REFINED * norm(rhs);
-            let mut x = vec![fx128::from(0.0); n];
+            let mut x = vec![Dd::from(0.0); n];
             let mut r = rhs.to_vec();
-            let mut nx = vec![fx128::from(0.0); n];
+            let mut nx = vec![Dd::from(0.0); n];
             let mut d = vec![0.0f64; n];
             let mut last = f64::INFINITY;
             for _ in 0..REFINEMENT_STEPS {
                 for (di, ri) in d.iter_mut().zip(&r) {
-                    *di = ri.0 + ri.1;
+                    *di = ri.to_f64();
                 }
                 spd.solve_in_place(&mut d);
                 for (xi, &di) in x.iter_mut().zip(&d) {
-                    *xi += fx128::from(di);
+                    *xi += Dd::from(di);
                 }
                 Self::multiply(pattern, &self.vals, &x, &mut nx);
                 for i in 0..n {
@@ -350,15 +351,19 @@ impl Objective<fx128> for Normal<'_> {
             }
         }
         if let Some(e) = &mut self.exact {
-            let m = faer::MatMut::from_column_major_slice_mut(rhs, n, 1);
+            let mut wide: Vec<fx128> = rhs.iter().map(|&v| to_fx128(v)).collect();
+            let m = faer::MatMut::from_column_major_slice_mut(&mut wide, n, 1);
             LltRef::new(&e.symbolic, &e.l).solve_in_place_with_conj(Conj::No, m, Par::Seq, MemStack::new(&mut e.mem));
+            for (r, w) in rhs.iter_mut().zip(wide) {
+                *r = from_fx128(w);
+            }
         }
     }
 
-    fn auxiliary(&self, x: &[fx128]) -> Option<Vec<f64>> {
-        let mut t = vec![fx128::from(0.0); self.f.f.nrows()];
+    fn auxiliary(&self, x: &[Dd]) -> Option<Vec<f64>> {
+        let mut t = vec![Dd::from(0.0); self.f.f.nrows()];
         self.auxiliary_into(x, &mut t);
-        Some(t.iter().map(|t| t.0 + t.1).collect())
+        Some(t.iter().map(|t| t.to_f64()).collect())
     }
 }
 
@@ -378,27 +383,27 @@ impl Objective<fx128> for Normal<'_> {
 /// assembled form per iteration (issue 38's "conditioning cliff").
 pub(super) struct Rounded<'r> {
     inner: Normal<'r>,
-    x: Vec<fx128>,
-    out: Vec<fx128>,
-    w: Vec<fx128>,
+    x: Vec<Dd>,
+    out: Vec<Dd>,
+    w: Vec<Dd>,
 }
 
 impl<'r> Rounded<'r> {
     pub(super) fn new(inner: Normal<'r>, n: usize, m: usize) -> Rounded<'r> {
-        let zero = fx128::from(0.0);
+        let zero = Dd::from(0.0);
         Rounded { inner, x: vec![zero; n], out: vec![zero; n], w: vec![zero; m] }
     }
 }
 
-fn widen(from: &[f64], to: &mut [fx128]) {
+fn widen(from: &[f64], to: &mut [Dd]) {
     for (t, &f) in to.iter_mut().zip(from) {
-        *t = fx128::from(f);
+        *t = Dd::from(f);
     }
 }
 
-fn round(from: &[fx128], to: &mut [f64]) {
+fn round(from: &[Dd], to: &mut [f64]) {
     for (t, f) in to.iter_mut().zip(from) {
-        *t = f.0 + f.1;
+        *t = f.to_f64();
     }
 }
 
@@ -421,7 +426,7 @@ impl Objective<f64> for Rounded<'_> {
     }
 
     fn auxiliary(&self, x: &[f64]) -> Option<Vec<f64>> {
-        let x: Vec<fx128> = x.iter().map(|&v| fx128::from(v)).collect();
+        let x: Vec<Dd> = x.iter().map(|&v| Dd::from(v)).collect();
         self.inner.auxiliary(&x)
     }
 }

@@ -230,7 +230,7 @@ pub(super) fn solve(
                 run::<f64, _>(r, rows, &mut objective, hint, settings)
             } else {
                 let mut objective = objective;
-                run::<faer::fx128, _>(r, rows, &mut objective, hint, settings)
+                run::<crate::linalg::double_double::Dd, _>(r, rows, &mut objective, hint, settings)
             }
         }
         None => {

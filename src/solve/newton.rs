@@ -5,6 +5,7 @@
 use super::problem::ReducedQp;
 pub(super) use super::problem::Rows;
 use crate::linalg as ordering;
+use crate::linalg::double_double::Dd;
 use faer::sparse::{SymbolicSparseColMat, SymbolicSparseColMatRef};
 
 /// Upper-triangular pattern of `N` and where each contribution lands in its value array.
@@ -140,7 +141,7 @@ impl Prepared {
     }
 }
 
-/// The arithmetic of an interior-point run: `f64`, or double-double (`fx128`) for the factored
+/// The arithmetic of an interior-point run: `f64`, or double-double ([`Dd`]) for the factored
 /// form of an ill-conditioned QP, where every residual and right-hand side must keep the digits
 /// that `P`'s condition number takes from the solve.
 pub(super) trait Real:
@@ -182,17 +183,20 @@ impl Real for f64 {
     }
 }
 
-impl Real for faer::fx128 {
+impl Real for Dd {
     const RECIPROCALS: bool = true;
     fn lift(v: &[f64]) -> std::borrow::Cow<'_, [Self]> {
-        std::borrow::Cow::Owned(v.iter().map(|&x| faer::fx128::from(x)).collect())
+        std::borrow::Cow::Owned(v.iter().map(|&x| Dd::from(x)).collect())
     }
+    #[inline(always)]
     fn of(x: f64) -> Self {
-        faer::fx128::from(x)
+        Dd::from(x)
     }
+    #[inline(always)]
     fn to_f64(self) -> f64 {
-        self.0 + self.1
+        Dd::to_f64(self)
     }
+    #[inline(always)]
     fn div_by(self, _den: Self, inv: Self) -> Self {
         self * inv
     }

@@ -12,7 +12,7 @@
 //! Everything is summed in double-double, so the bound measures the point, not the arithmetic.
 
 use super::problem::{constraint_rows, MonotoneQp, Row};
-use faer::fx128;
+use crate::linalg::double_double::Dd;
 
 /// The gap bound of a point and what it is made of, in the units of the QP as given.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -41,17 +41,17 @@ pub struct Optimality {
     pub distance: Option<f64>,
 }
 
-fn dd(x: f64) -> fx128 {
-    fx128::from(x)
+fn dd(x: f64) -> Dd {
+    Dd::from(x)
 }
 
-fn product(a: f64, b: f64) -> fx128 {
-    let p = a * b;
-    dd(p) + dd(a.mul_add(b, -p))
+/// `a · b` exactly.
+fn product(a: f64, b: f64) -> Dd {
+    dd(a) * dd(b)
 }
 
-fn round(x: fx128) -> f64 {
-    x.0 + x.1
+fn round(x: Dd) -> f64 {
+    x.to_f64()
 }
 
 /// The gap bound of `f` (`#V`, fixed entries at their values) with multipliers `z` (one per
@@ -126,7 +126,7 @@ pub fn optimality_with(
 
 /// The objective's gradient at `f` in double-double, `ρ = P f + q` (or, factored, `D f + q +
 /// Fᵀ y` with the auxiliary residual `|F f − y|`), over all entries (only the free ones count).
-fn gradient(qp: &MonotoneQp<'_>, f: &[f64], y: Option<&[f64]>) -> (Vec<fx128>, f64) {
+fn gradient(qp: &MonotoneQp<'_>, f: &[f64], y: Option<&[f64]>) -> (Vec<Dd>, f64) {
     let n = qp.q.len();
     let mut rho = vec![dd(0.0); n];
     let mut auxiliary_residual = 0.0;
@@ -136,7 +136,7 @@ fn gradient(qp: &MonotoneQp<'_>, f: &[f64], y: Option<&[f64]>) -> (Vec<fx128>, f
             assert_eq!(y.len(), m.nrows());
             let (cp, ri) = (m.symbolic().col_ptr(), m.symbolic().row_idx());
             // F f − y
-            let mut r: Vec<fx128> = y.iter().map(|&t| -dd(t)).collect();
+            let mut r: Vec<Dd> = y.iter().map(|&t| -dd(t)).collect();
             for j in 0..n {
                 for p in cp[j]..cp[j + 1] {
                     r[ri[p]] += factor.entry(p) * dd(f[j]);
@@ -171,7 +171,7 @@ fn gradient(qp: &MonotoneQp<'_>, f: &[f64], y: Option<&[f64]>) -> (Vec<fx128>, f
 
 /// Adds `Aᵀz` into `ρ`; returns the complementarity `Σ s z` and the smallest slack
 /// `s = b − A f` (z clipped at 0).
-fn rows_into(qp: &MonotoneQp<'_>, rows: &[Row], f: &[f64], z: &[f64], rho: &mut [fx128]) -> (fx128, f64) {
+fn rows_into(qp: &MonotoneQp<'_>, rows: &[Row], f: &[f64], z: &[f64], rho: &mut [Dd]) -> (Dd, f64) {
     let mut complementarity = dd(0.0);
     let mut min_slack = f64::INFINITY;
     for (row, &zk) in rows.iter().zip(z) {
@@ -215,7 +215,7 @@ fn half_energy(p: &crate::operators::Sparse, f: &[f64]) -> f64 {
 fn solve_with_p(
     qp: &MonotoneQp<'_>,
     free: &[bool],
-    rho: &[fx128],
+    rho: &[Dd],
     analyses: Option<&mut crate::linalg::Analyses>,
 ) -> Option<f64> {
     let n = free.len();

@@ -2,6 +2,7 @@
 //! bounds) and as the solvers see it (`ReducedQp`: the free variables only, one row per
 //! constraint).
 
+use crate::linalg::double_double::Dd;
 use crate::operators::{Factor, Sparse};
 
 /// A one-sided bound on one entry: `f_v ≤ value` (`upper`) or `f_v ≥ value`.
@@ -91,8 +92,9 @@ pub struct ReducedFactor {
 
 impl ReducedFactor {
     /// Stored entry `p` of `f` in double-double.
-    pub fn entry(&self, p: usize) -> faer::fx128 {
-        faer::fx128::from(self.f.val()[p]) + faer::fx128::from(self.lo[p])
+    #[inline]
+    pub fn entry(&self, p: usize) -> Dd {
+        Dd { hi: self.f.val()[p], lo: self.lo[p] }
     }
 }
 
@@ -281,15 +283,14 @@ pub(super) fn rescale(r: &mut ReducedQp, by: f64) {
 /// The factored objective on the free variables, scaled like the reduced QP (`F / √scale`),
 /// in double-double.
 pub(super) fn reduce_factor(qp: &MonotoneQp<'_>, f: &Factor, free: &[usize], scale: f64) -> ReducedFactor {
-    use faer::fx128;
     let n = qp.q.len();
     let mut slot = vec![usize::MAX; n];
     for (k, &i) in free.iter().enumerate() {
         slot[i] = k;
     }
-    let inv_root = fx128::from(1.0) / fx128::from(scale).sqrt();
+    let inv_root = Dd::from(1.0) / Dd::from(scale).sqrt();
     let m = &f.matrix;
-    let mut g = vec![fx128::from(0.0); m.nrows()];
+    let mut g = vec![Dd::ZERO; m.nrows()];
     let (cp, ri) = (m.symbolic().col_ptr(), m.symbolic().row_idx());
     let mut col_ptr = vec![0usize];
     let (mut row_idx, mut val, mut lo) = (Vec::new(), Vec::new(), Vec::new());
@@ -297,16 +298,16 @@ pub(super) fn reduce_factor(qp: &MonotoneQp<'_>, f: &Factor, free: &[usize], sca
         match qp.fixed[j] {
             Some(v) => {
                 for p in cp[j]..cp[j + 1] {
-                    g[ri[p]] += f.entry(p) * fx128::from(v) * inv_root;
+                    g[ri[p]] += f.entry(p) * Dd::from(v) * inv_root;
                 }
             }
             None => {
                 for (p, &i) in (cp[j]..cp[j + 1]).zip(&ri[cp[j]..cp[j + 1]]) {
                     let e = f.entry(p) * inv_root;
-                    let hi = e.0 + e.1;
+                    let hi = e.to_f64();
                     row_idx.push(i);
                     val.push(hi);
-                    lo.push((e - fx128::from(hi)).0);
+                    lo.push((e - Dd::from(hi)).hi);
                 }
                 col_ptr.push(row_idx.len());
             }
@@ -316,7 +317,7 @@ pub(super) fn reduce_factor(qp: &MonotoneQp<'_>, f: &Factor, free: &[usize], sca
     ReducedFactor {
         f: Sparse::new(symbolic, val),
         lo,
-        g: g.iter().map(|v| v.0 + v.1).collect(),
+        g: g.iter().map(|v| v.to_f64()).collect(),
         double_iteration: false,
     }
 }

@@ -118,12 +118,10 @@ impl<T: Real> Part<T> {
     #[allow(clippy::needless_range_loop)] // rows of the band and entries of x indexed together
     fn backward(&self, b: usize, x: &mut [T]) {
         let n = x.len();
-        for (xj, &inv) in x.iter_mut().zip(&self.inv_d) {
-            *xj = *xj * inv;
-        }
         for j in (0..n).rev() {
-            let mut s = x[j];
-            for i in j + 1..(j + b + 1).min(n) {
+            // the farthest rows first: the row just solved (j + 1) ends the dependent chain
+            let mut s = x[j] * self.inv_d[j];
+            for i in (j + 1..(j + b + 1).min(n)).rev() {
                 s = s - self.l[i * b + j + b - i] * x[i];
             }
             x[j] = s;

@@ -94,6 +94,59 @@ pub fn join<RA, RB: Send>(a: impl FnOnce() -> RA, b: impl FnOnce() -> RB + Send)
     })
 }
 
+/// Elements from which [`split_mut`] and [`split_mut2`] put a loop on several threads (below,
+/// a thread's start costs more than the loop).
+pub const SPLIT_FROM: usize = 1 << 17;
+
+/// The contiguous pieces of `n` elements for the current cap: at least [`SPLIT_FROM`] / 2 each.
+fn pieces(n: usize) -> usize {
+    threads().min(n / (SPLIT_FROM / 2)).max(1)
+}
+
+/// Runs `f(offset, piece)` on contiguous pieces of `a`, on up to the cap's threads: for loops
+/// whose every element is computed alone (no sum across elements), which give the same bits on
+/// any number of threads.
+pub fn split_mut<A: Send>(a: &mut [A], f: impl Fn(usize, &mut [A]) + Sync) {
+    let t = pieces(a.len());
+    if t < 2 {
+        f(0, a);
+        return;
+    }
+    let chunk = a.len().div_ceil(t);
+    let f = &f;
+    std::thread::scope(|scope| {
+        let mut pieces = a.chunks_mut(chunk).enumerate();
+        let (_, first) = pieces.next().expect("at least one piece");
+        for (i, piece) in pieces {
+            scope.spawn(move || with_threads(1, || f(i * chunk, piece)));
+        }
+        with_threads(1, || f(0, first));
+    });
+}
+
+/// [`split_mut`] over two slices of the same length, split at the same places.
+///
+/// # Panics
+/// If the lengths differ.
+pub fn split_mut2<A: Send, B: Send>(a: &mut [A], b: &mut [B], f: impl Fn(usize, &mut [A], &mut [B]) + Sync) {
+    assert_eq!(a.len(), b.len(), "split_mut2 over slices of different lengths");
+    let t = pieces(a.len());
+    if t < 2 {
+        f(0, a, b);
+        return;
+    }
+    let chunk = a.len().div_ceil(t);
+    let f = &f;
+    std::thread::scope(|scope| {
+        let mut pieces = a.chunks_mut(chunk).zip(b.chunks_mut(chunk)).enumerate();
+        let (_, (a0, b0)) = pieces.next().expect("at least one piece");
+        for (i, (pa, pb)) in pieces {
+            scope.spawn(move || with_threads(1, || f(i * chunk, pa, pb)));
+        }
+        with_threads(1, || f(0, a0, b0));
+    });
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -113,5 +166,30 @@ mod tests {
         assert_eq!(threads(), default_threads(), "restored after a panic");
         // faer's kernels follow the cap: one thread is sequential
         assert_eq!(with_threads(1, faer_par), faer::Par::Seq);
+    }
+
+    #[test]
+    fn split_loops_cover_every_element_once_at_its_offset() {
+        for n in [0, 5, SPLIT_FROM - 1, SPLIT_FROM, 3 * SPLIT_FROM + 11] {
+            for t in [1, 2, 3, 8] {
+                let mut a = vec![0usize; n];
+                let mut b = vec![0u8; n];
+                with_threads(t, || {
+                    split_mut(&mut a, |off, piece| {
+                        for (i, v) in piece.iter_mut().enumerate() {
+                            *v += off + i + 1;
+                        }
+                    });
+                    split_mut2(&mut a, &mut b, |off, pa, pb| {
+                        for (i, (v, w)) in pa.iter_mut().zip(pb.iter_mut()).enumerate() {
+                            assert_eq!(*v, off + i + 1);
+                            *w += 1;
+                        }
+                    });
+                });
+                assert!(a.iter().enumerate().all(|(i, &v)| v == i + 1), "n = {n}, {t} threads");
+                assert!(b.iter().all(|&w| w == 1));
+            }
+        }
     }
 }

@@ -134,3 +134,31 @@ fn results_are_bit_identical_for_one_and_two_threads() {
         assert_eq!(a.raw, b.raw, "weight {} differs between 1 and 2 threads", a.handle);
     }
 }
+
+/// A long series takes the routes that split work between threads: the interior-point
+/// iteration's vector loops (from `parallel::SPLIT_FROM` entries), the band factorised from both
+/// ends (from 2¹⁴ rows) and the output formatted in blocks; in double (assembled) and in
+/// double-double (factored), every thread count gives the same bits.
+#[test]
+fn a_long_series_is_bit_identical_for_1_2_and_3_threads_in_both_forms() {
+    use toposmooth::parallel::{with_threads, SPLIT_FROM};
+    use toposmooth::solve::Formulation;
+    let n = SPLIT_FROM + 1234;
+    let steps = uniform(42, n);
+    let mut h = Vec::with_capacity(n);
+    let mut v = 0.0;
+    for s in steps {
+        v += s - 0.5;
+        h.push(v);
+    }
+    let series = Series::uniform(n);
+    for formulation in [Formulation::Assembled, Formulation::Factored] {
+        let mut settings = SmoothSettings { selection: Selection::Relative(0.05), ..Default::default() };
+        settings.qp.formulation = formulation;
+        let runs: Vec<_> = (1..=3).map(|t| with_threads(t, || smooth(&series, &h, &settings).unwrap())).collect();
+        assert!(runs[0].report.certificate.passed, "{formulation:?}");
+        for (t, r) in runs.iter().enumerate().skip(1) {
+            assert_eq!(runs[0].output, r.output, "{formulation:?}: 1 and {} threads differ", t + 1);
+        }
+    }
+}

@@ -19,6 +19,7 @@ use super::problem::ReducedQp;
 use super::settings::QpSettings;
 use super::status::{Outcome, SolveStatus};
 use crate::linalg as ordering;
+use crate::parallel::{split_mut, split_mut2};
 use faer::sparse::SparseColMatRef;
 use std::borrow::Cow;
 
@@ -502,15 +503,20 @@ fn run<T: Real, O: Objective<T>>(
     let mut progress = Progress { best_gap: f64::INFINITY, best_at: 0, first: None };
     // the barrier weights `z / s`, with the slacks' reciprocals where the arithmetic uses them
     let weights = |point: &Iterate<T>, w: &mut [T], inv_s: &mut [T]| {
+        let (s, z) = (&point.s, &point.z);
         if T::RECIPROCALS {
-            for k in 0..m {
-                inv_s[k] = one / point.s[k];
-                w[k] = point.z[k].div_by(point.s[k], inv_s[k]);
-            }
+            split_mut2(w, inv_s, |offset, w, inv_s| {
+                for (j, k) in (offset..offset + w.len()).enumerate() {
+                    inv_s[j] = one / s[k];
+                    w[j] = z[k].div_by(s[k], inv_s[j]);
+                }
+            });
         } else {
-            for k in 0..m {
-                w[k] = point.z[k].div_by(point.s[k], point.s[k]);
-            }
+            split_mut(w, |offset, w| {
+                for (wk, k) in w.iter_mut().zip(offset..) {
+                    *wk = z[k].div_by(s[k], s[k]);
+                }
+            });
         }
     };
     // whether the last step was onto the rows (see [`Newton::onto_rows`]), and how many rows
@@ -588,7 +594,7 @@ fn residuals<T: Real, O: Objective<T>>(
     res: &mut Residuals<T>,
     tmp_n: &mut [T],
 ) {
-    let (n, m) = (it.x.len(), it.s.len());
+    let m = it.s.len();
     let (zero, of) = (T::of(0.0), T::of);
     let x = &it.x;
     objective.gradient(x, &mut res.rd);
@@ -598,14 +604,20 @@ fn residuals<T: Real, O: Objective<T>>(
         0.5 * x.iter().zip(res.rd.iter().zip(&r.q)).map(|(x, (g, q))| (*x * (*g + of(*q))).to_f64()).sum::<f64>()
     };
     rows.atz(&it.z, tmp_n);
-    for i in 0..n {
-        res.rd[i] += tmp_n[i];
-    }
+    let tmp_n = &*tmp_n;
+    split_mut(&mut res.rd, |offset, rd| {
+        for (r, i) in rd.iter_mut().zip(offset..) {
+            *r += tmp_n[i];
+        }
+    });
     rows.ax(x, &mut res.slack);
-    for k in 0..m {
-        res.rp[k] = res.slack[k] + it.s[k] - b[k];
-        res.slack[k] = b[k] - res.slack[k];
-    }
+    let s = &it.s;
+    split_mut2(&mut res.rp, &mut res.slack, |offset, rp, slack| {
+        for (j, k) in (offset..offset + rp.len()).enumerate() {
+            rp[j] = slack[j] + s[k] - b[k];
+            slack[j] = b[k] - slack[j];
+        }
+    });
     res.mu_t = it.s.iter().zip(&it.z).fold(zero, |a, (&s, &z)| a + s * z) / of(m as f64);
     res.mu = res.mu_t.to_f64();
     res.pres = res.rp.iter().fold(0.0f64, |a, v| a.max(v.to_f64().abs())) / bnorm;
@@ -825,30 +837,39 @@ impl<T: Real> Newton<T> {
         (w, inv_s): (&[T], &[T]),
     ) -> f64 {
         let (zero, of) = (T::of(0.0), T::of);
-        let (n, m) = (it.x.len(), it.s.len());
+        let m = it.s.len();
         let (s, z) = (&it.s, &it.z);
         let tmp_m = &mut self.tmp_m;
         // one Newton direction for complementarity target rc (s∘z − rc → 0)
+        let (rp, rd) = (&res.rp, &res.rd);
         let mut direction = |rc: &[T], dx: &mut Vec<T>, ds: &mut Vec<T>, dz: &mut Vec<T>| {
-            for k in 0..m {
-                tmp_m[k] = w[k] * res.rp[k] - rc[k].div_by(s[k], inv_s[k]);
-            }
+            split_mut(tmp_m, |offset, tmp| {
+                for (t, k) in tmp.iter_mut().zip(offset..) {
+                    *t = w[k] * rp[k] - rc[k].div_by(s[k], inv_s[k]);
+                }
+            });
             rows.atz(tmp_m, dx);
-            for i in 0..n {
-                dx[i] = -res.rd[i] - dx[i];
-            }
+            split_mut(dx, |offset, dx| {
+                for (d, i) in dx.iter_mut().zip(offset..) {
+                    *d = -rd[i] - *d;
+                }
+            });
             objective.solve_in_place(dx);
             rows.ax(dx, ds);
-            for k in 0..m {
-                let adx = ds[k];
-                dz[k] = w[k] * (adx + res.rp[k]) - rc[k].div_by(s[k], inv_s[k]);
-                ds[k] = -res.rp[k] - adx;
-            }
+            split_mut2(dz, ds, |offset, dz, ds| {
+                for (j, k) in (offset..offset + dz.len()).enumerate() {
+                    let adx = ds[j];
+                    dz[j] = w[k] * (adx + rp[k]) - rc[k].div_by(s[k], inv_s[k]);
+                    ds[j] = -rp[k] - adx;
+                }
+            });
         };
         // predictor
-        for k in 0..m {
-            self.rc[k] = s[k] * z[k];
-        }
+        split_mut(&mut self.rc, |offset, rc| {
+            for (r, k) in rc.iter_mut().zip(offset..) {
+                *r = s[k] * z[k];
+            }
+        });
         direction(&self.rc, &mut self.dx, &mut self.ds, &mut self.dz);
         let alpha_aff = predictor_step(s, &self.ds, z, &self.dz);
         let a_aff = of(alpha_aff);
@@ -857,9 +878,12 @@ impl<T: Real> Newton<T> {
         let sigma = (mu_aff / res.mu).powi(3).clamp(0.0, 1.0);
         let sigma_mu = of(sigma) * res.mu_t;
         // corrector
-        for k in 0..m {
-            self.rc[k] = s[k] * z[k] + self.ds[k] * self.dz[k] - sigma_mu;
-        }
+        let (ds, dz) = (&self.ds, &self.dz);
+        split_mut(&mut self.rc, |offset, rc| {
+            for (r, k) in rc.iter_mut().zip(offset..) {
+                *r = s[k] * z[k] + ds[k] * dz[k] - sigma_mu;
+            }
+        });
         direction(&self.rc, &mut self.dx, &mut self.ds, &mut self.dz);
         let mut alpha_max = max_step(s, &self.ds).min(max_step(z, &self.dz));
         let (lo, hi) = (of(0.1) * sigma_mu, of(10.0) * sigma_mu);
@@ -868,17 +892,20 @@ impl<T: Real> Newton<T> {
                 break;
             }
             let trial = of((alpha_max + CORRECTOR_STEP).min(1.0));
-            for k in 0..m {
-                let v = (s[k] + trial * self.ds[k]) * (z[k] + trial * self.dz[k]);
-                let t = if v < lo {
-                    lo - v
-                } else if v > hi {
-                    max(hi - v, -hi)
-                } else {
-                    zero
-                };
-                self.rc2[k] = self.rc[k] - t;
-            }
+            let (ds, dz, rc) = (&self.ds, &self.dz, &self.rc);
+            split_mut(&mut self.rc2, |offset, rc2| {
+                for (r2, k) in rc2.iter_mut().zip(offset..) {
+                    let v = (s[k] + trial * ds[k]) * (z[k] + trial * dz[k]);
+                    let t = if v < lo {
+                        lo - v
+                    } else if v > hi {
+                        max(hi - v, -hi)
+                    } else {
+                        zero
+                    };
+                    *r2 = rc[k] - t;
+                }
+            });
             direction(&self.rc2, &mut self.dx2, &mut self.ds2, &mut self.dz2);
             let a2 = max_step(s, &self.ds2).min(max_step(z, &self.dz2));
             if a2 >= alpha_max + 0.1 * CORRECTOR_STEP {
@@ -939,10 +966,13 @@ impl<T: Real> Newton<T> {
             last_step = last_step.max(dxi.to_f64().abs());
             *xi += dxi;
         }
-        for k in 0..it.s.len() {
-            it.s[k] += a * self.ds[k];
-            it.z[k] += a * self.dz[k];
-        }
+        let (ds, dz) = (&self.ds, &self.dz);
+        split_mut2(&mut it.s, &mut it.z, |offset, s, z| {
+            for (j, k) in (offset..offset + s.len()).enumerate() {
+                s[j] += a * ds[k];
+                z[j] += a * dz[k];
+            }
+        });
         last_step
     }
 }

@@ -146,6 +146,8 @@ impl Prepared {
 /// that `P`'s condition number takes from the solve.
 pub(super) trait Real:
     Copy
+    + Send
+    + Sync
     + PartialOrd
     + std::ops::Add<Output = Self>
     + std::ops::Sub<Output = Self>
@@ -213,11 +215,13 @@ pub(super) fn max<T: Real>(a: T, b: T) -> T {
 impl Rows {
     /// `out = A x`.
     pub(super) fn ax<T: Real>(&self, x: &[T], out: &mut [T]) {
-        for (k, o) in out.iter_mut().enumerate() {
-            let [c0, c1] = self.cols[k];
-            let [v0, v1] = self.vals[k];
-            *o = if self.len[k] == 2 { T::of(v0) * x[c0] + T::of(v1) * x[c1] } else { T::of(v0) * x[c0] };
-        }
+        crate::parallel::split_mut(out, |offset, out| {
+            for (k, o) in (offset..).zip(out.iter_mut()) {
+                let [c0, c1] = self.cols[k];
+                let [v0, v1] = self.vals[k];
+                *o = if self.len[k] == 2 { T::of(v0) * x[c0] + T::of(v1) * x[c1] } else { T::of(v0) * x[c0] };
+            }
+        });
     }
 
     /// `out = Aᵀ z`.

@@ -227,7 +227,7 @@ pub(crate) fn read_series_output_with(path: &Path, with_x: bool) -> Result<Serie
     let file = std::fs::File::open(path).map_err(|source| Error::Io { path: path.to_path_buf(), source })?;
     let mut reader = csv::ReaderBuilder::new()
         .has_headers(true)
-        .trim(csv::Trim::All)
+        .trim(csv::Trim::Headers)
         .from_reader(std::io::BufReader::with_capacity(1 << 20, file));
     let header = reader.headers().map_err(|e| err(format!("malformed CSV: {e}")))?.clone();
     let (cx, [ci, co, cu, cr], cf) = positions(&header).ok_or_else(|| {
@@ -248,27 +248,34 @@ pub(crate) fn read_series_output_with(path: &Path, with_x: bool) -> Result<Serie
     };
     let mut x_text = Vec::new();
     let mut filled = Vec::new();
-    let mut rec = csv::StringRecord::new();
-    while reader.read_record(&mut rec).map_err(|e| err(format!("malformed CSV: {e}")))? {
+    // byte records, each cell checked as UTF-8 and trimmed where it is used (the read-back of
+    // every run's output: string records validated and trimmed every cell of 10⁷ rows)
+    let mut rec = csv::ByteRecord::new();
+    while reader.read_byte_record(&mut rec).map_err(|e| err(format!("malformed CSV: {e}")))? {
         let line = rec.position().map(|p| p.line()).unwrap_or(0);
         let bad = |msg: String| err(format!("line {line}: {msg}")).at(Location::Line(line as usize));
+        let text = |c: usize, name: &str| -> Result<&str> {
+            std::str::from_utf8(rec.get(c).unwrap_or(b""))
+                .map(str::trim)
+                .map_err(|_| bad(format!("column `{name}` is not UTF-8 text")))
+        };
         let num = |c: usize, name: &str| -> Result<f64> {
-            let cell = rec.get(c).unwrap_or("");
+            let cell = text(c, name)?;
             cell.parse::<f64>().map_err(|_| bad(format!("`{cell}` in column `{name}` is not a number")))
         };
         out.input.push(num(ci, "input")?);
         out.output.push(num(co, "output")?);
         out.u.push(num(cu, "u")?);
-        let role = rec.get(cr).unwrap_or("");
+        let role = text(cr, "role")?;
         out.roles.push(
             Role::from_label(role)
                 .ok_or_else(|| bad(format!("unknown role `{role}` (min, max, fixed, end or empty)")))?,
         );
         if with_x {
-            x_text.push(cx.and_then(|c| rec.get(c)).unwrap_or("").to_string());
+            x_text.push(cx.map_or(Ok(""), |c| text(c, "x"))?.to_string());
         }
         if let Some(c) = cf {
-            filled.push(match rec.get(c).unwrap_or("") {
+            filled.push(match text(c, "filled")? {
                 "1" => true,
                 "0" => false,
                 other => return Err(bad(format!("`{other}` in column `filled` is not 0 or 1"))),
@@ -390,5 +397,18 @@ mod tests {
         std::fs::write(&p, "a,b\n1,2\n").unwrap();
         let e = read_series_output(&p).unwrap_err().to_string();
         assert!(e.contains("old.csv") && e.contains("X,input,output,u,role"), "{e}");
+        // cells are trimmed where they are used, and checked as UTF-8 text
+        std::fs::write(&p, "x,input,output,u,role\n a , 0.5 ,1,0, min\n1,1,1,1,max \n").unwrap();
+        let back = read_series_output(&p).unwrap();
+        assert_eq!((back.x_text.get(0), back.input[0], back.roles[0]), ("a".into(), 0.5, Role::Min));
+        // past the head the content check reads: the cell's own check
+        let mut bytes = b"x,input,output,u,role\n".to_vec();
+        for i in 0..100_000 {
+            bytes.extend_from_slice(format!("{i},0,0,0,\n").as_bytes());
+        }
+        bytes.extend_from_slice(b"100000,\xff1,1,1,max\n");
+        std::fs::write(&p, bytes).unwrap();
+        let e = read_series_output(&p).unwrap_err().to_string();
+        assert!(e.contains("line 100002") && e.contains("`input` is not UTF-8"), "{e}");
     }
 }

@@ -257,13 +257,21 @@ fn read_rows(path: &Path) -> Result<(Table, Dialect)> {
     let mut rec = csv::ByteRecord::new();
     while reader.read_byte_record(&mut rec).map_err(|e| err(format!("malformed CSV ({}): {e}", dialect.describe())))? {
         let line = rec.position().map(|p| p.line()).unwrap_or(0);
-        if rec.iter().all(|c| cell(c).is_ok_and(str::is_empty)) {
+        // each cell trimmed once, into the table; a row of empty cells taken back out
+        let (text_len, cells) = (table.text.len(), table.ends.len());
+        for c in &rec {
+            let c = cell(c).map_err(|_| err(format!("line {line}: not UTF-8 text")))?;
+            table.text.push_str(c);
+            table.ends.push(table.text.len());
+        }
+        if table.text.len() == text_len {
+            table.ends.truncate(cells);
             continue;
         }
         if table.lines.is_empty() {
             table.ncols = rec.len();
         } else if rec.len() != table.ncols {
-            // the reader refuses ragged rows itself; a row of empty cells skipped above is the
+            // the reader refuses ragged rows itself; a row of empty cells taken out above is the
             // only way to get here
             return Err(err(format!(
                 "malformed CSV ({}): line {line} has {} fields, the first row {}",
@@ -271,11 +279,6 @@ fn read_rows(path: &Path) -> Result<(Table, Dialect)> {
                 rec.len(),
                 table.ncols
             )));
-        }
-        for c in &rec {
-            let c = cell(c).map_err(|_| err(format!("line {line}: not UTF-8 text")))?;
-            table.text.push_str(c);
-            table.ends.push(table.text.len());
         }
         table.lines.push(line);
     }

@@ -137,7 +137,7 @@ pub fn stage_series_output(path: &Path, out: &SeriesColumns<'_>) -> Result<super
     let threads = crate::parallel::threads().max(1);
     super::stage(path, |w| {
         writeln!(w, "{},{}{}", csv_cell(out.x_name), COLUMNS.join(","), if filled.is_some() { ",filled" } else { "" })?;
-        // one text per block, reused: threads × 2 blocks of about 2 MB in memory at a time
+        // one text per thread, reused: a block of about 2 MB each in memory at a time
         let mut texts = vec![String::new(); threads];
         let mut start = 0;
         while start < n {

@@ -10,7 +10,7 @@
 
 use super::polyharmonic::{cut_edges, Energy};
 use super::sparse::{without_zeros, Sparse};
-use faer::fx128;
+use crate::linalg::double_double::Dd;
 
 /// A sparse matrix with double-double entries: `matrix` holds them rounded to double, `lo` the
 /// remainder of each stored entry.
@@ -25,8 +25,8 @@ pub struct Factor {
 impl Factor {
     /// Stored entry `p` (an index into `matrix`'s values) in double-double.
     #[inline]
-    pub fn entry(&self, p: usize) -> crate::linalg::double_double::Dd {
-        crate::linalg::double_double::Dd { hi: self.matrix.val()[p], lo: self.lo[p] }
+    pub fn entry(&self, p: usize) -> Dd {
+        Dd { hi: self.matrix.val()[p], lo: self.lo[p] }
     }
 
     /// A factor whose entries are doubles.
@@ -35,14 +35,14 @@ impl Factor {
         Factor { matrix, lo }
     }
 
-    fn from_dd(m: &Dd) -> Factor {
+    fn from_dd(m: &DdColumns) -> Factor {
         let mut row_idx = Vec::with_capacity(m.entries.len());
         let (mut val, mut lo) = (Vec::with_capacity(m.entries.len()), Vec::with_capacity(m.entries.len()));
         for &(i, v) in &m.entries {
             row_idx.push(i);
-            let hi = v.0 + v.1;
+            let hi = v.to_f64();
             val.push(hi);
-            lo.push((v - fx128::from(hi)).0);
+            lo.push((v - Dd::from(hi)).hi);
         }
         let symbolic =
             faer::sparse::SymbolicSparseColMat::new_checked(m.nrows, m.ncols(), m.col_ptr.clone(), None, row_idx);
@@ -53,27 +53,27 @@ impl Factor {
 /// Compressed columns with double-double values, rows sorted: the entries of column `j` are
 /// `entries[col_ptr[j]..col_ptr[j + 1]]` (one array, not a vector per column: at 3·10⁶
 /// samples those were millions of allocations).
-struct Dd {
+struct DdColumns {
     nrows: usize,
     col_ptr: Vec<usize>,
-    entries: Vec<(usize, fx128)>,
+    entries: Vec<(usize, Dd)>,
 }
 
-impl Dd {
+impl DdColumns {
     fn ncols(&self) -> usize {
         self.col_ptr.len() - 1
     }
 
-    fn col(&self, j: usize) -> &[(usize, fx128)] {
+    fn col(&self, j: usize) -> &[(usize, Dd)] {
         &self.entries[self.col_ptr[j]..self.col_ptr[j + 1]]
     }
 
     /// The matrix of `ncols` columns whose column `j` is `column(j)`.
-    fn from_columns<I: Iterator<Item = (usize, fx128)>>(
+    fn from_columns<I: Iterator<Item = (usize, Dd)>>(
         nrows: usize,
         ncols: usize,
         mut column: impl FnMut(usize) -> I,
-    ) -> Dd {
+    ) -> DdColumns {
         let mut col_ptr = Vec::with_capacity(ncols + 1);
         col_ptr.push(0);
         let mut entries = Vec::new();
@@ -82,25 +82,25 @@ impl Dd {
             col_ptr.push(entries.len());
         }
         entries.shrink_to_fit();
-        Dd { nrows, col_ptr, entries }
+        DdColumns { nrows, col_ptr, entries }
     }
 
-    fn of(a: &Sparse) -> Dd {
+    fn of(a: &Sparse) -> DdColumns {
         let (cp, ri, v) = (a.symbolic().col_ptr(), a.symbolic().row_idx(), a.val());
-        Dd::from_columns(a.nrows(), a.ncols(), |j| (cp[j]..cp[j + 1]).map(|p| (ri[p], fx128::from(v[p]))))
+        DdColumns::from_columns(a.nrows(), a.ncols(), |j| (cp[j]..cp[j + 1]).map(|p| (ri[p], Dd::from(v[p]))))
     }
 
     /// `diag(d) · self`, exact zeros dropped.
-    fn scale_rows(&self, d: &[fx128]) -> Dd {
-        let zero = fx128::from(0.0);
-        Dd::from_columns(self.nrows, self.ncols(), |j| {
+    fn scale_rows(&self, d: &[Dd]) -> DdColumns {
+        let zero = Dd::from(0.0);
+        DdColumns::from_columns(self.nrows, self.ncols(), |j| {
             self.col(j).iter().map(|&(i, v)| (i, d[i] * v)).filter(move |&(_, v)| v != zero)
         })
     }
 
     /// `self · b`.
-    fn mul(&self, b: &Dd) -> Dd {
-        let zero = fx128::from(0.0);
+    fn mul(&self, b: &DdColumns) -> DdColumns {
+        let zero = Dd::from(0.0);
         let mut acc = vec![zero; self.nrows];
         let mut seen = vec![false; self.nrows];
         let mut rows = Vec::new();
@@ -127,11 +127,11 @@ impl Dd {
             col_ptr.push(entries.len());
         }
         entries.shrink_to_fit();
-        Dd { nrows: self.nrows, col_ptr, entries }
+        DdColumns { nrows: self.nrows, col_ptr, entries }
     }
 
     /// The rows with `keep[row]`, renumbered in order.
-    fn select_rows(&self, keep: &[bool]) -> Dd {
+    fn select_rows(&self, keep: &[bool]) -> DdColumns {
         let mut slot = vec![usize::MAX; self.nrows];
         let mut n = 0;
         for (r, &k) in keep.iter().enumerate() {
@@ -140,14 +140,19 @@ impl Dd {
                 n += 1;
             }
         }
-        Dd::from_columns(n, self.ncols(), |j| self.col(j).iter().filter(|e| keep[e.0]).map(|&(i, v)| (slot[i], v)))
+        DdColumns::from_columns(n, self.ncols(), |j| {
+            self.col(j).iter().filter(|e| keep[e.0]).map(|&(i, v)| (slot[i], v))
+        })
     }
 
-    /// Without its empty rows.
-    fn without_empty_rows(&self) -> Dd {
+    /// Without its empty rows (itself when none is).
+    fn without_empty_rows(self) -> DdColumns {
         let mut used = vec![false; self.nrows];
         for &(i, _) in &self.entries {
             used[i] = true;
+        }
+        if used.iter().all(|&u| u) {
+            return self;
         }
         self.select_rows(&used)
     }
@@ -180,9 +185,12 @@ impl Dd {
 /// positive.
 pub fn edge_factor(k: &Sparse) -> Option<Factor> {
     let (cp, ri, v) = (k.symbolic().col_ptr(), k.symbolic().row_idx(), k.val());
-    let mut cols: Vec<Vec<(usize, fx128)>> = vec![Vec::new(); k.ncols()];
-    let mut row = 0;
-    for j in 0..k.ncols() {
+    let n = k.ncols();
+    // the edges (i < j, in column order) are the rows; each column's entries counted first, so
+    // that they are laid out in one array (a vector per column: millions of allocations)
+    let mut col_ptr = vec![0usize; n + 1];
+    let mut rows = 0;
+    for j in 0..n {
         for p in cp[j]..cp[j + 1] {
             let i = ri[p];
             if i < j {
@@ -190,16 +198,35 @@ pub fn edge_factor(k: &Sparse) -> Option<Factor> {
                     return None;
                 }
                 if v[p] < 0.0 {
-                    let r = fx128::from(-v[p]).sqrt();
-                    cols[i].push((row, r));
-                    cols[j].push((row, -r));
-                    row += 1;
+                    col_ptr[i + 1] += 1;
+                    col_ptr[j + 1] += 1;
+                    rows += 1;
                 }
             }
         }
     }
-    // each column's rows are in increasing order by construction
-    Some(Factor::from_dd(&Dd::from_columns(row, cols.len(), |j| cols[j].iter().copied())))
+    for j in 0..n {
+        col_ptr[j + 1] += col_ptr[j];
+    }
+    let mut fill = col_ptr[..n].to_vec();
+    let mut entries = vec![(0usize, Dd::ZERO); col_ptr[n]];
+    let mut row = 0;
+    for j in 0..n {
+        for p in cp[j]..cp[j + 1] {
+            let i = ri[p];
+            if i < j && v[p] < 0.0 {
+                let r = Dd::from(-v[p]).sqrt();
+                // a column's rows arrive in increasing order: its own edges to earlier columns
+                // while it is visited, then those of later columns
+                entries[fill[i]] = (row, r);
+                fill[i] += 1;
+                entries[fill[j]] = (row, -r);
+                fill[j] += 1;
+                row += 1;
+            }
+        }
+    }
+    Some(Factor::from_dd(&DdColumns { nrows: rows, col_ptr, entries }))
 }
 
 /// `F` with `FᵀF = Q` for the energy [`super::polyharmonic`] assembles from the same arguments,
@@ -223,20 +250,19 @@ pub fn polyharmonic_factor(k: &Sparse, k_factor: &Factor, m: &[f64], energy: &En
     for &v in &energy.sharp {
         sharp[v] = true;
     }
-    let zero = fx128::from(0.0);
-    let minv: Vec<fx128> = m.iter().map(|&x| fx128::from(1.0) / fx128::from(x)).collect();
-    let root_minv: Vec<fx128> = minv.iter().map(|x| x.sqrt()).collect();
-    let d: Vec<fx128> = (0..n).map(|i| if sharp[i] { zero } else { minv[i] }).collect();
-    let root_d: Vec<fx128> = (0..n).map(|i| if sharp[i] { zero } else { root_minv[i] }).collect();
-    let kd = Dd::of(k);
-    let f1 = factor_dd(k_factor);
-    let (support_start, support) = f1.row_supports();
-    let edge_rows = support_start.windows(2).all(|w| w[1] - w[0] <= 2);
-    let cut_factor = || -> Option<Dd> {
+    let zero = Dd::from(0.0);
+    let minv: Vec<Dd> = m.iter().map(|&x| Dd::from(1.0) / Dd::from(x)).collect();
+    let root_minv: Vec<Dd> = minv.iter().map(|x| x.sqrt()).collect();
+    let d: Vec<Dd> = (0..n).map(|i| if sharp[i] { zero } else { minv[i] }).collect();
+    let root_d: Vec<Dd> = (0..n).map(|i| if sharp[i] { zero } else { root_minv[i] }).collect();
+    let kd = DdColumns::of(k);
+    let cut_factor = || -> Option<DdColumns> {
+        let f1 = factor_dd(k_factor);
         if energy.sharp.is_empty() {
-            return Some(factor_dd(k_factor));
+            return Some(f1);
         }
-        if !edge_rows {
+        let (support_start, support) = f1.row_supports();
+        if !support_start.windows(2).all(|w| w[1] - w[0] <= 2) {
             return None;
         }
         let keep: Vec<bool> =
@@ -244,7 +270,7 @@ pub fn polyharmonic_factor(k: &Sparse, k_factor: &Factor, m: &[f64], energy: &En
         Some(f1.select_rows(&keep))
     };
     // each term's rows, stacked: column j holds every term's entries of column j in turn
-    let mut terms: Vec<(Dd, fx128, usize)> = Vec::new();
+    let mut terms: Vec<(DdColumns, Dd, usize)> = Vec::new();
     let mut base = 0;
     for (&(order, w), &s) in energy.terms.iter().zip(scale) {
         let c = w * s;
@@ -258,24 +284,27 @@ pub fn polyharmonic_factor(k: &Sparse, k_factor: &Factor, m: &[f64], energy: &En
             3 => cut_factor()?.mul(&g()),
             _ => {
                 let k_cut =
-                    if energy.sharp.is_empty() { kd.mul(&g()) } else { Dd::of(&cut_edges(k, &sharp)).mul(&g()) };
+                    if energy.sharp.is_empty() { kd.mul(&g()) } else { DdColumns::of(&cut_edges(k, &sharp)).mul(&g()) };
                 k_cut.scale_rows(&root_minv)
             }
         }
         .without_empty_rows();
-        let root = (fx128::from(w) * fx128::from(s)).sqrt();
+        let root = (Dd::from(w) * Dd::from(s)).sqrt();
         let rows = f.nrows;
         terms.push((f, root, base));
         base += rows;
     }
-    Some(Factor::from_dd(&Dd::from_columns(base, n, |j| {
+    if let [(f, root, _)] = &mut terms[..] {
+        // one term: its columns as they are, scaled in place
+        f.entries.iter_mut().for_each(|e| e.1 = *root * e.1);
+        return Some(Factor::from_dd(f));
+    }
+    Some(Factor::from_dd(&DdColumns::from_columns(base, n, |j| {
         terms.iter().flat_map(move |(f, root, at)| f.col(j).iter().map(move |&(i, v)| (at + i, *root * v)))
     })))
 }
 
-fn factor_dd(f: &Factor) -> Dd {
+fn factor_dd(f: &Factor) -> DdColumns {
     let (cp, ri) = (f.matrix.symbolic().col_ptr(), f.matrix.symbolic().row_idx());
-    Dd::from_columns(f.matrix.nrows(), f.matrix.ncols(), |j| {
-        (cp[j]..cp[j + 1]).map(|p| (ri[p], crate::linalg::double_double::to_fx128(f.entry(p))))
-    })
+    DdColumns::from_columns(f.matrix.nrows(), f.matrix.ncols(), |j| (cp[j]..cp[j + 1]).map(|p| (ri[p], f.entry(p))))
 }

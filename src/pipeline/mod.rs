@@ -305,30 +305,36 @@ fn smooth_stages<D: Smoothable + Sync>(
     let problem = Problem::new(h, &kept);
 
     // The energy and the solver's analysis of its normal matrix need only the kept set: they
-    // are built on the other core while the complex and the representative are.
-    let (ordered, (operators, operators_seconds, prepared)) = crate::parallel::join(
-        || {
-            let stage = Stage::begin("representative");
-            let ordered = order_representative(domain, &problem, settings, ops.fill(), analyses, &mut seconds);
-            if let Ok(o) = &ordered {
-                stage.end(|| format!("{}, {} constraint edges", o.name, o.edges.len()));
+    // are built on the other core while the complex and the representative are (after a
+    // representative that costs nothing, on every core).
+    let fill = ops.fill();
+    let mut representative = || {
+        let stage = Stage::begin("representative");
+        let ordered = order_representative(domain, &problem, settings, fill, analyses, &mut seconds);
+        if let Ok(o) = &ordered {
+            stage.end(|| format!("{}, {} constraint edges", o.name, o.edges.len()));
+        }
+        ordered
+    };
+    let energy = || {
+        let t = Instant::now();
+        let built = build_operators(domain, (&ops.stiffness, &ops.mass), settings, length.0, &problem);
+        let seconds = t.elapsed().as_secs_f64();
+        let prepared = match (&built, settings.qp.method) {
+            // a failed analysis is redone (and reported) by the solver itself
+            (Ok(o), Method::Structured) if o.factor.is_none() => {
+                crate::solve::prepare(&o.p, &problem.fixed, settings.qp.memory_limit).ok().flatten()
             }
-            ordered
-        },
-        || {
-            let t = Instant::now();
-            let built = build_operators(domain, (&ops.stiffness, &ops.mass), settings, length.0, &problem);
-            let seconds = t.elapsed().as_secs_f64();
-            let prepared = match (&built, settings.qp.method) {
-                // a failed analysis is redone (and reported) by the solver itself
-                (Ok(o), Method::Structured) if o.factor.is_none() => {
-                    crate::solve::prepare(&o.p, &problem.fixed, settings.qp.memory_limit).ok().flatten()
-                }
-                _ => None,
-            };
-            (built, seconds, prepared)
-        },
-    );
+            _ => None,
+        };
+        (built, seconds, prepared)
+    };
+    let (ordered, (operators, operators_seconds, prepared)) = if domain.light_representative() {
+        let ordered = representative();
+        (ordered, energy())
+    } else {
+        crate::parallel::join(representative, energy)
+    };
     let ordered = ordered?;
     let operators = operators?;
     crate::progress::checkpoint()?;

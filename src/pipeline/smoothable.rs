@@ -120,6 +120,12 @@ pub trait Smoothable: Domain {
     fn solid(&self) -> bool {
         false
     }
+    /// Whether the representative costs next to nothing (a series: a pass along the samples),
+    /// so that the pipeline builds the operators after it on every thread instead of beside
+    /// it on half of them.
+    fn light_representative(&self) -> bool {
+        false
+    }
     /// `F₁` with `F₁ᵀF₁ = k` (the stiffness): one row per edge of positive weight, or `None`
     /// when a weight is negative and the domain has no other square root.
     fn stiffness_factor(&self, k: &Sparse) -> Option<Factor> {
@@ -168,6 +174,9 @@ pub(crate) fn energy_on_edges<D: Smoothable>(
 impl Smoothable for Series {
     fn stiffness(&self) -> Sparse {
         series_stiffness(self)
+    }
+    fn light_representative(&self) -> bool {
+        true
     }
     fn mass(&self) -> Vec<f64> {
         series_mass(self)

@@ -40,16 +40,21 @@ pub fn condition_estimate(p: &crate::operators::Sparse, d: &[f64], fixed: &[Opti
     }
     let df: Vec<f64> = free.iter().map(|&i| d[i]).collect();
     let (cp, ri, val) = (p.symbolic().col_ptr(), p.symbolic().row_idx(), p.val());
+    // P is stored whole and symmetric, so column j is row j: each entry of `w` gathers its
+    // own row, on contiguous pieces one a thread (the same sums for any thread count)
     Some(power(&df, |v, w| {
-        for (kj, &j) in free.iter().enumerate() {
-            let vj = v[kj];
-            for q in cp[j]..cp[j + 1] {
-                let si = slot[ri[q]];
-                if si != usize::MAX {
-                    w[si] += val[q] * vj;
+        crate::parallel::split_mut(w, |offset, w| {
+            for (wk, &j) in w.iter_mut().zip(&free[offset..]) {
+                let mut sum = 0.0;
+                for q in cp[j]..cp[j + 1] {
+                    let si = slot[ri[q]];
+                    if si != usize::MAX {
+                        sum += val[q] * v[si];
+                    }
                 }
+                *wk += sum;
             }
-        }
+        });
     }))
 }
 

@@ -84,14 +84,14 @@ impl<T: Real> Part<T> {
                 // L_jk = (A_kj − Σ_{p<k} L_jp D_p L_kp) / D_k
                 let mut s = a(j, b - (j - k));
                 for p in first..k {
-                    s = s - ld[p + b - j] * self.l[k * b + p + b - k];
+                    s -= ld[p + b - j] * self.l[k * b + p + b - k];
                 }
                 ld[k + b - j] = s;
                 self.l[row + k + b - j] = s * self.inv_d[k];
             }
             let mut d = a(j, b) + shift;
             for k in first..j {
-                d = d - ld[k + b - j] * self.l[row + k + b - j];
+                d -= ld[k + b - j] * self.l[row + k + b - j];
             }
             if d.partial_cmp(&zero) != Some(std::cmp::Ordering::Greater) {
                 return false;
@@ -108,7 +108,7 @@ impl<T: Real> Part<T> {
             let first = j.saturating_sub(b);
             let mut s = x[j];
             for k in first..j {
-                s = s - self.l[j * b + k + b - j] * x[k];
+                s -= self.l[j * b + k + b - j] * x[k];
             }
             x[j] = s;
         }
@@ -122,7 +122,7 @@ impl<T: Real> Part<T> {
             // the farthest rows first: the row just solved (j + 1) ends the dependent chain
             let mut s = x[j] * self.inv_d[j];
             for i in (j + 1..(j + b + 1).min(n)).rev() {
-                s = s - self.l[i * b + j + b - i] * x[i];
+                s -= self.l[i * b + j + b - i] * x[i];
             }
             x[j] = s;
         }
@@ -245,8 +245,8 @@ impl<T: Real + Send + Sync> Banded<T> {
                     v += shift;
                 }
                 for r in 0..b {
-                    v = v - split.z_top[r * b + i] * self.top.inv_d[p - b + r] * split.z_top[r * b + j];
-                    v = v - split.z_bottom[r * b + i] * split.bottom.inv_d[nb - b + r] * split.z_bottom[r * b + j];
+                    v -= split.z_top[r * b + i] * self.top.inv_d[p - b + r] * split.z_top[r * b + j];
+                    v -= split.z_bottom[r * b + i] * split.bottom.inv_d[nb - b + r] * split.z_bottom[r * b + j];
                 }
                 schur[i * b + j] = v;
             }
@@ -256,7 +256,7 @@ impl<T: Real + Send + Sync> Banded<T> {
         for j in 0..b {
             let mut d = schur[j * b + j];
             for k in 0..j {
-                d = d - split.s_l[j * b + k] * split.s_l[j * b + k] * pivots[k];
+                d -= split.s_l[j * b + k] * split.s_l[j * b + k] * pivots[k];
             }
             if d.partial_cmp(&T::of(0.0)) != Some(std::cmp::Ordering::Greater) {
                 return false;
@@ -267,7 +267,7 @@ impl<T: Real + Send + Sync> Banded<T> {
             for i in j + 1..b {
                 let mut v = schur[i * b + j];
                 for k in 0..j {
-                    v = v - split.s_l[i * b + k] * split.s_l[j * b + k] * pivots[k];
+                    v -= split.s_l[i * b + k] * split.s_l[j * b + k] * pivots[k];
                 }
                 split.s_l[i * b + j] = v * split.s_inv_d[j];
             }
@@ -295,14 +295,14 @@ impl<T: Real + Send + Sync> Banded<T> {
         for s in 0..b {
             let mut v = xs[s];
             for r in 0..b {
-                v = v - split.z_top[r * b + s] * self.top.inv_d[nt - b + r] * xt[nt - b + r];
-                v = v - split.z_bottom[r * b + s] * split.bottom.inv_d[nb - b + r] * xb[nb - b + r];
+                v -= split.z_top[r * b + s] * self.top.inv_d[nt - b + r] * xt[nt - b + r];
+                v -= split.z_bottom[r * b + s] * split.bottom.inv_d[nb - b + r] * xb[nb - b + r];
             }
             xs[s] = v;
         }
         for i in 0..b {
             for k in 0..i {
-                xs[i] = xs[i] - split.s_l[i * b + k] * xs[k];
+                xs[i] -= split.s_l[i * b + k] * xs[k];
             }
         }
         for i in 0..b {
@@ -310,14 +310,14 @@ impl<T: Real + Send + Sync> Banded<T> {
         }
         for i in (0..b).rev() {
             for k in i + 1..b {
-                xs[i] = xs[i] - split.s_l[k * b + i] * xs[k];
+                xs[i] -= split.s_l[k * b + i] * xs[k];
             }
         }
         // each part less its coupling to the separator, then its backward sweep
         for r in 0..b {
             for s in 0..b {
-                xt[nt - b + r] = xt[nt - b + r] - split.z_top[r * b + s] * xs[s];
-                xb[nb - b + r] = xb[nb - b + r] - split.z_bottom[r * b + s] * xs[s];
+                xt[nt - b + r] -= split.z_top[r * b + s] * xs[s];
+                xb[nb - b + r] -= split.z_bottom[r * b + s] * xs[s];
             }
         }
         crate::parallel::join(|| self.top.backward(b, xt), || split.bottom.backward(b, xb));

@@ -105,7 +105,7 @@ impl<'r> Normal<'r> {
         let band = normal_band(r, &r.rows);
         let pattern = match band {
             Some(_) => None,
-            None => Some(Pattern::new(r, &r.rows.cols, &r.rows.len)),
+            None => Some(Pattern::new(r, &r.rows)),
         };
         let find = |i: usize, j: usize| -> std::result::Result<usize, String> {
             let outside = || format!("the factor couples variables {i} and {j}, which the assembled energy does not");
@@ -259,13 +259,13 @@ impl Objective<Dd> for Normal<'_> {
             let at = |i: usize, j: usize| Banded::<Dd>::at(b, i.min(j), i.max(j));
             let band = banded.band_mut();
             band.copy_from_slice(&self.base);
+            // each row's entries are +1 and −1: `w a aᵀ` adds w on the diagonal, −w off it
             for (k, &wk) in w.iter().enumerate() {
-                let [c1, c2] = rows.cols[k];
-                let [a1, a2] = rows.vals[k];
-                band[at(c1, c1)] += wk * Dd::from(a1 * a1);
-                if rows.len[k] == 2 {
-                    band[at(c2, c2)] += wk * Dd::from(a2 * a2);
-                    band[at(c1, c2)] += wk * Dd::from(a1 * a2);
+                let ([c1, c2], _, len) = rows.row(k);
+                band[at(c1, c1)] += wk;
+                if len == 2 {
+                    band[at(c2, c2)] += wk;
+                    band[at(c1, c2)] -= wk;
                 }
             }
             // the same regularisation as the general factorisation's, if it must
@@ -282,11 +282,10 @@ impl Objective<Dd> for Normal<'_> {
         self.vals.copy_from_slice(&self.base);
         for (k, &wk) in w.iter().enumerate() {
             let [p1, p2, p12] = pattern.pos_row[k];
-            let [a1, a2] = rows.vals[k];
-            self.vals[p1] += wk * Dd::from(a1 * a1);
-            if rows.len[k] == 2 {
-                self.vals[p2] += wk * Dd::from(a2 * a2);
-                self.vals[p12] += wk * Dd::from(a1 * a2);
+            self.vals[p1] += wk;
+            if rows.row(k).2 == 2 {
+                self.vals[p2] += wk;
+                self.vals[p12] -= wk;
             }
         }
         if self.exact.is_some() {

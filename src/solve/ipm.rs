@@ -16,6 +16,7 @@
 use super::banded::Banded;
 use super::newton::{max, normal_band, Normal, Objective, Prepared, Real, Rows};
 use super::problem::ReducedQp;
+use super::problem::ABSENT;
 use super::settings::QpSettings;
 use super::status::{Outcome, SolveStatus};
 use crate::linalg as ordering;
@@ -147,13 +148,12 @@ fn fill_pattern(normal: &Normal, vals: &mut [f64], r: &ReducedQp, rows: &Rows, w
     for (k, &(_, _, v)) in r.p.iter().enumerate() {
         vals[normal.pos_p[k]] += v;
     }
-    for (k, &wk) in w.iter().enumerate() {
-        let [p1, p2, p12] = normal.pos_row[k];
-        let [a1, a2] = rows.vals[k];
-        vals[p1] += wk * a1 * a1;
-        if rows.len[k] == 2 {
-            vals[p2] += wk * a2 * a2;
-            vals[p12] += wk * a1 * a2;
+    // each row's entries are +1 and −1: `w a aᵀ` adds w on the diagonal, −w off it
+    for ((&wk, &[p1, p2, p12]), e) in w.iter().zip(&normal.pos_row).zip(rows.ends()) {
+        vals[p1] += wk;
+        if !e.contains(&ABSENT) {
+            vals[p2] += wk;
+            vals[p12] -= wk;
         }
     }
     if reg > 0.0 {
@@ -174,12 +174,11 @@ fn fill_band(banded: &mut Banded<f64>, r: &ReducedQp, rows: &Rows, w: &[f64], re
         band[at(i, j)] += v;
     }
     for (k, &wk) in w.iter().enumerate() {
-        let [c1, c2] = rows.cols[k];
-        let [a1, a2] = rows.vals[k];
-        band[at(c1, c1)] += wk * a1 * a1;
-        if rows.len[k] == 2 {
-            band[at(c2, c2)] += wk * a2 * a2;
-            band[at(c1, c2)] += wk * a1 * a2;
+        let ([c1, c2], _, len) = rows.row(k);
+        band[at(c1, c1)] += wk;
+        if len == 2 {
+            band[at(c2, c2)] += wk;
+            band[at(c1, c2)] -= wk;
         }
     }
     if reg > 0.0 {
@@ -276,12 +275,12 @@ pub(super) struct Assembly {
 impl Assembly {
     fn new(r: &ReducedQp) -> std::result::Result<Assembly, crate::error::NumericalError> {
         let rows = &r.rows;
-        if rows.len.len() != r.m() {
+        if rows.len() != r.m() {
             return Err("the reduced QP was made without its rows".into());
         }
         let normal = match normal_band(r, rows) {
             Some(b) => NormalForm::Band(b),
-            None => NormalForm::Pattern(Normal::new(r, &rows.cols, &rows.len)),
+            None => NormalForm::Pattern(Normal::new(r, rows)),
         };
         Ok(Assembly { normal })
     }
@@ -980,7 +979,7 @@ impl<T: Real> Newton<T> {
 /// The normal matrix's pattern [`solve`] analyses for `r`.
 #[cfg(test)]
 pub(crate) fn normal_pattern(r: &ReducedQp) -> faer::sparse::SymbolicSparseColMat<usize> {
-    Normal::new(r, &r.rows.cols, &r.rows.len).symbolic
+    Normal::new(r, &r.rows).symbolic
 }
 
 /// Coordinate descent on the gap bound `Σ max(s, 0) z + ½ Σ ρ²/d` over the multipliers
@@ -997,11 +996,10 @@ fn polish_multipliers<T: Real>(
     for _ in 0..sweeps {
         for k in 0..z.len() {
             let s = max(slack[k], zero);
-            let [c0, c1] = rows.cols[k];
-            let [v0, v1] = rows.vals[k];
+            let ([c0, c1], [v0, v1], len) = rows.row(k);
             let (mut grad, mut curv) =
                 (s + (T::of(v0) * rho[c0]).div_by(d[c0], inv_d[c0]), T::of(v0 * v0).div_by(d[c0], inv_d[c0]));
-            if rows.len[k] == 2 {
+            if len == 2 {
                 grad += (T::of(v1) * rho[c1]).div_by(d[c1], inv_d[c1]);
                 curv += T::of(v1 * v1).div_by(d[c1], inv_d[c1]);
             }
@@ -1010,7 +1008,7 @@ fn polish_multipliers<T: Real>(
             if delta != zero {
                 z[k] = new;
                 rho[c0] += T::of(v0) * delta;
-                if rows.len[k] == 2 {
+                if len == 2 {
                     rho[c1] += T::of(v1) * delta;
                 }
             }
@@ -1059,22 +1057,17 @@ mod tests {
             }
         }
         let mut rows = Rows::default();
-        let mut push = |cols: [usize; 2], vals: [f64; 2], len: u8| {
-            rows.cols.push(cols);
-            rows.vals.push(vals);
-            rows.len.push(len);
-        };
         for k in 0..n - 1 {
             let s = if (k / 5) % 2 == 0 { 1.0 } else { -1.0 };
-            push([k, k + 1], [s, -s], 2);
+            rows.push(&[(k, s), (k + 1, -s)]);
         }
         for c in [0, n / 2] {
-            push([c, c], [-1.0, 0.0], 1);
+            rows.push(&[(c, -1.0)]);
         }
         if let Some(w) = wide {
-            push([0, w], [1.0, -1.0], 2);
+            rows.push(&[(0, 1.0), (w, -1.0)]);
         }
-        let m = rows.len.len();
+        let m = rows.len();
         ReducedQp {
             n,
             p,
@@ -1099,7 +1092,7 @@ mod tests {
         let w: Vec<f64> = (0..r.m()).map(|k| 10f64.powf(((k * 37) % 17) as f64 - 8.0)).collect();
         let rhs: Vec<f64> = (0..n).map(|i| (i as f64 * 0.31).sin()).collect();
         // the pattern's way: values on the normal pattern, copied into the band by position
-        let normal = Normal::new(&r, &rows.cols, &rows.len);
+        let normal = Normal::new(&r, rows);
         assert_eq!(ordering::band(normal.symbolic.as_ref()), Some(2));
         let mut vals = vec![0.0; normal.symbolic.row_idx().len()];
         fill_pattern(&normal, &mut vals, &r, rows, &w, 0.0);

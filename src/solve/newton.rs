@@ -4,6 +4,7 @@
 
 use super::problem::ReducedQp;
 pub(super) use super::problem::Rows;
+use super::problem::ABSENT;
 use crate::linalg as ordering;
 use crate::linalg::double_double::Dd;
 use faer::sparse::{SymbolicSparseColMat, SymbolicSparseColMatRef};
@@ -43,18 +44,18 @@ fn upper_pattern(n: usize, pairs: impl Iterator<Item = (usize, usize)> + Clone) 
 }
 
 impl Normal {
-    pub(super) fn new(r: &ReducedQp, row_cols: &[[usize; 2]], row_len: &[u8]) -> Normal {
+    pub(super) fn new(r: &ReducedQp, constraint_rows: &Rows) -> Normal {
         let n = r.n;
-        let rows = row_cols.iter().zip(row_len).filter(|(_, &l)| l == 2).map(|(c, _)| (c[0].min(c[1]), c[0].max(c[1])));
+        let pairs = constraint_rows.ends().iter().filter(|e| !e.contains(&ABSENT));
+        let rows = pairs.map(|&[a, b]| (a.min(b) as usize, a.max(b) as usize));
         let (col_ptr, row_idx) = upper_pattern(n, r.p.iter().map(|&(i, j, _)| (i, j)).chain(rows));
         let find = |i: usize, j: usize| {
             col_ptr[j] + row_idx[col_ptr[j]..col_ptr[j + 1]].binary_search(&i).expect("in pattern")
         };
         let pos_p = r.p.iter().map(|&(i, j, _)| find(i, j)).collect();
-        let pos_row = row_cols
-            .iter()
-            .zip(row_len)
-            .map(|(c, &len)| {
+        let pos_row = (0..constraint_rows.len())
+            .map(|k| {
+                let (c, _, len) = constraint_rows.row(k);
                 if len == 2 {
                     [find(c[0], c[0]), find(c[1], c[1]), find(c[0].min(c[1]), c[0].max(c[1]))]
                 } else {
@@ -76,7 +77,7 @@ impl Normal {
 /// and its position tables held 1.5 GB).
 pub(super) fn normal_band(r: &ReducedQp, rows: &Rows) -> Option<usize> {
     let p = r.p.iter().map(|&(i, j, _)| i.abs_diff(j)).max().unwrap_or(0);
-    let a = rows.cols.iter().zip(&rows.len).filter(|(_, &l)| l == 2).map(|(c, _)| c[0].abs_diff(c[1])).max();
+    let a = rows.ends().iter().filter(|e| !e.contains(&ABSENT)).map(|&[a, b]| a.abs_diff(b) as usize).max();
     let b = p.max(a.unwrap_or(0));
     (b <= ordering::BANDED_MAX).then_some(b)
 }
@@ -155,6 +156,7 @@ pub(super) trait Real:
     + std::ops::Div<Output = Self>
     + std::ops::Neg<Output = Self>
     + std::ops::AddAssign
+    + std::ops::SubAssign
 {
     /// Whether [`Real::div_by`] uses its reciprocal (else the iteration keeps none: any
     /// vector of the right length stands in for it).
@@ -215,11 +217,14 @@ pub(super) fn max<T: Real>(a: T, b: T) -> T {
 impl Rows {
     /// `out = A x`.
     pub(super) fn ax<T: Real>(&self, x: &[T], out: &mut [T]) {
+        let ends = self.ends();
         crate::parallel::split_mut(out, |offset, out| {
-            for (k, o) in (offset..).zip(out.iter_mut()) {
-                let [c0, c1] = self.cols[k];
-                let [v0, v1] = self.vals[k];
-                *o = if self.len[k] == 2 { T::of(v0) * x[c0] + T::of(v1) * x[c1] } else { T::of(v0) * x[c0] };
+            for (o, &[a, b]) in out.iter_mut().zip(&ends[offset..]) {
+                *o = match (a, b) {
+                    (a, ABSENT) => x[a as usize],
+                    (ABSENT, b) => -x[b as usize],
+                    (a, b) => x[a as usize] - x[b as usize],
+                };
             }
         });
     }
@@ -227,12 +232,12 @@ impl Rows {
     /// `out = Aᵀ z`.
     pub(super) fn atz<T: Real>(&self, z: &[T], out: &mut [T]) {
         out.iter_mut().for_each(|v| *v = T::of(0.0));
-        for (k, &zk) in z.iter().enumerate() {
-            let [c0, c1] = self.cols[k];
-            let [v0, v1] = self.vals[k];
-            out[c0] += T::of(v0) * zk;
-            if self.len[k] == 2 {
-                out[c1] += T::of(v1) * zk;
+        for (&zk, &[a, b]) in z.iter().zip(self.ends()) {
+            if a != ABSENT {
+                out[a as usize] += zk;
+            }
+            if b != ABSENT {
+                out[b as usize] -= zk;
             }
         }
     }

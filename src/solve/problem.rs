@@ -130,35 +130,71 @@ pub struct ReducedQp {
     pub constant: f64,
 }
 
-/// The constraint rows of a reduced QP: one or two entries each (at 10⁷ rows, triplets of A
-/// beside these were 0.5 GB).
+/// The constraint rows of a reduced QP. Every row is an ordering constraint on an edge or a
+/// bound, so its entries are `+1` and `−1`: row `k` is `x[a] − x[b]` for `[a, b] = ends[k]`,
+/// one end [`ABSENT`] for a bound (`x[a]` or `−x[b]`). Eight bytes a row (at 10⁷ rows the
+/// columns, values and lengths stored apart were 330 MB, and every product with A read them).
 #[derive(Clone, Debug, Default)]
 pub struct Rows {
-    /// The columns of each row's entries (the second unused for a row of one entry).
-    pub cols: Vec<[usize; 2]>,
-    /// Their values.
-    pub vals: Vec<[f64; 2]>,
-    /// The number of entries, 1 or 2.
-    pub len: Vec<u8>,
+    ends: Vec<[u32; 2]>,
 }
 
+/// A row's missing end.
+pub const ABSENT: u32 = u32::MAX;
+
+/// The largest number of variables rows can index.
+pub const MAX_VARIABLES: usize = ABSENT as usize;
+
 impl Rows {
-    fn with_capacity(m: usize) -> Rows {
-        Rows { cols: Vec::with_capacity(m), vals: Vec::with_capacity(m), len: Vec::with_capacity(m) }
+    pub(super) fn with_capacity(m: usize) -> Rows {
+        Rows { ends: Vec::with_capacity(m) }
     }
 
-    fn push(&mut self, entries: &[(usize, f64)]) {
-        let (c1, v1) = entries[0];
-        let (c2, v2) = entries.get(1).copied().unwrap_or((c1, 0.0));
-        self.cols.push([c1, c2]);
-        self.vals.push([v1, v2]);
-        self.len.push(entries.len() as u8);
+    /// Appends the row with these entries: one or two, `+1` and `−1`, on variables below
+    /// [`MAX_VARIABLES`] (what the reduction makes).
+    pub(super) fn push(&mut self, entries: &[(usize, f64)]) {
+        let end =
+            |c: usize| u32::try_from(c).ok().filter(|&c| c != ABSENT).expect("a variable index below MAX_VARIABLES");
+        debug_assert!(
+            entries.iter().all(|e| e.1.abs() == 1.0) && (entries.len() == 1 || entries[0].1 == -entries[1].1)
+        );
+        let row = match *entries {
+            [(c, v)] if v > 0.0 => [end(c), ABSENT],
+            [(c, _)] => [ABSENT, end(c)],
+            [(c1, v1), (c2, _)] if v1 > 0.0 => [end(c1), end(c2)],
+            [(c1, _), (c2, _)] => [end(c2), end(c1)],
+            _ => unreachable!("a row has one or two entries"),
+        };
+        self.ends.push(row);
+    }
+
+    /// The number of rows.
+    pub fn len(&self) -> usize {
+        self.ends.len()
+    }
+
+    /// The ends `[a, b]` of every row (`x[a] − x[b]`, [`ABSENT`] for a missing one).
+    pub fn ends(&self) -> &[[u32; 2]] {
+        &self.ends
+    }
+
+    /// Row `k` as columns, values and length: `([a, b], [1, −1], 2)` for a pair, `([c, c],
+    /// [±1, 0], 1)` for a bound.
+    #[inline]
+    pub fn row(&self, k: usize) -> ([usize; 2], [f64; 2], usize) {
+        match self.ends[k] {
+            [a, ABSENT] => ([a as usize, a as usize], [1.0, 0.0], 1),
+            [ABSENT, b] => ([b as usize, b as usize], [-1.0, 0.0], 1),
+            [a, b] => ([a as usize, b as usize], [1.0, -1.0], 2),
+        }
     }
 
     /// Every entry as `(row, column, value)`, row by row.
     pub fn entries(&self) -> impl Iterator<Item = (usize, usize, f64)> + '_ {
-        (0..self.len.len())
-            .flat_map(move |k| (0..self.len[k] as usize).map(move |l| (k, self.cols[k][l], self.vals[k][l])))
+        (0..self.len()).flat_map(move |k| {
+            let (c, v, len) = self.row(k);
+            (0..len).map(move |l| (k, c[l], v[l]))
+        })
     }
 }
 

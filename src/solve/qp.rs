@@ -2,7 +2,9 @@
 //! assembled or the factored form, Clarabel as its fallback or on its own.
 
 use super::newton::Prepared;
-use super::problem::{constraint_rows, reduce, reduce_factor, reduce_with, rescale, MonotoneQp, ReducedQp};
+use super::problem::{
+    constraint_rows, reduce, reduce_factor, reduce_with, rescale, MonotoneQp, ReducedQp, MAX_VARIABLES,
+};
 use super::settings::{Formulation, Method, QpSettings, DOUBLE_DOUBLE_ABOVE, FACTORED_ABOVE};
 use super::status::{QpSolution, SolveStatus};
 use crate::error::Result;
@@ -35,6 +37,13 @@ pub fn solve_monotone_qp_with(
     assert_eq!(qp.fixed.len(), n);
     assert_eq!(qp.p.nrows(), n);
     let free: Vec<usize> = (0..n).filter(|&i| qp.fixed[i].is_none()).collect();
+    if free.len() > MAX_VARIABLES {
+        return Err(crate::error::Error::Input {
+            path: None,
+            at: None,
+            message: format!("{} free vertices: the solver takes at most {MAX_VARIABLES}", free.len()),
+        });
+    }
     let mut x: Vec<f64> = qp.fixed.iter().map(|f| f.unwrap_or(0.0)).collect();
     if free.is_empty() {
         return Ok(QpSolution {

@@ -25,11 +25,26 @@ pub fn value_range<'a>(values: impl IntoIterator<Item = &'a f64>) -> (f64, f64) 
 
 /// Vertex indices sorted ascending by (value, index): a total order, hence a topological
 /// order of every edge orientation defined by it.
+///
+/// A stable radix sort of the values' order-preserving bit patterns, the indices in
+/// increasing order to begin with (so ties stay in index order): at 10⁷ samples a comparison
+/// sort took 1.2 s, and a run sorts three fields. −0 sorts as +0 (equal values, as in
+/// [`sos_less`]).
 pub fn sos_sort(values: &[f64]) -> Vec<usize> {
-    let mut idx: Vec<usize> = (0..values.len()).collect();
-    // partial_cmp, as in `sos_less`: −0 and +0 are equal values, ordered by index
-    idx.sort_unstable_by(|&a, &b| values[a].partial_cmp(&values[b]).unwrap_or(Ordering::Equal).then(a.cmp(&b)));
-    idx
+    let mut keyed: Vec<(u64, usize)> = values.iter().enumerate().map(|(i, &v)| (order_key(v), i)).collect();
+    radsort::sort_by_key(&mut keyed, |&(key, _)| key);
+    keyed.into_iter().map(|(_, i)| i).collect()
+}
+
+/// A key whose unsigned order is the order of finite doubles, −0 and +0 equal.
+#[inline]
+fn order_key(v: f64) -> u64 {
+    let bits = (v + 0.0).to_bits(); // −0 + 0 = +0
+    if bits >> 63 == 1 {
+        !bits
+    } else {
+        bits | 1 << 63
+    }
 }
 
 /// Share of the gap to the next distinct value (the previous one for the top value) over
@@ -94,6 +109,31 @@ mod tests {
         let z = [0.0, -0.0, 0.0];
         assert_eq!(sos_sort(&z), vec![0, 1, 2]);
         assert!(sos_less(&z, 0, 1) && sos_less(&z, 1, 2));
+    }
+
+    #[test]
+    fn the_radix_order_is_the_comparison_order() {
+        // negatives, both zeros, subnormals, huge values and ties by the thousand
+        let mut state = 0x2545_F491_4F6C_DD1Du64;
+        let mut next = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            state
+        };
+        let special = [0.0, -0.0, 5e-324, -5e-324, f64::MIN_POSITIVE, -f64::MAX, f64::MAX, 1.0, -1.0];
+        let v: Vec<f64> = (0..20_000)
+            .map(|i| match next() % 4 {
+                0 => special[i % special.len()],
+                1 => (next() % 50) as f64 - 25.0,
+                2 => f64::from_bits(next() >> 2) * if next() % 2 == 0 { 1.0 } else { -1.0 },
+                _ => ((next() % 1000) as f64 - 500.0) * 1e-3,
+            })
+            .collect();
+        let mut expected: Vec<usize> = (0..v.len()).collect();
+        expected.sort_by(|&a, &b| v[a].partial_cmp(&v[b]).unwrap_or(Ordering::Equal).then(a.cmp(&b)));
+        assert_eq!(sos_sort(&v), expected);
+        assert!(expected.windows(2).all(|w| sos_less(&v, w[0], w[1])));
     }
 
     #[test]

@@ -195,8 +195,10 @@ const STEP_TOLERANCE: f64 = 1e-5;
 /// what it has (the bound has reached its rounding floor).
 const STALL_ITERATIONS: u32 = 8;
 /// Coordinate-descent sweeps over the multipliers per iteration (20 and 100 gave the same
-/// bound as 5 on the 300² benchmark grid, each about 5 × below the solver's own).
-const POLISH_SWEEPS: usize = 5;
+/// bound as 5 on the 300² benchmark grid, each about 5 × below the solver's own; 2 instead of
+/// 5 gave the same iterations on every case measured, bounds within 1–6 %, and a 10⁷-sample
+/// series' solve 38.7 → 33.2 s: docs/performance.md, "constants").
+const POLISH_SWEEPS: usize = 2;
 
 /// Solves the reduced QP; `Err(reason)` when it cannot (the caller falls back to Clarabel).
 ///

@@ -283,7 +283,7 @@ impl Objective<Dd> for Normal<'_> {
         for (k, &wk) in w.iter().enumerate() {
             let [p1, p2, p12] = pattern.pos_row[k];
             self.vals[p1] += wk;
-            if rows.row(k).2 == 2 {
+            if rows.is_pair(k) {
                 self.vals[p2] += wk;
                 self.vals[p12] -= wk;
             }

@@ -16,7 +16,6 @@
 use super::banded::Banded;
 use super::newton::{max, normal_band, Normal, Objective, Prepared, Real, Rows};
 use super::problem::ReducedQp;
-use super::problem::ABSENT;
 use super::settings::QpSettings;
 use super::status::{Outcome, SolveStatus};
 use crate::linalg as ordering;
@@ -149,9 +148,9 @@ fn fill_pattern(normal: &Normal, vals: &mut [f64], r: &ReducedQp, rows: &Rows, w
         vals[normal.pos_p[k]] += v;
     }
     // each row's entries are +1 and −1: `w a aᵀ` adds w on the diagonal, −w off it
-    for ((&wk, &[p1, p2, p12]), e) in w.iter().zip(&normal.pos_row).zip(rows.ends()) {
+    for (k, (&wk, &[p1, p2, p12])) in w.iter().zip(&normal.pos_row).enumerate() {
         vals[p1] += wk;
-        if !e.contains(&ABSENT) {
+        if rows.is_pair(k) {
             vals[p2] += wk;
             vals[p12] -= wk;
         }

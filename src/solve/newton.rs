@@ -46,8 +46,7 @@ fn upper_pattern(n: usize, pairs: impl Iterator<Item = (usize, usize)> + Clone) 
 impl Normal {
     pub(super) fn new(r: &ReducedQp, constraint_rows: &Rows) -> Normal {
         let n = r.n;
-        let pairs = constraint_rows.ends().iter().filter(|e| !e.contains(&ABSENT));
-        let rows = pairs.map(|&[a, b]| (a.min(b) as usize, a.max(b) as usize));
+        let rows = constraint_rows.pairs().map(|(a, b)| (a.min(b), a.max(b)));
         let (col_ptr, row_idx) = upper_pattern(n, r.p.iter().map(|&(i, j, _)| (i, j)).chain(rows));
         let find = |i: usize, j: usize| {
             col_ptr[j] + row_idx[col_ptr[j]..col_ptr[j + 1]].binary_search(&i).expect("in pattern")
@@ -77,7 +76,7 @@ impl Normal {
 /// and its position tables held 1.5 GB).
 pub(super) fn normal_band(r: &ReducedQp, rows: &Rows) -> Option<usize> {
     let p = r.p.iter().map(|&(i, j, _)| i.abs_diff(j)).max().unwrap_or(0);
-    let a = rows.ends().iter().filter(|e| !e.contains(&ABSENT)).map(|&[a, b]| a.abs_diff(b) as usize).max();
+    let a = rows.pairs().map(|(a, b)| a.abs_diff(b)).max();
     let b = p.max(a.unwrap_or(0));
     (b <= ordering::BANDED_MAX).then_some(b)
 }

@@ -178,6 +178,17 @@ impl Rows {
         &self.ends
     }
 
+    /// Whether row `k` has two entries (an edge, not a bound).
+    #[inline]
+    pub fn is_pair(&self, k: usize) -> bool {
+        !self.ends[k].contains(&ABSENT)
+    }
+
+    /// The ends `(a, b)` of the rows with two entries, in order.
+    pub fn pairs(&self) -> impl Iterator<Item = (usize, usize)> + Clone + '_ {
+        self.ends.iter().filter(|e| !e.contains(&ABSENT)).map(|&[a, b]| (a as usize, b as usize))
+    }
+
     /// Row `k` as columns, values and length: `([a, b], [1, −1], 2)` for a pair, `([c, c],
     /// [±1, 0], 1)` for a bound.
     #[inline]

@@ -38,11 +38,10 @@ pub fn solve_monotone_qp_with(
     assert_eq!(qp.p.nrows(), n);
     let free: Vec<usize> = (0..n).filter(|&i| qp.fixed[i].is_none()).collect();
     if free.len() > MAX_VARIABLES {
-        return Err(crate::error::Error::Input {
-            path: None,
-            at: None,
-            message: format!("{} free vertices: the solver takes at most {MAX_VARIABLES}", free.len()),
-        });
+        return Err(crate::error::Error::input(format!(
+            "{} free vertices: the solver takes at most {MAX_VARIABLES}",
+            free.len()
+        )));
     }
     let mut x: Vec<f64> = qp.fixed.iter().map(|f| f.unwrap_or(0.0)).collect();
     if free.is_empty() {

@@ -20,7 +20,7 @@ pub(super) fn solve(r: &ReducedQp, settings: &QpSettings) -> Result<Outcome> {
     }
     let (pi, pj, pv): (Vec<usize>, Vec<usize>, Vec<f64>) = {
         let mut a = (Vec::with_capacity(r.p.len()), Vec::with_capacity(r.p.len()), Vec::with_capacity(r.p.len()));
-        for &(i, j, v) in &r.p {
+        for (i, j, v) in r.p.entries() {
             a.0.push(i);
             a.1.push(j);
             a.2.push(v);

@@ -17,14 +17,7 @@ pub(super) fn estimate(r: &ReducedQp) -> Option<f64> {
     if !r.gap_bound || r.n == 0 {
         return None;
     }
-    Some(power(&r.d, |v, w| {
-        for &(i, j, p) in &r.p {
-            w[i] += p * v[j];
-            if i != j {
-                w[j] += p * v[i];
-            }
-        }
-    }))
+    Some(power(&r.d, |v, w| r.p.add_product(v, w)))
 }
 
 /// `estimate` on the free block of a full `P` (upper and lower triangle stored) with data

@@ -15,7 +15,7 @@
 
 use super::banded::Banded;
 use super::newton::{max, normal_band, Normal, Objective, Prepared, Real, Rows};
-use super::problem::ReducedQp;
+use super::problem::{ReducedQp, UpperP};
 use super::settings::QpSettings;
 use super::status::{Outcome, SolveStatus};
 use crate::linalg as ordering;
@@ -75,12 +75,7 @@ impl Factorised {
 impl Objective<f64> for Assembled<'_> {
     fn gradient(&mut self, x: &[f64], out: &mut [f64]) {
         out.iter_mut().zip(&self.r.q).for_each(|(o, q)| *o = *q);
-        for &(i, j, v) in &self.r.p {
-            out[i] += v * x[j];
-            if i != j {
-                out[j] += v * x[i];
-            }
-        }
+        self.r.p.add_product(x, out);
     }
 
     /// With a growing diagonal shift if the matrix is not numerically positive definite.
@@ -144,7 +139,7 @@ enum Energy {
 /// entry sums P's triplets, then the rows' products, in their order.
 fn fill_pattern(normal: &Normal, vals: &mut [f64], r: &ReducedQp, rows: &Rows, w: &[f64], reg: f64) {
     vals.iter_mut().for_each(|v| *v = 0.0);
-    for (k, &(_, _, v)) in r.p.iter().enumerate() {
+    for (k, (_, _, v)) in r.p.entries().enumerate() {
         vals[normal.pos_p[k]] += v;
     }
     // each row's entries are +1 and −1: `w a aᵀ` adds w on the diagonal, −w off it
@@ -168,9 +163,15 @@ fn fill_band(banded: &mut Banded<f64>, r: &ReducedQp, rows: &Rows, w: &[f64], re
     let b = banded.width();
     let at = |i: usize, j: usize| Banded::<f64>::at(b, i.min(j), i.max(j));
     let band = banded.band_mut();
-    band.iter_mut().for_each(|v| *v = 0.0);
-    for &(i, j, v) in &r.p {
-        band[at(i, j)] += v;
+    match &r.p {
+        // the same layout: each entry is 0 + its value, as summed from triplets
+        UpperP::Band { width, values } if *width == b => band.copy_from_slice(values),
+        p => {
+            band.iter_mut().for_each(|v| *v = 0.0);
+            for (i, j, v) in p.entries() {
+                band[at(i, j)] += v;
+            }
+        }
     }
     for (k, &wk) in w.iter().enumerate() {
         let ([c1, c2], _, len) = rows.row(k);
@@ -1071,7 +1072,7 @@ mod tests {
         let m = rows.len();
         ReducedQp {
             n,
-            p,
+            p: UpperP::Triplets(p),
             q: vec![0.0; n],
             rows,
             b: vec![0.0; m],
@@ -1115,12 +1116,7 @@ mod tests {
         assert!(got.iter().zip(&expected).all(|(a, b)| a.to_bits() == b.to_bits()));
         // and it solves the matrix: N x = rhs checked through the rows and P
         let mut nx = vec![0.0; n];
-        for &(i, j, v) in &r.p {
-            nx[i] += v * got[j];
-            if i != j {
-                nx[j] += v * got[i];
-            }
-        }
+        r.p.add_product(&got, &mut nx);
         let mut ax = vec![0.0; r.m()];
         rows.ax(&got, &mut ax);
         let wax: Vec<f64> = ax.iter().zip(&w).map(|(a, w)| a * w).collect();
@@ -1133,5 +1129,55 @@ mod tests {
         assert_eq!(normal_band(&wide, &wide.rows), None);
         let edge = path_qp(n, Some(ordering::BANDED_MAX));
         assert_eq!(normal_band(&edge, &edge.rows), Some(ordering::BANDED_MAX));
+    }
+
+    #[test]
+    fn p_as_its_band_gives_the_triplets_entries_products_and_normal_band_bit_for_bit() {
+        let n = 300;
+        let r = path_qp(n, None);
+        let UpperP::Triplets(t) = &r.p else { unreachable!("path_qp makes triplets") };
+        let mut values = vec![0.0; n * 3];
+        for &(i, j, v) in t {
+            values[Banded::<f64>::at(2, i, j)] += v;
+        }
+        let banded = ReducedQp { p: UpperP::Band { width: 2, values }, ..path_qp(n, None) };
+        assert_eq!(banded.p.len(), t.len());
+        assert_eq!(banded.p.width(), 2);
+        assert!(banded.p.entries().eq(t.iter().copied()));
+        let x: Vec<f64> = (0..n).map(|i| (i as f64 * 0.7).cos() * 1e3).collect();
+        let (mut a, mut b) = (vec![0.25; n], vec![0.25; n]);
+        r.p.add_product(&x, &mut a);
+        banded.p.add_product(&x, &mut b);
+        assert!(a.iter().zip(&b).all(|(a, b)| a.to_bits() == b.to_bits()));
+        let w: Vec<f64> = (0..r.m()).map(|k| 10f64.powf(((k * 37) % 17) as f64 - 8.0)).collect();
+        let (mut fa, mut fb) = (Banded::<f64>::of_band(n, 2), Banded::<f64>::of_band(n, 2));
+        fill_band(&mut fa, &r, &r.rows, &w, 1e-9);
+        fill_band(&mut fb, &banded, &banded.rows, &w, 1e-9);
+        assert!(fa.band_mut().iter().zip(fb.band_mut().iter()).all(|(a, b)| a.to_bits() == b.to_bits()));
+        // a wider normal band (a row spanning 5 places) places P's band inside it
+        let (rw, bw) = (path_qp(n, Some(5)), ReducedQp { p: banded.p.clone(), ..path_qp(n, Some(5)) });
+        assert_eq!((normal_band(&rw, &rw.rows), normal_band(&bw, &bw.rows)), (Some(5), Some(5)));
+        let w: Vec<f64> = (0..rw.m()).map(|k| 1.0 + k as f64).collect();
+        let (mut fa, mut fb) = (Banded::<f64>::of_band(n, 5), Banded::<f64>::of_band(n, 5));
+        fill_band(&mut fa, &rw, &rw.rows, &w, 0.0);
+        fill_band(&mut fb, &bw, &bw.rows, &w, 0.0);
+        assert!(fa.band_mut().iter().zip(fb.band_mut().iter()).all(|(a, b)| a.to_bits() == b.to_bits()));
+        // long enough to be split over threads: the same bits on 1, 2 and 3
+        let n = 3 * crate::parallel::SPLIT_FROM + 7;
+        let r = path_qp(n, None);
+        let UpperP::Triplets(t) = &r.p else { unreachable!("path_qp makes triplets") };
+        let mut values = vec![0.0; n * 3];
+        for &(i, j, v) in t {
+            values[Banded::<f64>::at(2, i, j)] += v;
+        }
+        let banded = UpperP::Band { width: 2, values };
+        let x: Vec<f64> = (0..n).map(|i| (i as f64 * 0.37).sin() * 1e2 + 1e-3 * i as f64).collect();
+        let mut expected = vec![-0.5; n];
+        r.p.add_product(&x, &mut expected);
+        for threads in [1, 2, 3] {
+            let mut got = vec![-0.5; n];
+            crate::parallel::with_threads(threads, || banded.add_product(&x, &mut got));
+            assert!(got.iter().zip(&expected).all(|(a, b)| a.to_bits() == b.to_bits()), "{threads} threads");
+        }
     }
 }

@@ -47,11 +47,11 @@ impl Normal {
     pub(super) fn new(r: &ReducedQp, constraint_rows: &Rows) -> Normal {
         let n = r.n;
         let rows = constraint_rows.pairs().map(|(a, b)| (a.min(b), a.max(b)));
-        let (col_ptr, row_idx) = upper_pattern(n, r.p.iter().map(|&(i, j, _)| (i, j)).chain(rows));
+        let (col_ptr, row_idx) = upper_pattern(n, r.p.entries().map(|(i, j, _)| (i, j)).chain(rows));
         let find = |i: usize, j: usize| {
             col_ptr[j] + row_idx[col_ptr[j]..col_ptr[j + 1]].binary_search(&i).expect("in pattern")
         };
-        let pos_p = r.p.iter().map(|&(i, j, _)| find(i, j)).collect();
+        let pos_p = r.p.entries().map(|(i, j, _)| find(i, j)).collect();
         let pos_row = (0..constraint_rows.len())
             .map(|k| {
                 let (c, _, len) = constraint_rows.row(k);
@@ -75,7 +75,7 @@ impl Normal {
 /// that a banded normal matrix is assembled straight into its band (at 10⁷ samples the pattern
 /// and its position tables held 1.5 GB).
 pub(super) fn normal_band(r: &ReducedQp, rows: &Rows) -> Option<usize> {
-    let p = r.p.iter().map(|&(i, j, _)| i.abs_diff(j)).max().unwrap_or(0);
+    let p = r.p.width();
     let a = rows.pairs().map(|(a, b)| a.abs_diff(b)).max();
     let b = p.max(a.unwrap_or(0));
     (b <= ordering::BANDED_MAX).then_some(b)

@@ -268,6 +268,7 @@ pub fn prepare(
 
 #[cfg(test)]
 mod tests {
+    use super::super::problem::UpperP;
     use super::*;
     use faer::sparse::Triplet;
 
@@ -304,6 +305,24 @@ mod tests {
         (p, edges, q, fixed)
     }
 
+    /// [`wave_qp`]'s problem with a data term, its condition given (known: the active set's
+    /// reduced QP is made without triplets).
+    fn with_data<'a>(wave: &'a Wave, data: &'a [f64]) -> MonotoneQp<'a> {
+        let (p, edges, q, fixed) = wave;
+        MonotoneQp {
+            p,
+            q,
+            fixed,
+            edges,
+            margin: 1e-6,
+            hint: None,
+            bounds: &[],
+            data: Some(data),
+            factor: None,
+            condition: Some(1.0),
+        }
+    }
+
     #[test]
     fn a_banded_energy_is_not_prepared_and_a_grid_s_is() {
         // a path's P = K + I is tridiagonal: the solver factorises its normal matrix by the band
@@ -311,6 +330,47 @@ mod tests {
         assert!(prepare(&path, &[None; 40], None).unwrap().is_none());
         let (grid, _) = grid_qp(12, 10);
         assert!(prepare(&grid, &[None; 120], None).unwrap().is_some());
+    }
+
+    #[test]
+    fn a_banded_p_is_reduced_to_its_band_and_a_grid_s_to_triplets() {
+        // the free upper triangle of P, scaled as the reduction scales it, entry by entry
+        let expected = |p: &Sparse, free: &[usize], scale: f64| {
+            let (cp, ri, val) = (p.symbolic().col_ptr(), p.symbolic().row_idx(), p.val());
+            let mut e = Vec::new();
+            for (sj, &j) in free.iter().enumerate() {
+                for k in cp[j]..cp[j + 1] {
+                    if let Ok(si) = free.binary_search(&ri[k]) {
+                        if si <= sj {
+                            e.push((si, sj, val[k] / scale));
+                        }
+                    }
+                }
+            }
+            e
+        };
+        for (nx, ny) in [(40, 1), (12, 5)] {
+            let mut wave = wave_qp(nx, ny);
+            // a fixed vertex inside: its neighbours become neighbours in the reduced numbering
+            wave.3[nx * ny / 2] = Some(0.5);
+            let data = vec![0.5; nx * ny];
+            let qp = MonotoneQp { condition: None, ..with_data(&wave, &data) };
+            let (p, fixed) = (&wave.0, &wave.3);
+            let free: Vec<usize> = (0..nx * ny).filter(|&i| fixed[i].is_none()).collect();
+            let r = reduce(&qp, &free);
+            let want = expected(p, &free, r.scale);
+            let got: Vec<_> = r.p.entries().filter(|e| e.2 != 0.0).collect();
+            assert_eq!(got, want);
+            match (&r.p, ny) {
+                (UpperP::Band { width: 1, values }, 1) => assert_eq!(values.len(), 2 * free.len()),
+                (UpperP::Triplets(t), 5) => assert_eq!(t.len(), r.p.len()),
+                (other, _) => panic!("{nx}×{ny}: {other:?}"),
+            }
+            // the band's places without an entry (beside the fixed vertex) are the only zeros
+            assert_eq!(r.p.len() - got.len(), if ny == 1 { 1 } else { 0 });
+            // made for the active set: no entries in either form
+            assert_eq!(reduce_with(&qp, &free, false).0.p.len(), 0);
+        }
     }
 
     #[test]
@@ -364,29 +424,17 @@ mod tests {
     fn a_hand_over_from_the_active_set_solves_the_rebuilt_problem() {
         let (nx, ny) = (30, 20);
         let n = nx * ny;
-        let (p, edges, q, fixed) = wave_qp(nx, ny);
+        let wave = wave_qp(nx, ny);
         let mut data = vec![1.0; n];
         data[n / 2] = 0.0;
-        let qp = MonotoneQp {
-            p: &p,
-            q: &q,
-            fixed: &fixed,
-            edges: &edges,
-            margin: 1e-6,
-            hint: None,
-            bounds: &[],
-            data: Some(&data),
-            factor: None,
-            // known: the active set's reduced QP is made without triplets
-            condition: Some(1.0),
-        };
+        let qp = with_data(&wave, &data);
         let run = |method| solve_monotone_qp(&qp, &QpSettings { method, ..QpSettings::default() }).unwrap();
         let (handed, direct) = (run(Method::ActiveSet), run(Method::Structured));
         assert!(handed.fallback.as_deref().is_some_and(|f| f.contains("data term")), "{:?}", handed.fallback);
         assert_eq!(handed.method, Method::Structured);
         assert_eq!(handed.x, direct.x);
         assert_eq!(handed.iterations, direct.iterations);
-        assert!(edges.iter().all(|&(i, j)| handed.x[j] - handed.x[i] >= 0.5e-6));
+        assert!(wave.1.iter().all(|&(i, j)| handed.x[j] - handed.x[i] >= 0.5e-6));
     }
 
     type Chain = (Sparse, [f64; 4], [Option<f64>; 4], [(usize, usize); 3]);

@@ -346,7 +346,8 @@ fn starting_point<T: Real, O: Objective<T>>(rows: &Rows, objective: &mut O, x: V
     let mut g = vec![zero; n];
     objective.gradient(&x, &mut g);
     let gmean = g.iter().map(|a| a.to_f64().abs()).sum::<f64>() / n.max(1) as f64;
-    let z0 = (3.0 * gmean).max(1e-12);
+    let path = path_multiplier_scale(rows, &g).map_or(0.0, |y| PATH_MULTIPLIER_SHARE * y);
+    let z0 = (3.0 * gmean).max(path).max(1e-12);
     let mut z = vec![of(z0); m];
     let smin = s.iter().map(|v| v.to_f64()).fold(f64::INFINITY, f64::min);
     if smin <= 0.0 {
@@ -357,6 +358,53 @@ fn starting_point<T: Real, O: Objective<T>>(rows: &Rows, objective: &mut O, x: V
     s.iter_mut().for_each(|v| *v += of(0.5 * sz / zsum));
     z.iter_mut().for_each(|v| *v += of(0.5 * sz / ssum));
     Iterate { x, s, z }
+}
+
+/// The share of [`path_multiplier_scale`] the starting multipliers take at least. A walk of
+/// 10⁷ samples at a smoothing length of 20 samples has multipliers at its optimum 30 × the mean
+/// gradient at u (the sums of the gradient over terraces thousands of samples long), where
+/// 3 × took 19 iterations, 10 steps below 0.3 at first; from 0.03, 0.1 and 0.3 of the scale
+/// (0.3 × = 130 × the mean gradient) 14, 12 and 12. On the bench series, EUR/USD, a 10⁶ walk
+/// and a tie-heavy sensor series the scale × 0.1 is below 0.06 × the mean gradient and changes
+/// nothing (docs/performance.md, "constants").
+const PATH_MULTIPLIER_SHARE: f64 = 0.1;
+
+/// On a path (every row with two ends joins consecutive variables: a series), the mean size of
+/// the multipliers that balance the gradient `g` at the start on their own: along each run of
+/// variables joined by rows, stationarity makes the multiplier of the row after variable `i`
+/// the gradient summed over the run up to `i` plus a constant, taken here as the one that
+/// centres the sums (the run's end rows to fixed neighbours take up the rest). `None` off a
+/// path.
+fn path_multiplier_scale<T: Real>(rows: &Rows, g: &[T]) -> Option<f64> {
+    let n = g.len();
+    // per variable, whether a row joins it to the next one
+    let mut joined = vec![false; n];
+    for (a, b) in rows.pairs() {
+        if a.abs_diff(b) != 1 {
+            return None;
+        }
+        joined[a.min(b)] = true;
+    }
+    let (mut total, mut count) = (0.0, 0usize);
+    let mut run: Vec<f64> = Vec::new();
+    let mut centre = |run: &mut Vec<f64>| {
+        let mean = run.iter().sum::<f64>() / run.len().max(1) as f64;
+        total += run.iter().map(|y| (y - mean).abs()).sum::<f64>();
+        count += run.len();
+        run.clear();
+    };
+    let mut sum = 0.0;
+    for (i, &joined) in joined.iter().enumerate() {
+        sum += g[i].to_f64();
+        if joined {
+            run.push(sum);
+        } else {
+            centre(&mut run);
+            sum = 0.0;
+        }
+    }
+    centre(&mut run);
+    (count > 0).then(|| total / count as f64)
 }
 
 /// The residuals of an iterate: dual `rd = ∇φ + Aᵀz`, primal `rp = Ax + s − b`, the true
@@ -1047,6 +1095,27 @@ mod tests {
         // a few rows of a small problem: no crossing allowed, the largest step as before
         let a = predictor_step(&[1.0, 1.0], &[-4.0, 1.0], &[1.0, 1.0], &[0.0, 0.0]);
         assert!(a <= 0.25 && a > 0.25 * (1.0 - 1.0 / 64.0), "{a}");
+    }
+
+    #[test]
+    fn the_path_multipliers_scale_is_the_centred_runs_sums_mean() {
+        let mut rows = Rows::default();
+        // runs 0–1–2 and 3–4 (no row between 2 and 3), a bound on 2, orientations mixed
+        rows.push(&[(0, 1.0), (1, -1.0)]);
+        rows.push(&[(2, 1.0), (1, -1.0)]);
+        rows.push(&[(2, -1.0)]);
+        rows.push(&[(3, 1.0), (4, -1.0)]);
+        let g = [1.0, 1.0, 1.0, 2.0, 2.0];
+        // rows after 0, 1 and 3: sums 1, 2 (centred ∓0.5) and 2 (centred 0): 1 / 3
+        let scale = path_multiplier_scale(&rows, &g).unwrap();
+        assert!((scale - 1.0 / 3.0).abs() < 1e-15, "{scale}");
+        // a row across two places is not a path's
+        rows.push(&[(0, 1.0), (2, -1.0)]);
+        assert_eq!(path_multiplier_scale(&rows, &g), None);
+        // bounds alone: no run
+        let mut bounds = Rows::default();
+        bounds.push(&[(0, 1.0)]);
+        assert_eq!(path_multiplier_scale(&bounds, &g), None);
     }
 
     /// A reduced QP on a path of `n` variables: a pentadiagonal P (the upper triangle, sorted by

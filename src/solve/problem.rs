@@ -2,6 +2,7 @@
 //! bounds) and as the solvers see it (`ReducedQp`: the free variables only, one row per
 //! constraint).
 
+use super::banded::Banded;
 use crate::linalg::double_double::Dd;
 use crate::operators::{Factor, Sparse};
 
@@ -138,10 +139,16 @@ pub struct ReducedQp {
 pub enum UpperP {
     /// `(row, column, value)`, sorted by column then row.
     Triplets(Vec<(usize, usize, f64)>),
-    /// The entry `(i, j)`, `j − width ≤ i ≤ j`, at `j·(width + 1) + width − (j − i)` (the
-    /// layout of the structured solver's band); a place where P has no entry holds 0, one
+    /// The entry `(i, j)`, `j − width ≤ i ≤ j`, at [`place`] (the layout of the structured
+    /// solver's band); a place where P has no entry holds 0, one
     /// before the first row (`i < 0`) is never read.
     Band { width: usize, values: Vec<f64> },
+}
+
+/// Where the entry `(i, j)`, `i ≤ j ≤ i + width`, is in [`UpperP::Band`]'s values: the
+/// structured solver's band layout ([`Banded::at`]).
+fn place(width: usize, i: usize, j: usize) -> usize {
+    Banded::<f64>::at(width, i, j)
 }
 
 impl Default for UpperP {
@@ -160,7 +167,7 @@ impl UpperP {
         };
         triplets.iter().copied().chain(band.into_iter().flat_map(|(w, values)| {
             (0..values.len() / (w + 1))
-                .flat_map(move |j| (j.saturating_sub(w)..=j).map(move |i| (i, j, values[j * (w + 1) + w - (j - i)])))
+                .flat_map(move |j| (j.saturating_sub(w)..=j).map(move |i| (i, j, values[place(w, i, j)])))
         }))
     }
 
@@ -202,7 +209,7 @@ impl UpperP {
                 // the columns after it): the same sums, on contiguous pieces one a thread
                 let w = *width;
                 let n = values.len() / (w + 1);
-                let at = |i: usize, j: usize| values[j * (w + 1) + w - (j - i)];
+                let at = |i: usize, j: usize| values[place(w, i, j)];
                 crate::parallel::split_mut(out, |offset, out| {
                     for (o, i) in out.iter_mut().zip(offset..) {
                         let mut sum = *o;
@@ -357,7 +364,7 @@ pub(super) fn reduce_with(qp: &MonotoneQp<'_>, free: &[usize], triplets: bool) -
                 (si, sj) if si <= sj => {
                     upper += 1;
                     match (&mut band, width) {
-                        (Some(band), Some(w)) => band[sj * (w + 1) + w - (sj - si)] += val[k],
+                        (Some(band), Some(w)) => band[place(w, si, sj)] += val[k],
                         _ if triplets => p.push((si, sj, val[k])),
                         _ if si == sj => diag.push(val[k]),
                         _ => {}

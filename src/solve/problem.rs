@@ -2,7 +2,6 @@
 //! bounds) and as the solvers see it (`ReducedQp`: the free variables only, one row per
 //! constraint).
 
-use super::banded::Banded;
 use crate::linalg::double_double::Dd;
 use crate::operators::{Factor, Sparse};
 
@@ -145,10 +144,12 @@ pub enum UpperP {
     Band { width: usize, values: Vec<f64> },
 }
 
-/// Where the entry `(i, j)`, `i ≤ j ≤ i + width`, is in [`UpperP::Band`]'s values: the
-/// structured solver's band layout ([`Banded::at`]).
+/// Where the entry `(i, j)`, `i ≤ j ≤ i + width`, is in [`UpperP::Band`]'s values: column by
+/// column, `width + 1` places each, the diagonal last — the structured solver's band layout
+/// (`solve::banded`, which depends on this module; the two are tested equal in `solve::ipm`).
+#[inline]
 fn place(width: usize, i: usize, j: usize) -> usize {
-    Banded::<f64>::at(width, i, j)
+    j * (width + 1) + width - (j - i)
 }
 
 impl Default for UpperP {

@@ -7,7 +7,7 @@ use toposmooth::constraints::EdgeSet;
 use toposmooth::domain::Series;
 use toposmooth::operators::Energy;
 use toposmooth::pipeline::{smooth, SmoothSettings};
-use toposmooth::solve::{Method, QpSettings};
+use toposmooth::solve::{Method, QpSettings, SolveStatus};
 use toposmooth::topology::{Role, Selection};
 
 fn run(h: &[f64], selection: Selection) -> toposmooth::pipeline::Smoothed {
@@ -416,4 +416,60 @@ fn a_free_end_stays_inside_the_data() {
     let best = qp.solve(&feasible_start(&h, &out.roles, out.report.settings.margin[0]));
     assert!((best.f[n - 1] - hi).abs() < 1e-9, "the bound is active at the optimum: {}", best.f[n - 1]);
     assert!(qp.excess(&out.output, &best) <= out.report.fit.gap.unwrap() * (1.0 + 1e-6) + 1e-12);
+}
+
+/// Found by the property test: 54–57 samples of five levels, 7 pairs, k = 4 at ℓ = 0.2 of the
+/// series (condition 4–6·10¹⁰, the factored form). The interior point's gap bound reached its
+/// rounding floor, 1.5·10⁻⁶–4.6·10⁻⁵ of the data term (multipliers of 3–7·10⁹ in units where
+/// the data diagonal is 1), with barrier weights past 10²⁶; stepping on, the bound grew by
+/// 10⁴–10¹⁴ within three steps and never came back, and Clarabel, taking over, declared the
+/// feasible problem infeasible. The best point on the floor is kept and returned: its bound
+/// valid and below 10⁻⁴ of the data term, and a run stopped short of the target says so.
+#[test]
+fn the_best_point_on_the_rounding_floor_is_kept_when_the_steps_break_down() {
+    for levels in [
+        &[
+            4, 0, 4, 1, 0, 1, 2, 1, 4, 1, 1, 3, 3, 2, 2, 4, 1, 1, 1, 0, 0, 3, 0, 4, 1, 2, 0, 1, 4, 2, 1, 3, 1, 1, 2, 0,
+            3, 0, 1, 4, 3, 0, 1, 4, 1, 2, 4, 2, 2, 4, 1, 0, 4, 0,
+        ][..],
+        &[
+            4, 0, 4, 0, 0, 2, 3, 2, 4, 1, 1, 4, 3, 2, 1, 1, 4, 1, 3, 3, 0, 1, 3, 0, 4, 4, 1, 2, 0, 3, 4, 2, 1, 3, 1, 3,
+            2, 0, 3, 0, 1, 4, 3, 0, 1, 4, 1, 2, 4, 2, 2, 4, 1, 0, 4, 0,
+        ][..],
+        &[
+            4, 0, 4, 1, 0, 2, 3, 4, 1, 4, 1, 1, 2, 3, 1, 2, 1, 4, 1, 3, 3, 0, 1, 3, 0, 4, 4, 1, 2, 0, 1, 4, 2, 1, 3, 1,
+            3, 2, 0, 3, 0, 1, 4, 3, 0, 1, 4, 1, 2, 4, 2, 2, 4, 1, 0, 4, 0,
+        ][..],
+        &[
+            4, 0, 4, 1, 0, 2, 3, 4, 2, 4, 1, 1, 4, 3, 1, 2, 1, 4, 1, 3, 3, 0, 1, 3, 0, 4, 4, 1, 2, 0, 3, 4, 2, 1, 3, 1,
+            3, 2, 0, 3, 0, 1, 4, 2, 0, 1, 4, 1, 2, 2, 2, 2, 4, 1, 0, 4, 0,
+        ][..],
+    ] {
+        let h: Vec<f64> = levels.iter().map(|&v| f64::from(v)).collect();
+        stops_at_a_valid_bound(&h);
+    }
+}
+
+fn stops_at_a_valid_bound(h: &[f64]) {
+    let series = Series::uniform(h.len());
+    let settings = SmoothSettings {
+        selection: Selection::Pairs(7),
+        energy: Energy::order(4),
+        smooth_length: Some(0.2),
+        ..Default::default()
+    };
+    let out = smooth(&series, h, &settings).expect("certified");
+    assert_exact(h, &out);
+    assert!(out.report.solver_fallback.is_none(), "{:?}", out.report.solver_fallback);
+    let fit = &out.report.fit;
+    assert_eq!(fit.formulation, toposmooth::solve::Formulation::Factored);
+    let qp = reference_of(series.x(), h, &out);
+    let best = qp.solve(&feasible_start(h, &out.roles, out.report.settings.margin[0]));
+    let (excess, data) = (qp.excess(&out.output, &best), qp.data_term(&out.output));
+    let gap = fit.gap.expect("a data term everywhere");
+    assert!(excess <= gap * (1.0 + 1e-6), "J − J* = {excess:e} > Ĝ = {gap:e}");
+    assert!(gap <= 1e-4 * data, "Ĝ = {gap:e}, data term {data:e}");
+    let short = out.report.warnings.iter().any(|w| w.contains("stopped short of its target"));
+    let solved = matches!(out.report.solver_status, SolveStatus::Solved | SolveStatus::AlmostSolved);
+    assert!(short != solved, "{:?}: {:?}", out.report.solver_status, out.report.warnings);
 }

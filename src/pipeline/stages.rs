@@ -17,7 +17,7 @@ use crate::operators::{
 };
 use crate::solve::{
     condition_estimate, meet_margin, repair, Bound, Formulation, MarginSummary, Method, QpSolution, RepairSummary,
-    FACTORED_ABOVE,
+    SolveStatus, FACTORED_ABOVE,
 };
 use crate::topology::morse_smale::MorseSmale;
 use crate::topology::{KeptSet, Role};
@@ -327,6 +327,17 @@ impl Run<'_> {
                 "{:.0} % of the free vertices sit on an active constraint (largest terrace {} vertices): where the smoothing fights the constraints, lower the smoothing length; where the selection cancels large features, the output is held flat there by design",
                 100.0 * constraint_activity.active_fraction,
                 constraint_activity.largest_terrace
+            ));
+        }
+        if matches!(self.sol.status, SolveStatus::Stalled | SolveStatus::MaxIterations) {
+            let bound = match (fit.gap_over_data, fit.gap_over_energy) {
+                (Some(g), _) => format!("{g:.1e} × the data term"),
+                (None, Some(g)) => format!("{g:.1e} × the energy"),
+                (None, None) => "not bounded".into(),
+            };
+            warnings.push(format!(
+                "the solver stopped short of its target ({:?} after {} iterations): the topology is certified, the fit is optimal only to its gap bound ({bound}, target {:.0e})",
+                self.sol.status, self.sol.iterations, settings.qp.gap_tolerance
             ));
         }
         let smoothness = quadratic_form_without_diagonal(&ops.p, &ops.data_diag, f);

@@ -194,6 +194,14 @@ const STEP_TOLERANCE: f64 = 1e-5;
 /// Iterations without a halving of the best gap bound after which the solver stops with
 /// what it has (the bound has reached its rounding floor).
 const STALL_ITERATIONS: u32 = 8;
+
+/// The complementarity's share of the gap bound below which the bound sits on its rounding
+/// floor (the dual residual's part, which further steps cannot lower): from there the best point
+/// is kept, and returned if the steps break down or stall.
+const FLOOR_COMPLEMENTARITY: f64 = 1e-2;
+
+/// The growth of the gap bound over the best point kept that counts as a breakdown.
+const BREAKDOWN_GROWTH: f64 = 1e3;
 /// Coordinate-descent sweeps over the multipliers per iteration (20 and 100 gave the same
 /// bound as 5 on the 300² benchmark grid, each about 5 × below the solver's own; 2 instead of
 /// 5 gave the same iterations on every case measured, bounds within 1–6 %, and a 10⁷-sample
@@ -307,8 +315,9 @@ pub(super) fn predicted_bytes(
     }
     let assembly = Assembly::new(r)?;
     let (n, m) = (r.n as u64, r.m() as u64);
-    // about 14 vectors of n and 18 of m in the iteration (the rows are the reduced QP's)
-    let vectors = 8 * (14 * n + 18 * m);
+    // about 14 vectors of n and 18 of m in the iteration (the rows are the reduced QP's), one
+    // of each more for the best point on the gap bound's rounding floor
+    let vectors = 8 * (15 * n + 19 * m);
     let matrix_bytes = match &assembly.normal {
         // the band's own LDLᵀ: the band, L and 1/D (n·(b + 1), n·b and n values)
         NormalForm::Band(b) => 8 * n * (2 * *b as u64 + 2),
@@ -454,6 +463,11 @@ impl<T> Copy for At<'_, T> {}
 struct Progress {
     best_gap: f64,
     best_at: u32,
+    /// The last test's gap bound and its target.
+    gap: f64,
+    target: f64,
+    /// Whether the last bound sat on its rounding floor (see [`FLOOR_COMPLEMENTARITY`]).
+    on_floor: bool,
     /// The first gap (relative to its target's base): where the reported fraction starts.
     first: Option<f64>,
 }
@@ -481,6 +495,36 @@ struct Targets<'r, T: Clone> {
     inv_d: Cow<'r, [T]>,
     q_free: Cow<'r, [T]>,
     d_sum: f64,
+}
+
+/// The best point on the gap bound's rounding floor: `x`, its polished multipliers, its bound
+/// and the bound's target.
+struct BestPoint<T> {
+    x: Vec<T>,
+    z: Vec<T>,
+    gap: f64,
+    target: f64,
+}
+
+impl<T: Real> BestPoint<T> {
+    /// The outcome of stopping with this point: solved or almost (within 100× the target) as
+    /// the stopping test would say, else stalled, its bound reported as it is.
+    fn finish<O: Objective<T>>(&self, iterations: u32, objective: &O) -> Outcome {
+        let status = if self.gap <= self.target {
+            SolveStatus::Solved
+        } else if self.gap <= 1e2 * self.target {
+            SolveStatus::AlmostSolved
+        } else {
+            SolveStatus::Stalled
+        };
+        Outcome {
+            x: self.x.iter().map(|v| v.to_f64()).collect(),
+            z: self.z.iter().map(|v| v.to_f64()).collect(),
+            y: objective.auxiliary(&self.x),
+            status,
+            iterations,
+        }
+    }
 }
 
 /// The interior-point iteration in arithmetic `T`.
@@ -549,7 +593,8 @@ fn run<T: Real, O: Objective<T>>(
     let mut newton = Newton::new(n, m);
     let mut last = (f64::INFINITY, f64::INFINITY, f64::INFINITY);
     let mut last_step = f64::INFINITY;
-    let mut progress = Progress { best_gap: f64::INFINITY, best_at: 0, first: None };
+    let mut progress =
+        Progress { best_gap: f64::INFINITY, best_at: 0, gap: f64::INFINITY, target: 0.0, on_floor: false, first: None };
     // the barrier weights `z / s`, with the slacks' reciprocals where the arithmetic uses them
     let weights = |point: &Iterate<T>, w: &mut [T], inv_s: &mut [T]| {
         let (s, z) = (&point.s, &point.z);
@@ -572,6 +617,8 @@ fn run<T: Real, O: Objective<T>>(
     // may stay short of their margin without one
     let mut corrected = false;
     let short_rows = SHORT_ROWS + m / SHORT_ROWS_PER;
+    // the best point on the bound's rounding floor, made when the floor is first reached
+    let mut best: Option<BestPoint<T>> = None;
     for it in 0..settings.max_iter {
         if crate::progress::cancelled() {
             return Err(crate::error::NumericalError(format!("cancelled at iteration {it}")));
@@ -579,6 +626,9 @@ fn run<T: Real, O: Objective<T>>(
         residuals(r, rows, objective, &point, &b, (bnorm, qnorm), &mut res, &mut newton.dx2);
         last = (res.pres, res.dres, res.mu);
         if !(res.pres.is_finite() && res.dres.is_finite() && res.mu.is_finite()) {
+            if let Some(b) = &best {
+                return Ok(b.finish(it, objective));
+            }
             return Err(crate::error::NumericalError(format!("non-finite iterate at iteration {it}")));
         }
         let xmax = point.x.iter().fold(0.0f64, |a, v| a.max(v.to_f64().abs()));
@@ -604,21 +654,48 @@ fn run<T: Real, O: Objective<T>>(
                 last_step = newton.advance_onto_rows(&mut point);
                 continue;
             }
-            Verdict::Go(fallback) => fallback,
+            Verdict::Go(fallback) => {
+                if progress.on_floor && best.as_ref().is_none_or(|b| progress.gap < b.gap) {
+                    let b = best.get_or_insert_with(|| BestPoint {
+                        x: vec![zero; n],
+                        z: vec![zero; m],
+                        gap: f64::INFINITY,
+                        target: 0.0,
+                    });
+                    b.x.copy_from_slice(&point.x);
+                    b.z.copy_from_slice(&newton.dz2);
+                    (b.gap, b.target) = (progress.gap, progress.target);
+                }
+                // past the best point on the floor: broken down (weights z/s past what the
+                // arithmetic resolves), or no better for as long as the stall test waits
+                if let Some(b) = &best {
+                    if progress.gap > BREAKDOWN_GROWTH * b.gap || it >= progress.best_at + STALL_ITERATIONS {
+                        return Ok(b.finish(it, objective));
+                    }
+                }
+                fallback
+            }
         };
         weights(&point, &mut w, &mut inv_s);
         if let Err(e) = objective.factor(rows, &w) {
-            return match fallback_status {
-                Some(status) => Ok(finish(&point.x, &point.z, status, it, objective)),
-                None => Err(e),
+            return match (fallback_status, &best) {
+                (Some(status), _) => Ok(finish(&point.x, &point.z, status, it, objective)),
+                (None, Some(b)) => Ok(b.finish(it, objective)),
+                (None, None) => Err(e),
             };
         }
         let inv = if T::RECIPROCALS { &inv_s[..] } else { &point.s[..] };
         let alpha = newton.step(rows, objective, &point, &res, (&w, inv));
         if alpha < 1e-12 {
+            if let Some(b) = &best {
+                return Ok(b.finish(it, objective));
+            }
             return Err(crate::error::NumericalError(format!("step length {alpha:e} at iteration {it}")));
         }
         last_step = newton.advance(&mut point, alpha);
+    }
+    if let Some(b) = &best {
+        return Ok(b.finish(settings.max_iter, objective));
     }
     let (pres, dres, mu) = last;
     let tol = targets.tol;
@@ -707,6 +784,8 @@ fn verdict_with_data<'s, T: Real>(
         gap
     };
     let target = t.gap_tolerance * data;
+    (progress.gap, progress.target) = (gap, target);
+    progress.on_floor = pres <= t.tol && comp.to_f64() <= FLOOR_COMPLEMENTARITY * gap;
     crate::progress::update("solve", || {
         format!(
             "iteration {iteration}: gap {:.1e} of the data (target {:.0e}), primal residual {pres:.1e}",

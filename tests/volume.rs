@@ -1060,10 +1060,12 @@ fn the_bundled_fmri_frame_inside_its_mask_is_solved_by_the_active_set_iteration_
 fn the_active_set_iteration_gives_the_same_bits_on_1_2_and_3_threads() {
     use toposmooth::parallel::with_threads;
     use toposmooth::solve::Method;
-    // large enough (over 20,000 variables) that the products split between threads
+    // large enough (over 20,000 variables) that the products split between threads, and
+    // quantised to 24 levels (ties everywhere, as in 8-bit scans) so that the clusters' flows,
+    // over more than 16,384 variables, are shared out between threads too
     let n = [40, 36, 30];
     let h = noisy_field(n, 11, |x, y, z, noise| {
-        (0.25 * x).sin() * (0.2 * y).cos() + 0.3 * (0.3 * z).sin() + 0.2 * (noise - 0.5)
+        (6.0 * ((0.25 * x).sin() * (0.2 * y).cos() + 0.3 * (0.3 * z).sin() + 0.2 * (noise - 0.5))).round()
     });
     let g = Grid3d::with_geometry(n, [1.0; 3], [0.0; 3]).unwrap();
     let settings = SmoothSettings { selection: Selection::Relative(0.1), ..Default::default() };

@@ -89,14 +89,16 @@ pub(crate) fn operand_bytes(n: usize, m: usize, p_entries: usize) -> u64 {
 /// rows' flags and multipliers (16 a variable, 10 a row) and the clusters with their trees (60
 /// a variable); the conjugate gradients' vectors and unknown map (100); the flow network when
 /// every cluster is marked and every row is an arc (nodes, terminals, supplies, cut sides:
-/// 198 a variable; arcs with their reverses, doubled by the vectors' growth, and the arc
-/// list: 96 a row); the join's labels, tables and violated list (27 a variable, 33 a row);
-/// the clusters' construction (41). The flow's phase is the largest: 16 + 60 + 8 + 198 per
-/// variable, 10 + 96 per row, rounded up.
+/// 198 a variable, and 12 more where the clusters are shared out between two networks: a
+/// node and a cluster map per network, the clusters' sizes; arcs with their reverses, doubled
+/// by the vectors' growth, the arc list and the flows handed back: 112 a row); the join's
+/// labels, tables and violated list (27 a variable, 33 a row); the clusters' construction
+/// (41). The flow's phase is the largest: 16 + 60 + 8 + 210 per variable, 10 + 112 per row,
+/// rounded up.
 #[must_use]
 pub(crate) fn iteration_bytes(n: usize, m: usize) -> u64 {
     let (n, m) = (n as u64, m as u64);
-    290 * n + 110 * m
+    300 * n + 125 * m
 }
 
 /// P and the constraint rows in the iteration's own forms ([`RowClasses`], [`Row`]).

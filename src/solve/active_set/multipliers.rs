@@ -81,97 +81,181 @@ pub(super) fn flow_multipliers(
     significant: f64,
     z: &mut [f64],
 ) -> usize {
-    let n = x.len();
     let nc = cl.anchor.len();
-    // per marked cluster its own source and sink (a network per cluster: each flow's phases
-    // search that cluster only), then a node per variable
-    let mut terminals = vec![(NONE, NONE); nc];
-    let mut node = vec![NONE; n];
-    let mut count = 0usize;
+    // the marked clusters with their sizes, and the residual threshold from all of them
+    let mut size = vec![0u32; nc];
     let mut scale = 0.0f64;
-    for v in 0..n {
-        let c = cl.label[v] as usize;
-        if marked[c] {
-            if terminals[c].0 == NONE {
-                terminals[c] = (count as u32, count as u32 + 1);
-                count += 2;
-            }
-            node[v] = count as u32;
-            count += 1;
+    for (v, &c) in cl.label.iter().enumerate() {
+        if marked[c as usize] {
+            size[c as usize] += 1;
             scale = scale.max(balanced[v].abs());
         }
     }
-    if count == 0 || scale == 0.0 {
+    let clusters: Vec<u32> = (0..nc as u32).filter(|&c| size[c as usize] > 0).collect();
+    if clusters.is_empty() || scale == 0.0 {
         return 0;
     }
-    let eps = 1e-14 * scale;
-    let mut net = Network::new(count);
-    // per cluster: the sum to send out, the supply arcs, the smallest data diagonal
-    let mut sum = vec![0.0; nc];
-    let mut dmin = vec![f64::INFINITY; nc];
-    let mut supply: Vec<(u32, usize, f64)> = Vec::new();
-    for v in 0..n {
-        if node[v] == NONE {
-            continue;
-        }
-        let c = cl.label[v] as usize;
-        let (source, sink) = (terminals[c].0 as usize, terminals[c].1 as usize);
-        let out = -balanced[v];
-        sum[c] += out;
-        dmin[c] = dmin[c].min(d[v]);
-        if out > 0.0 {
-            supply.push((c as u32, net.add_arc(source, node[v] as usize, out), out));
-        } else if out < 0.0 {
-            net.add_arc(node[v] as usize, sink, -out);
-        }
-    }
-    let mut arcs: Vec<(usize, usize)> = Vec::new();
-    for (k, row) in rows.iter().enumerate() {
-        match *row {
-            Row::Pair(i, j, _) => {
-                if node[i] == NONE || cl.label[i] != cl.label[j] || !(in_set[k] || row.slack(x) <= TIGHT) {
-                    continue;
-                }
-                arcs.push((k, net.add_arc(node[i] as usize, node[j] as usize, f64::INFINITY)));
-            }
-            Row::Bound(v, a, _) if in_set[k] && node[v] != NONE => {
-                let c = cl.label[v] as usize;
-                let (source, sink) = (terminals[c].0 as usize, terminals[c].1 as usize);
-                let hub = net.add_node();
-                if a > 0.0 {
-                    // x_v ≤ b: the anchor takes what the cluster sends out
-                    arcs.push((k, net.add_arc(node[v] as usize, hub, f64::INFINITY)));
-                    supply_or_demand(&mut net, &mut supply, hub, sink, sum[c].max(0.0), None);
-                } else {
-                    arcs.push((k, net.add_arc(hub, node[v] as usize, f64::INFINITY)));
-                    supply_or_demand(&mut net, &mut supply, source, hub, (-sum[c]).max(0.0), Some(c as u32));
-                }
-            }
-            Row::Bound(..) => {}
-        }
-    }
-    let mut side = vec![false; net.nodes()];
-    for &(source, sink) in terminals.iter().filter(|t| t.0 != NONE) {
-        net.max_flow(source as usize, sink as usize, eps);
-        net.mark_reachable(source as usize, eps, &mut side);
-    }
-    let mut deficit = vec![0.0; nc];
-    for &(c, a, cap) in &supply {
-        deficit[c as usize] += cap - net.flow(a);
-    }
-    let cut: Vec<bool> = (0..nc).map(|c| marked[c] && deficit[c] * deficit[c] / dmin[c] > significant).collect();
+    let network = Flows { rows, in_set, cl, balanced, x, d, significant, eps: 1e-14 * scale };
     let mut dropped = 0;
-    for &(k, a) in &arcs {
-        z[k] = net.flow(a);
-        if let Row::Pair(i, j, _) = rows[k] {
-            if in_set[k] && cut[cl.label[i] as usize] && side[node[i] as usize] != side[node[j] as usize] {
-                in_set[k] = false;
-                z[k] = 0.0;
-                dropped += 1;
-            }
+    for group in network.in_groups(clusters, &size) {
+        for (k, flow) in group.z {
+            z[k] = flow;
+        }
+        for k in group.dropped {
+            in_set[k] = false;
+            z[k] = 0.0;
+            dropped += 1;
         }
     }
     dropped
+}
+
+/// Marked variables from which [`Flows::in_groups`] splits the clusters between two threads
+/// (each network scans every row once more, a few milliseconds at 128³ against flows of
+/// 0.1–1 s an outer iteration).
+const FLOW_SPLIT_FROM: usize = 1 << 11;
+
+/// What [`flow_multipliers`] reads, for the flows of any group of its clusters.
+struct Flows<'a> {
+    rows: &'a [Row],
+    in_set: &'a [bool],
+    cl: &'a Clusters,
+    balanced: &'a [f64],
+    x: &'a [f64],
+    d: &'a [f64],
+    significant: f64,
+    /// Residuals at or below it are taken as none.
+    eps: f64,
+}
+
+/// The flows of one group of clusters: each row arc's flow, and the rows the minimum cuts drop.
+struct GroupFlow {
+    z: Vec<(usize, f64)>,
+    dropped: Vec<usize>,
+}
+
+impl Flows<'_> {
+    /// The flows of `clusters` (ascending), on as many threads as the cap allows: the clusters
+    /// are shared out by size between two networks, each half again while threads remain.
+    /// Each cluster is its own component of whatever network holds it, with its arcs in the
+    /// same order, so its flow, and the multipliers, are the same bits on every thread count.
+    fn in_groups(&self, clusters: Vec<u32>, size: &[u32]) -> Vec<GroupFlow> {
+        let nodes: usize = clusters.iter().map(|&c| size[c as usize] as usize).sum();
+        if crate::parallel::threads() < 2 || clusters.len() < 2 || nodes < FLOW_SPLIT_FROM {
+            return vec![self.group(&clusters)];
+        }
+        // the largest first, each to the lighter side (ties by cluster number)
+        let mut by_size = clusters;
+        by_size.sort_by_key(|&c| (std::cmp::Reverse(size[c as usize]), c));
+        let (mut a, mut b) = ((Vec::new(), 0usize), (Vec::new(), 0usize));
+        for c in by_size {
+            let side = if a.1 <= b.1 { &mut a } else { &mut b };
+            side.0.push(c);
+            side.1 += size[c as usize] as usize;
+        }
+        a.0.sort_unstable();
+        b.0.sort_unstable();
+        let (mut first, second) = crate::parallel::join(|| self.in_groups(a.0, size), || self.in_groups(b.0, size));
+        first.extend(second);
+        first
+    }
+
+    /// The flows of `clusters` (ascending) on one network.
+    fn group(&self, clusters: &[u32]) -> GroupFlow {
+        let Flows { rows, in_set, cl, balanced, x, d, significant, eps } = *self;
+        let (n, nc) = (x.len(), cl.anchor.len());
+        // per cluster its own source and sink (a network per cluster: each flow's phases
+        // search that cluster only), then a node per variable
+        // per cluster its place in the group (NONE outside it), so that what is kept per
+        // cluster is the group's size, not the problem's
+        let mut local = vec![NONE; nc];
+        for (l, &c) in clusters.iter().enumerate() {
+            local[c as usize] = l as u32;
+        }
+        let mut terminals = vec![(NONE, NONE); clusters.len()];
+        let mut node = vec![NONE; n];
+        let mut count = 0usize;
+        for v in 0..n {
+            let c = local[cl.label[v] as usize] as usize;
+            if c != NONE as usize {
+                if terminals[c].0 == NONE {
+                    terminals[c] = (count as u32, count as u32 + 1);
+                    count += 2;
+                }
+                node[v] = count as u32;
+                count += 1;
+            }
+        }
+        let mut net = Network::new(count);
+        // per cluster: the sum to send out, the supply arcs, the smallest data diagonal
+        let mut sum = vec![0.0; clusters.len()];
+        let mut dmin = vec![f64::INFINITY; clusters.len()];
+        let mut supply: Vec<(u32, usize, f64)> = Vec::new();
+        for v in 0..n {
+            if node[v] == NONE {
+                continue;
+            }
+            let c = local[cl.label[v] as usize] as usize;
+            let (source, sink) = (terminals[c].0 as usize, terminals[c].1 as usize);
+            let out = -balanced[v];
+            sum[c] += out;
+            dmin[c] = dmin[c].min(d[v]);
+            if out > 0.0 {
+                supply.push((c as u32, net.add_arc(source, node[v] as usize, out), out));
+            } else if out < 0.0 {
+                net.add_arc(node[v] as usize, sink, -out);
+            }
+        }
+        let mut arcs: Vec<(usize, usize)> = Vec::new();
+        for (k, row) in rows.iter().enumerate() {
+            match *row {
+                Row::Pair(i, j, _) => {
+                    if node[i] == NONE || cl.label[i] != cl.label[j] || !(in_set[k] || row.slack(x) <= TIGHT) {
+                        continue;
+                    }
+                    arcs.push((k, net.add_arc(node[i] as usize, node[j] as usize, f64::INFINITY)));
+                }
+                Row::Bound(v, a, _) if in_set[k] && node[v] != NONE => {
+                    let c = local[cl.label[v] as usize] as usize;
+                    let (source, sink) = (terminals[c].0 as usize, terminals[c].1 as usize);
+                    let hub = net.add_node();
+                    if a > 0.0 {
+                        // x_v ≤ b: the anchor takes what the cluster sends out
+                        arcs.push((k, net.add_arc(node[v] as usize, hub, f64::INFINITY)));
+                        supply_or_demand(&mut net, &mut supply, hub, sink, sum[c].max(0.0), None);
+                    } else {
+                        arcs.push((k, net.add_arc(hub, node[v] as usize, f64::INFINITY)));
+                        supply_or_demand(&mut net, &mut supply, source, hub, (-sum[c]).max(0.0), Some(c as u32));
+                    }
+                }
+                Row::Bound(..) => {}
+            }
+        }
+        let mut side = vec![false; net.nodes()];
+        for &(source, sink) in &terminals {
+            net.max_flow(source as usize, sink as usize, eps);
+            net.mark_reachable(source as usize, eps, &mut side);
+        }
+        let mut deficit = vec![0.0; clusters.len()];
+        for &(c, a, cap) in &supply {
+            deficit[c as usize] += cap - net.flow(a);
+        }
+        let cut = |c: usize| deficit[c] * deficit[c] / dmin[c] > significant;
+        let mut out = GroupFlow { z: Vec::with_capacity(arcs.len()), dropped: Vec::new() };
+        for &(k, a) in &arcs {
+            if let Row::Pair(i, j, _) = rows[k] {
+                if in_set[k]
+                    && cut(local[cl.label[i] as usize] as usize)
+                    && side[node[i] as usize] != side[node[j] as usize]
+                {
+                    out.dropped.push(k);
+                    continue;
+                }
+            }
+            out.z.push((k, net.flow(a)));
+        }
+        out
+    }
 }
 
 /// An arc `from → to` of capacity `cap`, recorded as supply of cluster `c` when it leaves the

@@ -506,24 +506,23 @@ struct BestPoint<T> {
     target: f64,
 }
 
-impl<T: Real> BestPoint<T> {
-    /// The outcome of stopping with this point: solved or almost (within 100× the target) as
-    /// the stopping test would say, else stalled, its bound reported as it is.
-    fn finish<O: Objective<T>>(&self, iterations: u32, objective: &O) -> Outcome {
-        let status = if self.gap <= self.target {
-            SolveStatus::Solved
-        } else if self.gap <= 1e2 * self.target {
-            SolveStatus::AlmostSolved
-        } else {
-            SolveStatus::Stalled
-        };
-        Outcome {
-            x: self.x.iter().map(|v| v.to_f64()).collect(),
-            z: self.z.iter().map(|v| v.to_f64()).collect(),
-            y: objective.auxiliary(&self.x),
-            status,
-            iterations,
-        }
+impl<T> BestPoint<T> {
+    /// The status of stopping with this point: as the stopping test would give it, else
+    /// stalled, its bound reported as it is.
+    fn status(&self) -> SolveStatus {
+        status_within(self.gap, self.target).unwrap_or(SolveStatus::Stalled)
+    }
+}
+
+/// The status a point with gap bound `gap` (its rows met) may stop with: solved within the
+/// target, almost within 100 × it.
+fn status_within(gap: f64, target: f64) -> Option<SolveStatus> {
+    if gap <= target {
+        Some(SolveStatus::Solved)
+    } else if gap <= 1e2 * target {
+        Some(SolveStatus::AlmostSolved)
+    } else {
+        None
     }
 }
 
@@ -627,7 +626,7 @@ fn run<T: Real, O: Objective<T>>(
         last = (res.pres, res.dres, res.mu);
         if !(res.pres.is_finite() && res.dres.is_finite() && res.mu.is_finite()) {
             if let Some(b) = &best {
-                return Ok(b.finish(it, objective));
+                return Ok(finish(&b.x, &b.z, b.status(), it, objective));
             }
             return Err(crate::error::NumericalError(format!("non-finite iterate at iteration {it}")));
         }
@@ -670,7 +669,7 @@ fn run<T: Real, O: Objective<T>>(
                 // arithmetic resolves), or no better for as long as the stall test waits
                 if let Some(b) = &best {
                     if progress.gap > BREAKDOWN_GROWTH * b.gap || it >= progress.best_at + STALL_ITERATIONS {
-                        return Ok(b.finish(it, objective));
+                        return Ok(finish(&b.x, &b.z, b.status(), it, objective));
                     }
                 }
                 fallback
@@ -680,7 +679,7 @@ fn run<T: Real, O: Objective<T>>(
         if let Err(e) = objective.factor(rows, &w) {
             return match (fallback_status, &best) {
                 (Some(status), _) => Ok(finish(&point.x, &point.z, status, it, objective)),
-                (None, Some(b)) => Ok(b.finish(it, objective)),
+                (None, Some(b)) => Ok(finish(&b.x, &b.z, b.status(), it, objective)),
                 (None, None) => Err(e),
             };
         }
@@ -688,14 +687,14 @@ fn run<T: Real, O: Objective<T>>(
         let alpha = newton.step(rows, objective, &point, &res, (&w, inv));
         if alpha < 1e-12 {
             if let Some(b) = &best {
-                return Ok(b.finish(it, objective));
+                return Ok(finish(&b.x, &b.z, b.status(), it, objective));
             }
             return Err(crate::error::NumericalError(format!("step length {alpha:e} at iteration {it}")));
         }
         last_step = newton.advance(&mut point, alpha);
     }
     if let Some(b) = &best {
-        return Ok(b.finish(settings.max_iter, objective));
+        return Ok(finish(&b.x, &b.z, b.status(), settings.max_iter, objective));
     }
     let (pres, dres, mu) = last;
     let tol = targets.tol;
@@ -797,15 +796,7 @@ fn verdict_with_data<'s, T: Real>(
     if pres <= t.tol && small_step && gap <= target {
         return (Verdict::Stop(SolveStatus::Solved), Some(&*polished));
     }
-    let fallback = if pres > t.tol {
-        None
-    } else if gap <= target {
-        Some(SolveStatus::Solved)
-    } else if gap <= 1e2 * target {
-        Some(SolveStatus::AlmostSolved)
-    } else {
-        None
-    };
+    let fallback = if pres > t.tol { None } else { status_within(gap, target) };
     if gap < 0.5 * progress.best_gap {
         (progress.best_gap, progress.best_at) = (gap, iteration);
     } else if pres <= t.tol && iteration >= progress.best_at + STALL_ITERATIONS && gap <= 1e2 * target {

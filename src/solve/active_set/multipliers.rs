@@ -164,14 +164,14 @@ impl Flows<'_> {
     fn group(&self, clusters: &[u32]) -> GroupFlow {
         let Flows { rows, in_set, cl, balanced, x, d, significant, eps } = *self;
         let (n, nc) = (x.len(), cl.anchor.len());
-        // per cluster its own source and sink (a network per cluster: each flow's phases
-        // search that cluster only), then a node per variable
         // per cluster its place in the group (NONE outside it), so that what is kept per
         // cluster is the group's size, not the problem's
         let mut local = vec![NONE; nc];
         for (l, &c) in clusters.iter().enumerate() {
             local[c as usize] = l as u32;
         }
+        // per cluster its own source and sink (a network per cluster: each flow's phases
+        // search that cluster only), then a node per variable
         let mut terminals = vec![(NONE, NONE); clusters.len()];
         let mut node = vec![NONE; n];
         let mut count = 0usize;

@@ -1,5 +1,6 @@
 //! The join step of an outer iteration: violated rows enter the working set, the most
-//! violated first and those within [`JOIN_SHARE`] of the worst, merging distinct clusters
+//! violated first and those within [`JOIN_SHARE`] of the worst ([`SETTLED_JOIN_SHARE`] once
+//! the working set has settled), merging distinct clusters
 //! (never closing a cycle among them), swapping out a tree row where a row closes a cycle
 //! inside one cluster, or a bound where two anchored clusters are pulled together.
 
@@ -14,6 +15,17 @@ pub(super) const ADD_ABOVE: f64 = 1e-10;
 /// merges clusters the next solve splits again: at 48³ 88 outer and 8,696 conjugate-gradient
 /// iterations with all of them, 35 and 2,412 with a share of 10⁻²).
 pub(super) const JOIN_SHARE: f64 = 0.03;
+/// Once an outer iteration changes fewer rows than this share of the variables, the working
+/// set has settled, and the next join takes the rows violated by at least
+/// [`SETTLED_JOIN_SHARE`] of the worst: most of the late outer iterations had changed a few
+/// hundred rows each while thousands stayed violated below 3 % of the worst (the 128³ bench:
+/// 72 outer iterations, 40 of them changing fewer than 1,000 rows, each a pass over all
+/// 2.1 million variables). With it: 36; the tie-heavy 64³ volume 112 → 61, the masked fMRI
+/// frame 91 → 53 (docs/performance.md §3). Joining every violated row there (a share of 0)
+/// left the fMRI frame stuck on four rows between anchored clusters and handed over.
+pub(super) const SETTLED_CHANGES: f64 = 1e-2;
+/// The join share once the working set has settled ([`SETTLED_CHANGES`]).
+pub(super) const SETTLED_JOIN_SHARE: f64 = 3e-4;
 
 /// What the join step did.
 pub(super) struct Joined {
@@ -33,8 +45,9 @@ pub(super) struct Joined {
 }
 
 /// The join step on the working set `in_set` (multipliers `z`, the trees `forest` walked) at
-/// the point `x`; `changed` counts the changes made before it this iteration, and `tabu` how
-/// often each row joined two anchored clusters.
+/// the point `x`; `changed` counts the changes made before it this iteration, `tabu` how
+/// often each row joined two anchored clusters, and `share` is the join share of the worst
+/// violation.
 pub(super) fn join(
     rows: &[Row],
     in_set: &mut [bool],
@@ -42,7 +55,7 @@ pub(super) fn join(
     x: &[f64],
     forest: &Forest,
     tabu: &mut [u8],
-    mut changed: usize,
+    (mut changed, share): (usize, f64),
 ) -> Joined {
     let n = x.len();
     // the clusters after the cuts: labels are union-find roots, so the tables below run
@@ -57,7 +70,7 @@ pub(super) fn join(
         .collect();
     violated.sort_by(|a, b| b.0.total_cmp(&a.0));
     let worst = violated.first().map_or(0.0, |v| v.0);
-    let joining = violated.partition_point(|v| v.0 >= JOIN_SHARE * worst);
+    let joining = violated.partition_point(|v| v.0 >= share * worst);
     let nc = n;
     let mut parent: Vec<u32> = (0..nc as u32).collect();
     let anchor_row = cl.anchor_row;
@@ -77,7 +90,7 @@ pub(super) fn join(
         if rank == joining && changed > 0 {
             break;
         }
-        if beyond.is_some_and(|v| violation < JOIN_SHARE * v) {
+        if beyond.is_some_and(|v| violation < share * v) {
             break;
         }
         let before = changed;

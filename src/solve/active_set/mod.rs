@@ -13,8 +13,8 @@
 //! rows form cycles, and a tree's multipliers are one of many): if the flow carries the whole
 //! imbalance the multipliers are non-negative and the cluster stays; if not, the cluster
 //! splits along the minimum cut, the one split the gradient pulls apart. Violated rows
-//! within [`join::JOIN_SHARE`] of the worst join `S` (merging two clusters, never closing a
-//! cycle), and the iteration stops when nothing joins or leaves and the gap bound of
+//! within [`join::JOIN_SHARE`] of the worst (a smaller share once few rows change) join `S`
+//! (merging two clusters, never closing a cycle), and the iteration stops when nothing joins or leaves and the gap bound of
 //! [`super::optimality`] — `Σ s⁺z + ½ Σ ρ²/d` with the data term's diagonal `d` — is below
 //! the tolerance. Inside a cluster the values step by the margin along the tree's rows; a row
 //! that closes a cycle in a cluster may miss its margin by a few ε, which the caller's margin
@@ -32,7 +32,7 @@ use super::settings::QpSettings;
 use super::status::{Outcome, SolveStatus};
 use crate::error::NumericalError;
 use clusters::{Clusters, NONE};
-use join::{join, Joined, ADD_ABOVE};
+use join::{join, Joined, ADD_ABOVE, JOIN_SHARE, SETTLED_CHANGES, SETTLED_JOIN_SHARE};
 use multipliers::{balanced_gradient, flow_multipliers, gap_bound, tree_multipliers};
 use objective::{solve_clustered, Objective};
 use operator::RowClasses;
@@ -212,8 +212,12 @@ pub(super) fn solve(
         let drops = flow_multipliers(&rows, &mut in_set, &cl, &balanced, &x, &r.d, &marked, significant, &mut z);
         changed += drops;
         let t4 = std::time::Instant::now();
+        let share = match history.last() {
+            Some(&(_, _, c)) if (c as f64) < SETTLED_CHANGES * n as f64 => SETTLED_JOIN_SHARE,
+            _ => JOIN_SHARE,
+        };
         let Joined { changed, swaps, stuck, worst, violated } =
-            join(&rows, &mut in_set, &mut z, &x, &cl.forest, &mut tabu, changed);
+            join(&rows, &mut in_set, &mut z, &x, &cl.forest, &mut tabu, (changed, share));
         let gap = gap_bound(&rows, &x, &z, &g, &r.d);
         let t5 = std::time::Instant::now();
         crate::progress::update("solve", || {

@@ -167,6 +167,7 @@ pub(super) fn solve(
     // once per anchor, as the next cut tends to undo it
     let mut tabu = vec![0u8; rows.len()];
     let mut first_gap = None;
+    let mut waited_inside = 0usize;
     while outer < MAX_OUTER {
         if crate::progress::cancelled() {
             return Err("cancelled".into());
@@ -212,12 +213,15 @@ pub(super) fn solve(
         let drops = flow_multipliers(&rows, &mut in_set, &cl, &balanced, &x, &r.d, &marked, significant, &mut z);
         changed += drops;
         let t4 = std::time::Instant::now();
+        // settled: the last outer iteration changed few rows, and no more violated rows
+        // waited inside clusters its join merged than it changed
         let share = match history.last() {
-            Some(&(_, _, c)) if (c as f64) < SETTLED_CHANGES * n as f64 => SETTLED_JOIN_SHARE,
+            Some(&(_, _, c)) if (c as f64) < SETTLED_CHANGES * n as f64 && waited_inside <= c => SETTLED_JOIN_SHARE,
             _ => JOIN_SHARE,
         };
         let Joined { changed, swaps, stuck, worst, violated } =
             join(&rows, &mut in_set, &mut z, &x, &cl.forest, &mut tabu, (changed, share));
+        waited_inside = stuck[2];
         let gap = gap_bound(&rows, &x, &z, &g, &r.d);
         let t5 = std::time::Instant::now();
         crate::progress::update("solve", || {

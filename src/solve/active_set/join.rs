@@ -1,8 +1,8 @@
 //! The join step of an outer iteration: violated rows enter the working set, the most
 //! violated first and those within [`JOIN_SHARE`] of the worst ([`SETTLED_JOIN_SHARE`] once
-//! the working set has settled), merging distinct clusters
-//! (never closing a cycle among them), swapping out a tree row where a row closes a cycle
-//! inside one cluster, or a bound where two anchored clusters are pulled together.
+//! the working set has settled: [`share_after`]), merging distinct clusters (never closing a
+//! cycle among them), swapping out a tree row where a row closes a cycle inside one cluster,
+//! or a bound where two anchored clusters are pulled together.
 
 use super::clusters::{find, Forest, Labels};
 use super::rows::Row;
@@ -31,6 +31,17 @@ pub(super) const SETTLED_CHANGES: f64 = 1e-2;
 /// The join share once the working set has settled ([`SETTLED_CHANGES`]).
 pub(super) const SETTLED_JOIN_SHARE: f64 = 3e-4;
 
+/// The join share after the outer iteration whose join was `last` ([`JOIN_SHARE`] before the
+/// first), for `n` variables.
+pub(super) fn share_after(last: Option<&Joined>, n: usize) -> f64 {
+    match last {
+        Some(j) if (j.changed as f64) < SETTLED_CHANGES * n as f64 && j.waited_inside() <= j.changed => {
+            SETTLED_JOIN_SHARE
+        }
+        _ => JOIN_SHARE,
+    }
+}
+
 /// What the join step did.
 pub(super) struct Joined {
     /// Working-set changes this iteration, those before the join step included.
@@ -46,6 +57,13 @@ pub(super) struct Joined {
     pub(super) worst: f64,
     /// Rows violated by more than [`ADD_ABOVE`].
     pub(super) violated: usize,
+}
+
+impl Joined {
+    /// Violated rows left waiting inside a cluster merged this iteration.
+    pub(super) fn waited_inside(&self) -> usize {
+        self.stuck[2]
+    }
 }
 
 /// The join step on the working set `in_set` (multipliers `z`, the trees `forest` walked) at

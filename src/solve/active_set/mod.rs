@@ -14,8 +14,8 @@
 //! imbalance the multipliers are non-negative and the cluster stays; if not, the cluster
 //! splits along the minimum cut, the one split the gradient pulls apart. Violated rows
 //! within [`join::JOIN_SHARE`] of the worst (a smaller share once few rows change) join `S`
-//! (merging two clusters, never closing a cycle), and the iteration stops when nothing joins or leaves and the gap bound of
-//! [`super::optimality`] — `Σ s⁺z + ½ Σ ρ²/d` with the data term's diagonal `d` — is below
+//! (merging two clusters, never closing a cycle), and the iteration stops when nothing joins
+//! or leaves and the gap bound of [`super::optimality`] — `Σ s⁺z + ½ Σ ρ²/d` with the data term's diagonal `d` — is below
 //! the tolerance. Inside a cluster the values step by the margin along the tree's rows; a row
 //! that closes a cycle in a cluster may miss its margin by a few ε, which the caller's margin
 //! repair restores, and the certificate and the gap of the output as written decide.
@@ -32,7 +32,7 @@ use super::settings::QpSettings;
 use super::status::{Outcome, SolveStatus};
 use crate::error::NumericalError;
 use clusters::{Clusters, NONE};
-use join::{join, Joined, ADD_ABOVE, JOIN_SHARE, SETTLED_CHANGES, SETTLED_JOIN_SHARE};
+use join::{join, share_after, Joined, ADD_ABOVE};
 use multipliers::{balanced_gradient, flow_multipliers, gap_bound, tree_multipliers};
 use objective::{solve_clustered, Objective};
 use operator::RowClasses;
@@ -167,7 +167,7 @@ pub(super) fn solve(
     // once per anchor, as the next cut tends to undo it
     let mut tabu = vec![0u8; rows.len()];
     let mut first_gap = None;
-    let mut waited_inside = 0usize;
+    let mut last_join: Option<Joined> = None;
     while outer < MAX_OUTER {
         if crate::progress::cancelled() {
             return Err("cancelled".into());
@@ -213,15 +213,10 @@ pub(super) fn solve(
         let drops = flow_multipliers(&rows, &mut in_set, &cl, &balanced, &x, &r.d, &marked, significant, &mut z);
         changed += drops;
         let t4 = std::time::Instant::now();
-        // settled: the last outer iteration changed few rows, and no more violated rows
-        // waited inside clusters its join merged than it changed
-        let share = match history.last() {
-            Some(&(_, _, c)) if (c as f64) < SETTLED_CHANGES * n as f64 && waited_inside <= c => SETTLED_JOIN_SHARE,
-            _ => JOIN_SHARE,
-        };
-        let Joined { changed, swaps, stuck, worst, violated } =
-            join(&rows, &mut in_set, &mut z, &x, &cl.forest, &mut tabu, (changed, share));
-        waited_inside = stuck[2];
+        let share = share_after(last_join.as_ref(), n);
+        let joined = join(&rows, &mut in_set, &mut z, &x, &cl.forest, &mut tabu, (changed, share));
+        let Joined { changed, swaps, stuck, worst, violated } = joined;
+        last_join = Some(joined);
         let gap = gap_bound(&rows, &x, &z, &g, &r.d);
         let t5 = std::time::Instant::now();
         crate::progress::update("solve", || {

@@ -6,9 +6,10 @@
 //! `fma` function, a library call on any build without the FMA target feature (the default
 //! x86-64 target). On a series of 3·10⁶ samples those calls were 40 % of the run (perf:
 //! `add_estimate` 10 %, `sub_estimate` 10 %, `fma` 14 %, division 6 %). Here the product's
-//! rounding error comes from Dekker's splitting, in plain multiplications and additions, and
-//! the sum is Knuth's branch-free two-sum: the same results on every x86-64 and aarch64
-//! build, with or without FMA, and no call in the loops. faer's sparse kernels still need
+//! rounding error comes from the processor's fused multiply-add, found at run time and issued
+//! inline, or where there is none from Dekker's splitting, in plain multiplications and
+//! additions; the sum is Knuth's branch-free two-sum: the same results on every x86-64 and
+//! aarch64 processor, with or without FMA, and no call in the loops. faer's sparse kernels still need
 //! `fx128`: [`to_fx128`] and [`from_fx128`] convert at that border.
 //!
 //! The operations are those of Bailey's QD library in its "sloppy" form (as `qd`'s `+`, `−`,
@@ -54,13 +55,66 @@ fn split(a: f64) -> (f64, f64) {
     (hi, a - hi)
 }
 
-/// `p + e = a · b` exactly (Dekker).
+/// `p + e = a · b` exactly: the fused multiply-add's `a·b − p` where the processor has one
+/// ([`fused`]), else Dekker's splitting. Both give the exact error term (below the splitting's
+/// overflow, about `2⁹⁹⁶`, and above the subnormals), so the same bits either way.
 #[inline(always)]
 fn two_prod(a: f64, b: f64) -> Dd {
     let p = a * b;
+    if let Some(lo) = fused::error(a, b, p) {
+        return Dd { hi: p, lo };
+    }
+    dekker(a, b, p)
+}
+
+/// Dekker's exact product's error term `a·b − p`, in plain multiplications and additions.
+#[inline(always)]
+fn dekker(a: f64, b: f64, p: f64) -> Dd {
     let (ah, al) = split(a);
     let (bh, bl) = split(b);
     Dd { hi: p, lo: ((ah * bh - p) + ah * bl + al * bh) + al * bl }
+}
+
+/// The fused multiply-add, found at run time: the default x86-64 target has none, so
+/// `f64::mul_add` there is a library call (the reason this module splits instead), while every
+/// x86-64 processor since 2013 executes `vfmsub213sd`. Its exact error term costs one
+/// instruction where the splitting costs ten dependent ones (a series of 3·10⁶ samples in
+/// double-double: solve 16.6 → 13.9 s, docs/performance.md §3).
+mod fused {
+    /// `a·b − p` rounded once, if the processor fuses.
+    #[cfg(target_arch = "x86_64")]
+    #[inline(always)]
+    pub(super) fn error(a: f64, b: f64, p: f64) -> Option<f64> {
+        if !std::arch::is_x86_feature_detected!("fma") {
+            return None;
+        }
+        let mut r = a;
+        // SAFETY: executed only where the processor reports FMA; registers only, no memory.
+        unsafe {
+            std::arch::asm!(
+                "vfmsub213sd {r}, {b}, {p}",
+                r = inout(xmm_reg) r,
+                b = in(xmm_reg) b,
+                p = in(xmm_reg) p,
+                options(pure, nomem, nostack, preserves_flags)
+            );
+        }
+        Some(r)
+    }
+
+    /// `a·b − p` rounded once (FMA is in every aarch64 processor's base set).
+    #[cfg(target_arch = "aarch64")]
+    #[inline(always)]
+    pub(super) fn error(a: f64, b: f64, p: f64) -> Option<f64> {
+        Some(a.mul_add(b, -p))
+    }
+
+    /// No fused multiply-add known on this architecture: Dekker's splitting.
+    #[cfg(not(any(target_arch = "x86_64", target_arch = "aarch64")))]
+    #[inline(always)]
+    pub(super) fn error(_: f64, _: f64, _: f64) -> Option<f64> {
+        None
+    }
 }
 
 impl Dd {
@@ -209,6 +263,8 @@ mod tests {
             let (x, y) = (next() * 1e3, next() * 1e-3);
             let p = two_prod(x, y);
             assert_eq!(p.lo, x.mul_add(y, -p.hi), "{x} × {y}");
+            // the splitting, run on every processor, gives the fused bits
+            assert_eq!(dekker(x, y, p.hi), p, "{x} × {y}");
             // the sum's error term: hi + lo − x − y vanishes to double-double precision
             let s = two_sum(x, y);
             assert_eq!(s.hi, x + y);

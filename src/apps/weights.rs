@@ -293,6 +293,7 @@ fn one_function<D: Smoothable>(
                 hint: Some(&out.u),
                 factor: None,
                 condition: None,
+                second_order: None,
             };
             let sol = solve_monotone_qp_with(&qp, &settings.qp, analyses, None)?;
             let mut f = sol.x;

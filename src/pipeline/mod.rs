@@ -348,7 +348,7 @@ fn smooth_stages<D: Smoothable + Sync>(
     }
 
     let stage = Stage::begin("solve");
-    let sol = solve_qp(&problem, &ordered, &operators, settings, analyses, prepared)?;
+    let sol = solve_qp(&problem, &ordered, (&operators, &ops.stiffness), settings, analyses, prepared)?;
     seconds.solve = stage.end(|| format!("{:?} after {} iterations", sol.status, sol.iterations));
     let peak_after_solve = crate::memory::peak_resident();
 
@@ -422,7 +422,7 @@ fn smooth_stages<D: Smoothable + Sync>(
 fn solve_qp(
     problem: &Problem,
     ordered: &Ordered,
-    operators: &Operators,
+    (operators, stiffness): (&Operators, &crate::operators::Sparse),
     settings: &SmoothSettings,
     analyses: &mut Analyses,
     prepared: Option<crate::solve::Prepared>,
@@ -441,6 +441,10 @@ fn solve_qp(
         hint: Some(&hint),
         factor: operators.factor.as_ref(),
         condition: operators.condition,
+        second_order: operators
+            .row_scale
+            .as_deref()
+            .map(|row_scale| crate::solve::SecondOrder { k: stiffness, row_scale }),
     };
     solve_monotone_qp_with(&qp, &settings.qp, analyses, prepared)
 }

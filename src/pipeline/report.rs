@@ -254,6 +254,7 @@ pub(super) fn fit_report(
         hint: None,
         factor: sol.y.as_ref().and(factor),
         condition: sol.condition,
+        second_order: None,
     };
     // multipliers and t = F f scale with the values (f = lo + range·x; F·1 = 0 up to the
     // rounding of F's entries, which is left in ½‖F f − y‖²: carried into y it would enter ρ

@@ -207,6 +207,9 @@ pub(super) struct Operators {
     pub(super) p: Sparse,
     pub(super) q: Vec<f64>,
     pub(super) condition: Option<f64>,
+    /// `s` with the energy `K diag(s) K` where it is of order 2 and the active set runs
+    /// (its products then take two passes over K: [`crate::solve::SecondOrder`]).
+    pub(super) row_scale: Option<Vec<f64>>,
 }
 
 /// The QP's objective for smoothing length `ell`: `P` = the energy plus the data diagonal
@@ -251,7 +254,26 @@ pub(super) fn build_operators<D: Smoothable>(
     } else {
         None
     };
-    Ok(Operators { weights, data_diag, factor, p, q, condition })
+    let row_scale =
+        (settings.qp.method == Method::ActiveSet).then(|| second_order_scale(m, &settings.energy, &weights)).flatten();
+    Ok(Operators { weights, data_diag, factor, p, q, condition, row_scale })
+}
+
+/// `s` with the energy `c K M⁻¹ K = K diag(s) K` (`s = c / m`, 0 at sharp vertices, as
+/// [`crate::operators::polyharmonic`] assembles it) when its one term of non-zero weight is of
+/// order 2; else `None`.
+fn second_order_scale(m: &[f64], energy: &crate::operators::Energy, weights: &[f64]) -> Option<Vec<f64>> {
+    let mut terms = energy.terms.iter().zip(weights).filter(|(t, s)| t.1 * **s != 0.0);
+    let (&(order, w), &s) = terms.next()?;
+    if order != 2 || terms.next().is_some() {
+        return None;
+    }
+    let c = w * s;
+    let mut scale: Vec<f64> = m.iter().map(|mi| c / mi).collect();
+    for &v in &energy.sharp {
+        scale[v] = 0.0;
+    }
+    Some(scale)
 }
 
 /// The solver's point `x` (unit values) as the output: in the field's units, the kept values

@@ -44,6 +44,20 @@ pub struct MonotoneQp<'a> {
     pub factor: Option<&'a Factor>,
     /// [`super::condition_estimate`] of this problem if already known (else estimated here).
     pub condition: Option<f64>,
+    /// P's energy as `K diag(s) K` (order 2), for products in two passes over `K`'s stencil
+    /// (the active-set iteration), if known.
+    pub second_order: Option<SecondOrder<'a>>,
+}
+
+/// An energy of order 2 as its stiffness and the scales between: `Q = K diag(row_scale) K`
+/// (`row_scale = c / m` with the term's weight `c` and the lumped mass `m`, 0 at sharp
+/// vertices), so that `P = Q + diag(data)`.
+#[derive(Clone, Copy, Debug)]
+pub struct SecondOrder<'a> {
+    /// The stiffness, `#V × #V`, symmetric.
+    pub k: &'a Sparse,
+    /// `#V`.
+    pub row_scale: &'a [f64],
 }
 
 /// One constraint row of a [`MonotoneQp`] (fixed values substituted when it is reduced).

@@ -131,7 +131,8 @@ pub fn solve_monotone_qp_with(
                 }
             };
             // its operands first, then the iteration beside them, each checked before it is made
-            let before = fits(super::active_set::operand_bytes(reduced.n, reduced.m(), upper_entries))?;
+            let two_pass = qp.second_order.map(|e| (e.k.ncols(), e.k.val().len()));
+            let before = fits(super::active_set::operand_bytes(reduced.n, reduced.m(), upper_entries, two_pass))?;
             let outcome = match super::active_set::Operands::new(qp, &free, &reduced) {
                 Ok(operands) => {
                     let beside = fits(super::active_set::iteration_bytes(reduced.n, reduced.m()))?;
@@ -337,6 +338,7 @@ mod tests {
             data: Some(data),
             factor: None,
             condition: Some(1.0),
+            second_order: None,
         }
     }
 
@@ -408,6 +410,7 @@ mod tests {
             data: None,
             factor: None,
             condition: None,
+            second_order: None,
         };
         let free: Vec<usize> = (0..n).filter(|&i| fixed[i].is_none()).collect();
         let reduced = reduce(&qp, &free);
@@ -471,7 +474,19 @@ mod tests {
         edges: &'a [(usize, usize)],
         hint: Option<&'a [f64]>,
     ) -> MonotoneQp<'a> {
-        MonotoneQp { p, q, fixed, edges, margin: 1e-6, hint, bounds: &[], data: None, factor: None, condition: None }
+        MonotoneQp {
+            p,
+            q,
+            fixed,
+            edges,
+            margin: 1e-6,
+            hint,
+            bounds: &[],
+            data: None,
+            factor: None,
+            condition: None,
+            second_order: None,
+        }
     }
 
     #[test]
@@ -561,6 +576,7 @@ mod tests {
             data: Some(&d),
             factor: None,
             condition: None,
+            second_order: None,
         };
         let objective = |x: &[f64]| {
             let px = &p * faer::Mat::from_fn(n, 1, |i, _| x[i]);

@@ -35,7 +35,7 @@ use clusters::{Clusters, NONE};
 use join::{join, share_after, Joined, ADD_ABOVE};
 use multipliers::{balanced_gradient, flow_multipliers, gap_bound, tree_multipliers};
 use objective::{solve_clustered, Objective};
-use operator::RowClasses;
+use operator::{RowClasses, TwoPass};
 use rows::{rows_of, Row};
 
 /// Outer iterations at most. The tie-heavy 96³ volume (`bench --single 96x96x96q`) needs 407:
@@ -76,11 +76,16 @@ pub(super) struct ActiveSetOutcome {
 /// rows and `p_entries` stored entries of P's upper triangle: the rows (32 bytes each, with the
 /// 24 of the problem's own row list they are made from), the row classes' tables (12 bytes an
 /// entry of both triangles when no row repeats, as on a mesh; a grid's few hundred classes
-/// take next to nothing) and per variable its class, slot and cursor.
+/// take next to nothing) and per variable its class, slot and cursor; with the product in two
+/// passes over a stiffness of `(vertices, entries)` ([`TwoPass`]), per vertex its intermediate
+/// value and inner class (12), per variable its outer class, data diagonal and the three test
+/// vectors of its check (36), and both passes' tables (12 bytes an entry each when no row
+/// repeats).
 #[must_use]
-pub(crate) fn operand_bytes(n: usize, m: usize, p_entries: usize) -> u64 {
+pub(crate) fn operand_bytes(n: usize, m: usize, p_entries: usize, two_pass: Option<(usize, usize)>) -> u64 {
     let (n, m, p) = (n as u64, m as u64, p_entries as u64);
-    56 * m + 12 * (2 * p) + 20 * (n + 1)
+    let two_pass = two_pass.map_or(0, |(v, k)| 12 * v as u64 + 36 * n + 24 * k as u64);
+    56 * m + 12 * (2 * p) + 20 * (n + 1) + two_pass
 }
 
 /// Bytes the iteration allocates beside its operands, at most, for `n` variables and `m` rows,
@@ -104,6 +109,7 @@ pub(crate) fn iteration_bytes(n: usize, m: usize) -> u64 {
 /// P and the constraint rows in the iteration's own forms ([`RowClasses`], [`Row`]).
 pub(super) struct Operands {
     p: RowClasses,
+    two_pass: Option<TwoPass>,
     rows: Vec<Row>,
 }
 
@@ -130,9 +136,47 @@ impl Operands {
         }
         let rows = rows_of(qp, &slot);
         let p = RowClasses::from_columns(qp.p, free, &slot, r.scale)?;
-        Ok(Operands { p, rows })
+        let two_pass = qp.second_order.and_then(|e| two_pass(&e, qp, &p, free, &slot, r.scale));
+        Ok(Operands { p, two_pass, rows })
     }
 }
+
+/// P's product in two passes over the stiffness ([`TwoPass`]) for the energy `e`, if it agrees
+/// with P's rows on a test vector to `TWO_PASS_AGREEMENT` of the products' size (else `None`:
+/// P's own rows multiply).
+fn two_pass(
+    e: &super::problem::SecondOrder<'_>,
+    qp: &MonotoneQp<'_>,
+    p: &RowClasses,
+    free: &[usize],
+    slot: &[usize],
+    scale: f64,
+) -> Option<TwoPass> {
+    let data = qp.data?;
+    let row_scale: Vec<f64> = e.row_scale.iter().map(|s| s / scale).collect();
+    let d: Vec<f64> = free.iter().map(|&v| data[v] / scale).collect();
+    let t = TwoPass::new(e.k, &row_scale, d, free, slot).ok()?;
+    // a fixed pseudo-random test vector (xorshift)
+    let mut state = 0x2545_F491_4F6C_DD1Du64;
+    let x: Vec<f64> = (0..free.len())
+        .map(|_| {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+        })
+        .collect();
+    let (mut a, mut b) = (vec![0.0; x.len()], vec![0.0; x.len()]);
+    p.apply(&x, &mut a);
+    t.apply(&x, &mut b);
+    let size = a.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    let off = a.iter().zip(&b).fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+    (off <= TWO_PASS_AGREEMENT * size).then_some(t)
+}
+
+/// How closely [`TwoPass`]'s product must agree with P's rows (relative to the largest entry
+/// of the product) to replace them: rounding only.
+const TWO_PASS_AGREEMENT: f64 = 1e-12;
 
 /// Runs the iteration from `hint` (or the data's target) on the reduced QP `r` whose P and
 /// rows `operands` hold.
@@ -143,11 +187,16 @@ pub(super) fn solve(
     settings: &QpSettings,
 ) -> std::result::Result<ActiveSetOutcome, NumericalError> {
     let n = r.n;
-    let Operands { p, rows } = operands;
-    let obj = Objective { p, q: &r.q, d: &r.d, q_free: &r.q_free };
+    let Operands { p, two_pass, rows } = operands;
     if std::env::var_os("TOPOSMOOTH_TRACE_ACTIVE").is_some() {
-        eprintln!("active set: {n} variables, {} rows, P in {} row classes", rows.len(), obj.p.classes());
+        let product = if two_pass.is_some() { "two passes over K" } else { "P's rows" };
+        eprintln!(
+            "active set: {n} variables, {} rows, P in {} row classes, product by {product}",
+            rows.len(),
+            p.classes()
+        );
     }
+    let obj = Objective { p, two_pass, q: &r.q, d: &r.d, q_free: &r.q_free };
     let mut x: Vec<f64> = match hint {
         Some(h) => h.to_vec(),
         None => r.q_free.iter().zip(&r.d).map(|(q, d)| -q / d).collect(),

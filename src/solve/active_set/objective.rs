@@ -1,22 +1,33 @@
 //! The objective as the iteration uses it and the conjugate gradients on the cluster values.
 
 use super::clusters::{Clusters, NONE};
-use super::operator::RowClasses;
+use super::operator::{RowClasses, TwoPass};
 
 /// Conjugate-gradient iterations per solve at most.
 const MAX_CG: usize = 5000;
 
 /// The objective's pieces the iteration needs.
 pub(super) struct Objective<'a> {
+    /// P's rows: its diagonal and each cluster's, and its product where `two_pass` is absent.
     pub(super) p: RowClasses,
+    /// P's product over the stiffness, where the energy is of order 2.
+    pub(super) two_pass: Option<TwoPass>,
     pub(super) q: &'a [f64],
     pub(super) d: &'a [f64],
     pub(super) q_free: &'a [f64],
 }
 
 impl Objective<'_> {
+    /// `y = P x`.
+    pub(super) fn apply(&self, x: &[f64], y: &mut [f64]) {
+        match &self.two_pass {
+            Some(t) => t.apply(x, y),
+            None => self.p.apply(x, y),
+        }
+    }
+
     pub(super) fn gradient(&self, x: &[f64], g: &mut [f64]) {
-        self.p.apply(x, g);
+        self.apply(x, g);
         g.iter_mut().zip(self.q).for_each(|(g, q)| *g += q);
     }
 
@@ -96,12 +107,12 @@ pub(super) fn solve_clustered(obj: &Objective<'_>, cl: &Clusters, x: &mut [f64],
             break;
         }
         if identity {
-            obj.p.apply(&dir, &mut hd);
+            obj.apply(&dir, &mut hd);
         } else {
             for (xv, &u) in xs.iter_mut().zip(&of_vertex) {
                 *xv = if u == NONE { 0.0 } else { dir[u as usize] };
             }
-            obj.p.apply(&xs, &mut px);
+            obj.apply(&xs, &mut px);
             gather(&of_vertex, &px, &mut hd);
         }
         let dhd = dot(&dir, &hd);

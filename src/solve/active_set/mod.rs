@@ -78,13 +78,13 @@ pub(super) struct ActiveSetOutcome {
 /// entry of both triangles when no row repeats, as on a mesh; a grid's few hundred classes
 /// take next to nothing) and per variable its class, slot and cursor; with the product in two
 /// passes over a stiffness of `(vertices, entries)` ([`TwoPass`]), per vertex its intermediate
-/// value and inner class (12), per variable its outer class, data diagonal and the three test
-/// vectors of its check (36), and both passes' tables (12 bytes an entry each when no row
+/// value and inner class (12), per variable its outer class and the three test vectors of its
+/// check (28), and both passes' tables (12 bytes an entry each when no row
 /// repeats).
 #[must_use]
 pub(crate) fn operand_bytes(n: usize, m: usize, p_entries: usize, two_pass: Option<(usize, usize)>) -> u64 {
     let (n, m, p) = (n as u64, m as u64, p_entries as u64);
-    let two_pass = two_pass.map_or(0, |(v, k)| 12 * v as u64 + 36 * n + 24 * k as u64);
+    let two_pass = two_pass.map_or(0, |(v, k)| 12 * v as u64 + 28 * n + 24 * k as u64);
     56 * m + 12 * (2 * p) + 20 * (n + 1) + two_pass
 }
 
@@ -136,7 +136,7 @@ impl Operands {
         }
         let rows = rows_of(qp, &slot);
         let p = RowClasses::from_columns(qp.p, free, &slot, r.scale)?;
-        let two_pass = qp.second_order.and_then(|e| two_pass(&e, qp, &p, free, &slot, r.scale));
+        let two_pass = qp.second_order.and_then(|e| two_pass(&e, r, &p, free, &slot));
         Ok(Operands { p, two_pass, rows })
     }
 }
@@ -146,16 +146,12 @@ impl Operands {
 /// P's own rows multiply).
 fn two_pass(
     e: &super::problem::SecondOrder<'_>,
-    qp: &MonotoneQp<'_>,
+    r: &ReducedQp,
     p: &RowClasses,
     free: &[usize],
     slot: &[usize],
-    scale: f64,
 ) -> Option<TwoPass> {
-    let data = qp.data?;
-    let row_scale: Vec<f64> = e.row_scale.iter().map(|s| s / scale).collect();
-    let d: Vec<f64> = free.iter().map(|&v| data[v] / scale).collect();
-    let t = TwoPass::new(e.k, &row_scale, d, free, slot).ok()?;
+    let t = TwoPass::new(e.k, e.row_scale, r.scale, free, slot).ok()?;
     // a fixed pseudo-random test vector (xorshift)
     let mut state = 0x2545_F491_4F6C_DD1Du64;
     let x: Vec<f64> = (0..free.len())
@@ -168,7 +164,7 @@ fn two_pass(
         .collect();
     let (mut a, mut b) = (vec![0.0; x.len()], vec![0.0; x.len()]);
     p.apply(&x, &mut a);
-    t.apply(&x, &mut b);
+    t.apply(&x, &r.d, &mut b);
     let size = a.iter().fold(0.0f64, |m, v| m.max(v.abs()));
     let off = a.iter().zip(&b).fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
     (off <= TWO_PASS_AGREEMENT * size).then_some(t)

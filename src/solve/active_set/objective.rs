@@ -21,7 +21,7 @@ impl Objective<'_> {
     /// `y = P x`.
     pub(super) fn apply(&self, x: &[f64], y: &mut [f64]) {
         match &self.two_pass {
-            Some(t) => t.apply(x, y),
+            Some(t) => t.apply(x, self.d, y),
             None => self.p.apply(x, y),
         }
     }

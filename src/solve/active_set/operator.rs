@@ -248,9 +248,9 @@ impl RowClasses {
     }
 }
 
-/// P's product in two passes over the stiffness `K` where the energy is of order 2:
-/// `P x = K (s ∘ (K x)) + d ∘ x` (the assembled P is `K diag(s) K + diag(d)`), 2 × 7 entries
-/// a row on a volume's 7-point K instead of the bilaplacian's 25 (docs/performance.md §3).
+/// The energy's product in two passes over the stiffness `K` where it is of order 2:
+/// `K (s ∘ (K x))` (P is `K diag(s) K + diag(d)`; the caller adds `d ∘ x`), 2 × 7 entries a
+/// row on a volume's 7-point K instead of the bilaplacian's 25 (docs/performance.md §3).
 /// The inner pass runs over every vertex (fixed ones too: their values are in q, not in x),
 /// the outer one over the free variables; both are [`RowClasses`], so they sum rows side by
 /// side as P's product does. The sums differ from P's by rounding.
@@ -259,25 +259,23 @@ pub(super) struct TwoPass {
     inner: RowClasses,
     /// Row `u` (a free variable): `K_{free[u], v}` over every vertex `v`.
     outer: RowClasses,
-    /// The data term's diagonal on the free variables.
-    data: Vec<f64>,
     /// `s ∘ (K x)`, one a vertex.
     scratch: std::sync::Mutex<Vec<f64>>,
 }
 
 impl TwoPass {
-    /// From the stiffness `k` (whole, symmetric), the inner pass's row scales `s` (already
-    /// divided by the problem's scale) and the free variables' data diagonal (likewise).
+    /// From the stiffness `k` (whole, symmetric) and the inner pass's row scales `s`, both
+    /// divided by `scale` (the problem's).
     pub(super) fn new(
         k: &Sparse,
         row_scale: &[f64],
-        data: Vec<f64>,
+        scale: f64,
         free: &[usize],
         slot: &[usize],
     ) -> Result<TwoPass, &'static str> {
         let (cp, ri, val) = (k.symbolic().col_ptr(), k.symbolic().row_idx(), k.val());
         let n_all = k.ncols();
-        if row_scale.len() != n_all || slot.len() != n_all || data.len() != free.len() {
+        if row_scale.len() != n_all || slot.len() != n_all {
             return Err("the stiffness, its row scales and the free variables disagree in size");
         }
         // K is symmetric: column v is row v
@@ -285,7 +283,7 @@ impl TwoPass {
             for q in cp[v]..cp[v + 1] {
                 let s = slot[ri[q]];
                 if s != usize::MAX {
-                    entry(s, row_scale[v] * val[q]);
+                    entry(s, (row_scale[v] / scale) * val[q]);
                 }
             }
             Ok(())
@@ -297,15 +295,15 @@ impl TwoPass {
             }
             Ok(())
         })?;
-        Ok(TwoPass { inner, outer, data, scratch: std::sync::Mutex::new(vec![0.0; n_all]) })
+        Ok(TwoPass { inner, outer, scratch: std::sync::Mutex::new(vec![0.0; n_all]) })
     }
 
-    /// `y = P x`.
-    pub(super) fn apply(&self, x: &[f64], y: &mut [f64]) {
+    /// `y = K (s ∘ (K x)) + d ∘ x`, with `d` the data term's diagonal on the free variables.
+    pub(super) fn apply(&self, x: &[f64], d: &[f64], y: &mut [f64]) {
         let mut t = self.scratch.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
         self.inner.apply(x, &mut t);
         self.outer.apply(&t, y);
-        y.iter_mut().zip(x).zip(&self.data).for_each(|((y, x), d)| *y += d * x);
+        y.iter_mut().zip(x).zip(d).for_each(|((y, x), d)| *y += d * x);
     }
 }
 
@@ -471,12 +469,13 @@ mod tests {
         let free: Vec<usize> = (0..n).filter(|v| !fixed.contains(v)).collect();
         let mut slot = vec![usize::MAX; n];
         free.iter().enumerate().for_each(|(k, &v)| slot[v] = k);
-        let two = TwoPass::new(&k, &s, free.iter().map(|&v| data[v]).collect(), &free, &slot).unwrap();
+        let two = TwoPass::new(&k, &s, 1.0, &free, &slot).unwrap();
+        let d: Vec<f64> = free.iter().map(|&v| data[v]).collect();
         // the inner rows inside the box repeat: far fewer classes than rows
         assert!(two.inner.classes() < n / 2, "{} classes", two.inner.classes());
         let x: Vec<f64> = (0..free.len()).map(|i| (i as f64 * 0.37).sin()).collect();
         let mut y = vec![0.0; free.len()];
-        two.apply(&x, &mut y);
+        two.apply(&x, &d, &mut y);
         for (u, &i) in free.iter().enumerate() {
             let mut expected = data[i] * x[u];
             for (w, &j) in free.iter().enumerate() {
@@ -486,6 +485,6 @@ mod tests {
             assert!((y[u] - expected).abs() <= 1e-12 * (1.0 + expected.abs()), "row {u}: {} against {expected}", y[u]);
         }
         // sizes that disagree are refused
-        assert!(TwoPass::new(&k, &s[1..], vec![0.0; free.len()], &free, &slot).is_err());
+        assert!(TwoPass::new(&k, &s[1..], 1.0, &free, &slot).is_err());
     }
 }

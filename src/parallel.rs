@@ -124,6 +124,27 @@ pub fn split_mut<A: Send>(a: &mut [A], f: impl Fn(usize, &mut [A]) + Sync) {
     });
 }
 
+/// Runs `f` on every item of `items`, on up to the cap's threads, each thread a contiguous run
+/// of at least `min_items` items: for work cut into blocks fixed by the data (a sum per block,
+/// the blocks' sums added in order after), which gives the same bits on any number of threads.
+pub fn for_each_mut<A: Send>(items: &mut [A], min_items: usize, f: impl Fn(&mut A) + Sync) {
+    let t = threads().min(items.len() / min_items.max(1)).max(1);
+    if t < 2 {
+        items.iter_mut().for_each(f);
+        return;
+    }
+    let chunk = items.len().div_ceil(t);
+    let f = &f;
+    std::thread::scope(|scope| {
+        let mut pieces = items.chunks_mut(chunk);
+        let first = pieces.next().expect("at least one piece");
+        for piece in pieces {
+            scope.spawn(move || with_threads(1, || piece.iter_mut().for_each(f)));
+        }
+        with_threads(1, || first.iter_mut().for_each(f));
+    });
+}
+
 /// [`split_mut`] over two slices of the same length, split at the same places.
 ///
 /// # Panics
@@ -189,6 +210,9 @@ mod tests {
                 });
                 assert!(a.iter().enumerate().all(|(i, &v)| v == i + 1), "n = {n}, {t} threads");
                 assert!(b.iter().all(|&w| w == 1));
+                let mut items: Vec<(usize, usize)> = (0..n % 1000).map(|i| (i, 0)).collect();
+                with_threads(t, || for_each_mut(&mut items, 3, |(i, v)| *v = *i + 1));
+                assert!(items.iter().all(|&(i, v)| v == i + 1), "{} items, {t} threads", n % 1000);
             }
         }
     }

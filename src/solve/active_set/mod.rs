@@ -62,8 +62,13 @@ const FIRST_TOLERANCE: f64 = 1e-3;
 /// 32³ this halves the conjugate-gradient iterations of a fixed tenth-per-iteration schedule
 /// at the same outer count, where 10⁻³ of the gap stalls the iteration.
 const GAP_SHARE: f64 = 1e-2;
-/// The loosest solve after the first.
-const LOOSEST_TOLERANCE: f64 = 1e-4;
+/// The loosest solve after the first, relative to the data term. Measured 2026-12-06 against
+/// 10⁻⁴ (docs/performance.md §3): 10⁻² halves the conjugate-gradient iterations at 64³ and
+/// 128³ (2,108 → 1,399, 2,578 → 1,596) and on the tie-heavy volumes (64³ 4,528 → 2,973),
+/// with the same outer count within 10 %; looser solves (3·10⁻², 10⁻¹) took more outer
+/// iterations on the tie-heavy volumes and sent the fMRI frame past the fit's target after the
+/// margin repair (a hand-over, 8 → 87 s).
+const LOOSEST_TOLERANCE: f64 = 1e-2;
 
 /// What the iteration did, beside the point.
 pub(super) struct ActiveSetOutcome {
@@ -92,13 +97,13 @@ pub(crate) fn operand_bytes(n: usize, m: usize, p_entries: usize, two_pass: Opti
 /// phase by phase (clusters, trees and unknowns never outnumber the variables; the set's pair
 /// rows form a forest, so fewer than the variables): throughout, the point, the gradient, the
 /// rows' flags and multipliers (16 a variable, 10 a row) and the clusters with their trees (60
-/// a variable); the conjugate gradients' vectors and unknown map (100); the flow network when
-/// every cluster is marked and every row is an arc (nodes, terminals, supplies, cut sides:
-/// 198 a variable, and 12 more where the clusters are shared out between two networks: a
-/// node and a cluster map per network, the clusters' sizes; arcs with their reverses, doubled
-/// by the vectors' growth, the arc list and the flows handed back: 112 a row); the join's
-/// labels, tables and violated list (27 a variable, 33 a row); the clusters' construction
-/// (41). The flow's phase is the largest: 16 + 60 + 8 + 210 per variable, 10 + 112 per row,
+/// a variable); the conjugate gradients' vectors, unknown map and each unknown's variables
+/// (100); the flow network when every cluster is marked and every row is an arc (nodes,
+/// terminals, supplies, cut sides: 198 a variable, and 12 more where the clusters are shared
+/// out between two networks: a node and a cluster map per network, the clusters' sizes; arcs
+/// with their reverses, doubled by the vectors' growth, the arc list and the flows handed
+/// back: 112 a row); the join's labels, tables and violated list (27 a variable, 33 a row);
+/// the clusters' construction (41). The flow's phase is the largest: 16 + 60 + 8 + 210 per variable, 10 + 112 per row,
 /// rounded up.
 #[must_use]
 pub(crate) fn iteration_bytes(n: usize, m: usize) -> u64 {

@@ -16,6 +16,9 @@ use std::collections::HashMap;
 /// Rows of one class a product sums side by side.
 const LANES: usize = 8;
 
+/// A diagonal and a vector whose product a row's sum is given: `(d, v)` for `+ d ∘ v`.
+type Plus<'a> = (&'a [f64], &'a [f64]);
+
 /// Rows below which a product stays on one thread.
 const PARALLEL_ROWS: usize = 20_000;
 
@@ -195,7 +198,7 @@ impl RowClasses {
     /// rows at a time, each entry applied to all of them (their sums are independent, so
     /// they overlap in the pipeline and the loads are contiguous), each row still summed in
     /// its entries' order.
-    fn rows_into(&self, first: usize, x: &[f64], y: &mut [f64]) {
+    fn rows_into(&self, first: usize, x: &[f64], plus: Option<Plus<'_>>, y: &mut [f64]) {
         let mut k = 0;
         while k < y.len() {
             let i = first + k;
@@ -217,7 +220,14 @@ impl RowClasses {
                         *acc += v * xv;
                     }
                 }
-                y[k..k + LANES].copy_from_slice(&acc);
+                match plus {
+                    Some((d, v)) => {
+                        for (l, acc) in acc.iter().enumerate() {
+                            y[k + l] = acc + d[i + l] * v[i + l];
+                        }
+                    }
+                    None => y[k..k + LANES].copy_from_slice(&acc),
+                }
                 k += LANES;
             }
             while k < run_end {
@@ -226,25 +236,37 @@ impl RowClasses {
                 for (&o, &v) in offset.iter().zip(value) {
                     acc += v * x[(i as i64 + o as i64) as usize];
                 }
-                y[k] = acc;
+                y[k] = match plus {
+                    Some((d, v)) => acc + d[i] * v[i],
+                    None => acc,
+                };
                 k += 1;
             }
         }
     }
 
-    fn rows_into_split(&self, first: usize, x: &[f64], y: &mut [f64]) {
+    fn rows_into_split(&self, first: usize, x: &[f64], plus: Option<Plus<'_>>, y: &mut [f64]) {
         if y.len() < PARALLEL_ROWS || crate::parallel::threads() < 2 {
-            return self.rows_into(first, x, y);
+            return self.rows_into(first, x, plus, y);
         }
         let mid = y.len() / 2;
         let (a, b) = y.split_at_mut(mid);
-        crate::parallel::join(|| self.rows_into_split(first, x, a), || self.rows_into_split(first + mid, x, b));
+        crate::parallel::join(
+            || self.rows_into_split(first, x, plus, a),
+            || self.rows_into_split(first + mid, x, plus, b),
+        );
     }
 
     /// `y = P x`, the rows split between the threads the cap allows (each row's sum is the
     /// same whatever the split).
     pub(super) fn apply(&self, x: &[f64], y: &mut [f64]) {
-        self.rows_into_split(0, x, y);
+        self.rows_into_split(0, x, None, y);
+    }
+
+    /// `y = P x + d ∘ v`, each row's sum then `d v` added, as [`RowClasses::apply`] followed by
+    /// `y += d ∘ v` would give it.
+    pub(super) fn apply_plus(&self, x: &[f64], (d, v): Plus<'_>, y: &mut [f64]) {
+        self.rows_into_split(0, x, Some((d, v)), y);
     }
 }
 
@@ -299,11 +321,11 @@ impl TwoPass {
     }
 
     /// `y = K (s ∘ (K x)) + d ∘ x`, with `d` the data term's diagonal on the free variables.
+    /// The data term's product is added to each row's sum in the outer pass.
     pub(super) fn apply(&self, x: &[f64], d: &[f64], y: &mut [f64]) {
         let mut t = self.scratch.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
         self.inner.apply(x, &mut t);
-        self.outer.apply(&t, y);
-        y.iter_mut().zip(x).zip(d).for_each(|((y, x), d)| *y += d * x);
+        self.outer.apply_plus(&t, (d, x), y);
     }
 }
 

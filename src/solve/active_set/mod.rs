@@ -63,10 +63,10 @@ const FIRST_TOLERANCE: f64 = 1e-3;
 /// at the same outer count, where 10⁻³ of the gap stalls the iteration.
 const GAP_SHARE: f64 = 1e-2;
 /// The loosest solve after the first, relative to the data term. Looser ones were measured
-/// (2026-12-06, docs/performance.md §3): 10⁻² halves the conjugate-gradient iterations at
-/// 128³ (2,578 → 1,596; 80.7 → 64.0 s) but the tie-heavy 96³ volume then ends at the outer
-/// limit (a hand-over predicted past the memory, exit 3), and 10⁻² for the first 15 outer
-/// iterations only takes the tie-heavy 64³ from 61 to 101 outer iterations.
+/// (2026-12-06, docs/performance.md §3): 10⁻² cuts the conjugate-gradient iterations at 128³
+/// from 2,578 to 1,596 (77.9–80.7 → 61.1–64.0 s), but the tie-heavy 96³ volume then ends at
+/// the outer limit (a hand-over predicted past the memory, exit 3); 10⁻² for the first 15
+/// outer iterations only takes the tie-heavy 64³ from 61 to 101 outer iterations.
 const LOOSEST_TOLERANCE: f64 = 1e-4;
 
 /// What the iteration did, beside the point.

@@ -102,8 +102,8 @@ pub(crate) fn operand_bytes(n: usize, m: usize, p_entries: usize, two_pass: Opti
 /// out between two networks: a node and a cluster map per network, the clusters' sizes; arcs
 /// with their reverses, doubled by the vectors' growth, the arc list and the flows handed
 /// back: 112 a row); the join's labels, tables and violated list (27 a variable, 33 a row);
-/// the clusters' construction (41). The flow's phase is the largest: 16 + 60 + 8 + 210 per variable, 10 + 112 per row,
-/// rounded up.
+/// the clusters' construction (41). The flow's phase is the largest: 16 + 60 + 8 + 210 per
+/// variable, 10 + 112 per row, rounded up.
 #[must_use]
 pub(crate) fn iteration_bytes(n: usize, m: usize) -> u64 {
     let (n, m) = (n as u64, m as u64);

@@ -265,8 +265,8 @@ impl RowClasses {
 
     /// `y = P x + d ∘ v`, each row's sum then `d v` added, as [`RowClasses::apply`] followed by
     /// `y += d ∘ v` would give it.
-    pub(super) fn apply_plus(&self, x: &[f64], (d, v): Plus<'_>, y: &mut [f64]) {
-        self.rows_into_split(0, x, Some((d, v)), y);
+    pub(super) fn apply_plus(&self, x: &[f64], plus: Plus<'_>, y: &mut [f64]) {
+        self.rows_into_split(0, x, Some(plus), y);
     }
 }
 

@@ -6,42 +6,57 @@ use super::rows::Row;
 pub(super) const NONE: u32 = u32::MAX;
 
 /// The working set's trees, breadth first from each cluster's root (its anchor row's variable
-/// when anchored, else its first variable): each variable's row to its parent (`usize::MAX`
-/// at a root) and its depth.
+/// when anchored, else its first variable): each variable's step up and its depth.
 pub(super) struct Forest {
-    pub(super) parent_row: Vec<usize>,
+    pub(super) up: Vec<Up>,
     pub(super) depth: Vec<u32>,
     /// The variables cluster by cluster, each cluster's in breadth-first order from its root.
     pub(super) order: Vec<usize>,
 }
 
+/// A variable's step up its tree: the row to its parent, which side of the row it is (the
+/// row's top bit: set when the variable is the first of `Pair(i, j, _)`), and its parent;
+/// [`Up::ROOT`] at a root. One record per variable, so that a search touches one place.
+#[derive(Clone, Copy)]
+pub(super) struct Up {
+    row: u32,
+    parent: u32,
+}
+
+impl Up {
+    const FIRST: u32 = 1 << 31;
+    pub(super) const ROOT: Up = Up { row: NONE, parent: NONE };
+
+    /// The row to the parent, `None` at a root.
+    pub(super) fn row(self) -> Option<usize> {
+        (self.row != NONE).then_some((self.row & !Up::FIRST) as usize)
+    }
+
+    pub(super) fn parent(self) -> usize {
+        self.parent as usize
+    }
+
+    /// Whether the variable is its row's first (`i` of `Pair(i, j, _)`).
+    pub(super) fn is_first(self) -> bool {
+        self.row & Up::FIRST != 0
+    }
+}
+
 impl Forest {
     /// Calls `visit(row, rises)` for each tree row on the path from `i` to `j` (one tree),
     /// `rises` when `x` rises along it in the direction `i → j`.
-    pub(super) fn walk_path(&self, rows: &[Row], mut i: usize, mut j: usize, mut visit: impl FnMut(usize, bool)) {
+    pub(super) fn walk_path(&self, mut i: usize, mut j: usize, mut visit: impl FnMut(usize, bool)) {
         // Pair(a, b) is x_a − x_b ≤ −ε: x rises from a to b. Walking up from i, a row rises
         // along i → j when i's side is its a; walking up from j, when j's side is its b.
-        let other = |k: usize, v: usize| match rows[k] {
-            Row::Pair(a, b, _) => (if a == v { b } else { a }, a == v),
-            Row::Bound(..) => unreachable!("tree rows are pairs"),
-        };
         while i != j {
-            if self.depth[i] >= self.depth[j] {
-                let k = self.parent_row[i];
-                if k == usize::MAX {
-                    return;
-                }
-                let (p, from_a) = other(k, i);
-                visit(k, from_a);
-                i = p;
+            let (v, from_i) = if self.depth[i] >= self.depth[j] { (i, true) } else { (j, false) };
+            let up = self.up[v];
+            let Some(k) = up.row() else { return };
+            visit(k, up.is_first() == from_i);
+            if from_i {
+                i = up.parent();
             } else {
-                let k = self.parent_row[j];
-                if k == usize::MAX {
-                    return;
-                }
-                let (p, from_a) = other(k, j);
-                visit(k, !from_a);
-                j = p;
+                j = up.parent();
             }
         }
     }
@@ -102,11 +117,24 @@ impl Labels {
     }
 }
 
+/// A row of the working set as seen from one of its variables: the variable across it and
+/// that variable's offset from this one.
+#[derive(Clone, Copy)]
+struct Across {
+    /// The row, its top bit set when `to` is its first variable (as in [`Up`]).
+    row: u32,
+    to: u32,
+    step: f64,
+}
+
 impl Clusters {
     pub(super) fn new(n: usize, rows: &[Row], in_set: &[bool]) -> Clusters {
-        // the forest's adjacency: per variable its rows in the set, in row order
-        let mut deg = vec![0usize; n + 1];
-        for (row, _) in rows.iter().zip(in_set).filter(|(_, &s)| s) {
+        // the forest's adjacency: per variable its rows in the set, in row order, each with
+        // the variable across it and that variable's offset from this one (x_i − x_j = b:
+        // from i, j lies at −b; from j, i at +b), so that the searches below never look up
+        // the rows themselves
+        let mut deg = vec![0u32; n + 1];
+        for row in rows.iter().zip(in_set).filter(|(_, &s)| s).map(|(r, _)| r) {
             if let Row::Pair(i, j, _) = *row {
                 deg[i + 1] += 1;
                 deg[j + 1] += 1;
@@ -115,31 +143,23 @@ impl Clusters {
         for v in 0..n {
             deg[v + 1] += deg[v];
         }
-        let mut adj = vec![0usize; deg[n]];
+        let mut adj = vec![Across { row: 0, to: 0, step: 0.0 }; deg[n] as usize];
         let mut at = deg.clone();
-        for (k, (row, _)) in rows.iter().zip(in_set).enumerate().filter(|(_, (_, &s))| s) {
-            if let Row::Pair(i, j, _) = *row {
-                adj[at[i]] = k;
+        for (k, row) in rows.iter().enumerate().zip(in_set).filter(|(_, &s)| s).map(|(r, _)| r) {
+            if let Row::Pair(i, j, b) = *row {
+                adj[at[i] as usize] = Across { row: k as u32, to: j as u32, step: -b };
                 at[i] += 1;
-                adj[at[j]] = k;
+                adj[at[j] as usize] = Across { row: k as u32 | Up::FIRST, to: i as u32, step: b };
                 at[j] += 1;
             }
         }
         drop(at);
-        // x_i − x_j = b: from i, j lies at −b; from j, i at +b
-        let across = |k: usize, v: usize| match rows[k] {
-            Row::Pair(i, j, b) => {
-                if v == i {
-                    (j, -b)
-                } else {
-                    (i, b)
-                }
-            }
-            Row::Bound(..) => unreachable!("the adjacency holds pair rows"),
-        };
+        let adjacent = |v: usize| &adj[deg[v] as usize..deg[v + 1] as usize];
         let mut label = vec![NONE; n];
         let mut offset = vec![0.0; n];
-        let mut parent_row = vec![usize::MAX; n];
+        // rows and variables are counted in u32, the row's top bit marking its side
+        assert!(rows.len() < Up::FIRST as usize && n < NONE as usize, "more rows or variables than the clusters count");
+        let mut up = vec![Up::ROOT; n];
         let mut depth = vec![0u32; n];
         let mut order = Vec::with_capacity(n);
         let mut first = Vec::new();
@@ -155,12 +175,12 @@ impl Clusters {
             while head < order.len() {
                 let v = order[head];
                 head += 1;
-                for &k in &adj[deg[v]..deg[v + 1]] {
-                    let (w, step) = across(k, v);
+                for a in adjacent(v) {
+                    let w = a.to as usize;
                     if label[w] == NONE {
                         label[w] = count;
-                        offset[w] = offset[v] + step;
-                        parent_row[w] = k;
+                        offset[w] = offset[v] + a.step;
+                        up[w] = Up { row: a.row, parent: v as u32 };
                         depth[w] = depth[v] + 1;
                         order.push(w);
                     }
@@ -172,7 +192,7 @@ impl Clusters {
         let nc = count as usize;
         let mut anchor: Vec<Option<f64>> = vec![None; nc];
         let mut anchor_row = vec![usize::MAX; nc];
-        for (k, (row, _)) in rows.iter().zip(in_set).enumerate().filter(|(_, (_, &s))| s) {
+        for (k, row) in rows.iter().enumerate().zip(in_set).filter(|(_, &s)| s).map(|(r, _)| r) {
             if let Row::Bound(v, a, b) = *row {
                 anchor[label[v] as usize] = Some(a * b - offset[v]);
                 anchor_row[label[v] as usize] = k;
@@ -191,18 +211,18 @@ impl Clusters {
             }
             let (start, end) = (first[c], first[c + 1]);
             seen[root] = true;
-            parent_row[root] = usize::MAX;
+            up[root] = Up::ROOT;
             depth[root] = 0;
             order[start] = root;
             let (mut head, mut tail) = (start, start + 1);
             while head < tail {
                 let v = order[head];
                 head += 1;
-                for &k in &adj[deg[v]..deg[v + 1]] {
-                    let (w, _) = across(k, v);
+                for a in adjacent(v) {
+                    let w = a.to as usize;
                     if !seen[w] {
                         seen[w] = true;
-                        parent_row[w] = k;
+                        up[w] = Up { row: a.row, parent: v as u32 };
                         depth[w] = depth[v] + 1;
                         order[tail] = w;
                         tail += 1;
@@ -219,15 +239,18 @@ impl Clusters {
                 n_unknowns += 1;
             }
         }
-        Clusters { label, offset, anchor, anchor_row, unknown, n_unknowns, forest: Forest { parent_row, depth, order } }
+        Clusters { label, offset, anchor, anchor_row, unknown, n_unknowns, forest: Forest { up, depth, order } }
     }
 
+    /// `x = C y + anchors + offsets`, on contiguous pieces one a thread.
     pub(super) fn expand(&self, y: &[f64], x: &mut [f64]) {
-        for ((xv, &c), o) in x.iter_mut().zip(&self.label).zip(&self.offset) {
-            *xv = o + match self.anchor[c as usize] {
-                Some(a) => a,
-                None => y[self.unknown[c as usize] as usize],
-            };
-        }
+        crate::parallel::split_mut(x, |off, piece| {
+            for ((xv, &c), o) in piece.iter_mut().zip(&self.label[off..]).zip(&self.offset[off..]) {
+                *xv = o + match self.anchor[c as usize] {
+                    Some(a) => a,
+                    None => y[self.unknown[c as usize] as usize],
+                };
+            }
+        });
     }
 }

@@ -82,15 +82,16 @@ pub(super) fn join(
     let n = x.len();
     // the clusters after the cuts: labels are union-find roots, so the tables below run
     // over variables
-    let cl = Labels::new(n, rows, in_set);
-    let mut violated: Vec<(f64, usize)> = rows
-        .iter()
-        .enumerate()
-        .filter(|(k, _)| !in_set[*k])
-        .map(|(k, row)| (row.violation(x), k))
-        .filter(|&(v, _)| v > ADD_ABOVE)
-        .collect();
-    violated.sort_by(|a, b| b.0.total_cmp(&a.0));
+    // the labels on one thread, the violated rows (in row order, then by violation, a stable
+    // sort) on the other: the same on any number of threads
+    let (cl, violated) = crate::parallel::join(
+        || Labels::new(n, rows, in_set),
+        || {
+            let mut violated = violated_rows(rows, in_set, x);
+            violated.sort_by(|a, b| b.0.total_cmp(&a.0));
+            violated
+        },
+    );
     let worst = violated.first().map_or(0.0, |v| v.0);
     let joining = violated.partition_point(|v| v.0 >= share * worst);
     let nc = n;
@@ -128,7 +129,7 @@ pub(super) fn join(
                 let c = cl.label[i] as usize;
                 let mut crosses = reanchored[c];
                 let mut rising: Option<usize> = None;
-                forest.walk_path(rows, i, j, |row, rises| {
+                forest.walk_path(i, j, |row, rises| {
                     crosses |= taken_out[row];
                     if rises && rising.is_none_or(|b| z[row] < z[b]) {
                         rising = Some(row);
@@ -213,3 +214,22 @@ pub(super) fn join(
     }
     Joined { changed, swaps, stuck, worst, violated: violated.len() }
 }
+
+/// The rows outside `in_set` violated by more than [`ADD_ABOVE`] at `x`, as (violation, row)
+/// in row order; made on contiguous pieces of the rows one a thread and put together in order.
+fn violated_rows(rows: &[Row], in_set: &[bool], x: &[f64]) -> Vec<(f64, usize)> {
+    let mut pieces: Vec<(usize, Vec<(f64, usize)>)> =
+        (0..rows.len().div_ceil(ROWS_PIECE)).map(|p| (p * ROWS_PIECE, Vec::new())).collect();
+    crate::parallel::for_each_mut(&mut pieces, 1, |(first, out)| {
+        let end = (*first + ROWS_PIECE).min(rows.len());
+        out.extend(
+            (*first..end).filter(|&k| !in_set[k]).map(|k| (rows[k].violation(x), k)).filter(|&(v, _)| v > ADD_ABOVE),
+        );
+    });
+    let mut all = Vec::with_capacity(pieces.iter().map(|p| p.1.len()).sum());
+    pieces.into_iter().for_each(|(_, p)| all.extend(p));
+    all
+}
+
+/// Rows per piece of [`violated_rows`].
+const ROWS_PIECE: usize = 1 << 18;

@@ -35,21 +35,19 @@ pub(super) fn balanced_gradient(cl: &Clusters, g: &[f64], d: &[f64]) -> Vec<f64>
 pub(super) fn tree_multipliers(rows: &[Row], cl: &Clusters, balanced: &[f64], z: &mut [f64]) {
     z.iter_mut().for_each(|v| *v = 0.0);
     let mut acc = balanced.to_vec();
-    let Forest { parent_row, order, .. } = &cl.forest;
+    let Forest { up, order, .. } = &cl.forest;
     for &v in order.iter().rev() {
-        let k = parent_row[v];
-        if k == usize::MAX {
+        let Some(k) = up[v].row() else {
             let anchor = cl.anchor_row[cl.label[v] as usize];
             if let Some(Row::Bound(_, a, _)) = rows.get(anchor) {
                 z[anchor] = -a * acc[v];
             }
             continue;
-        }
-        let Row::Pair(i, j, _) = rows[k] else { unreachable!("tree rows are pairs") };
-        // stationarity at v: acc_v + a_kv z_k = 0, a = +1 at i, −1 at j
-        let (a_v, parent) = if v == i { (1.0, j) } else { (-1.0, i) };
+        };
+        // stationarity at v: acc_v + a_kv z_k = 0, a = +1 at i, −1 at j of Pair(i, j, _)
+        let a_v = if up[v].is_first() { 1.0 } else { -1.0 };
         z[k] = -a_v * acc[v];
-        acc[parent] += acc[v];
+        acc[up[v].parent()] += acc[v];
     }
 }
 

@@ -91,39 +91,14 @@ pub(super) fn solve_clustered(obj: &Objective<'_>, cl: &Clusters, x: &mut [f64],
         return 0;
     }
     // each variable's unknown (NONE when anchored); the identity when no row is in the set
-    let of_vertex: Vec<u32> = cl.label.iter().map(|&c| cl.unknown[c as usize]).collect();
+    let mut of_vertex = vec![0u32; n];
+    crate::parallel::split_mut(&mut of_vertex, |off, piece| {
+        piece.iter_mut().zip(&cl.label[off..]).for_each(|(u, &c)| *u = cl.unknown[c as usize]);
+    });
     let identity = nu == n && of_vertex.iter().enumerate().all(|(v, &u)| u as usize == v);
-    // start: cluster means; weights D_c; Jacobi diagonal of CᵀPC
-    let mut y = vec![0.0; nu];
-    let mut size = vec![0.0; nu];
-    let mut dsum = vec![0.0; nu];
-    for (v, xv) in x.iter().enumerate() {
-        let u = of_vertex[v];
-        if u != NONE {
-            y[u as usize] += xv - cl.offset[v];
-            size[u as usize] += 1.0;
-            dsum[u as usize] += obj.d[v];
-        }
-    }
-    y.iter_mut().zip(&size).for_each(|(y, s)| *y /= s);
-    let mut diag = vec![0.0; nu];
-    for (i, &u) in of_vertex.iter().enumerate() {
-        if u == NONE {
-            continue;
-        }
-        if size[u as usize] == 1.0 {
-            // a cluster of one: its diagonal alone (the same sum, in the same order)
-            diag[u as usize] = obj.p.diagonal(i);
-            continue;
-        }
-        for (j, v) in obj.p.row(i) {
-            if cl.label[j] == cl.label[i] {
-                diag[u as usize] += v;
-            }
-        }
-    }
-    drop(size);
     let members = (!identity).then(|| Members::new(&of_vertex, nu));
+    // start: cluster means; weights 1 / D_c; Jacobi weights 1 / diag(CᵀPC)
+    let (mut y, inv_dsum, inv_diag) = unknowns_start(obj, cl, x, members.as_ref());
     let mut xs = if identity { Vec::new() } else { vec![0.0; n] };
     let mut px = vec![0.0; n];
     // r = −Cᵀ∇φ(C y + anchors)
@@ -131,15 +106,13 @@ pub(super) fn solve_clustered(obj: &Objective<'_>, cl: &Clusters, x: &mut [f64],
     obj.gradient(x, &mut px);
     let mut r = vec![0.0; nu];
     match &members {
-        Some(m) => {
-            r.iter_mut().enumerate().for_each(|(u, r)| *r = -m.of(u).iter().fold(0.0, |s, &v| s + px[v as usize]))
-        }
+        Some(m) => crate::parallel::split_mut(&mut r, |off, piece| {
+            for (k, r) in piece.iter_mut().enumerate() {
+                *r = -m.of(off + k).iter().fold(0.0, |s, &v| s + px[v as usize]);
+            }
+        }),
         None => r.iter_mut().zip(&px).for_each(|(r, p)| *r = -p),
     }
-    let inv_dsum: Vec<f64> = dsum.iter().map(|d| 1.0 / d.max(f64::MIN_POSITIVE)).collect();
-    drop(dsum);
-    let inv_diag: Vec<f64> = diag.iter().map(|d| 1.0 / d).collect();
-    drop(diag);
     let measure = |r: &[f64]| 0.5 * r.iter().zip(&inv_dsum).map(|(r, w)| r * r * w).sum::<f64>();
     let mut zv: Vec<f64> = r.iter().zip(&inv_diag).map(|(r, w)| r * w).collect();
     let mut dir = zv.clone();
@@ -180,6 +153,61 @@ pub(super) fn solve_clustered(obj: &Objective<'_>, cl: &Clusters, x: &mut [f64],
     }
     cl.expand(&y, x);
     it
+}
+
+/// Per unknown (on blocks of [`BLOCK`] unknowns, shared between threads): the mean of its
+/// variables' `x − offset`, the inverse of their data diagonal's sum and the inverse of its
+/// diagonal in CᵀPC, each summed over its variables in increasing order (one variable per
+/// unknown when `members` is absent); the same bits on any number of threads.
+fn unknowns_start(
+    obj: &Objective<'_>,
+    cl: &Clusters,
+    x: &[f64],
+    members: Option<&Members>,
+) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
+    let nu = cl.n_unknowns;
+    let (mut y, mut inv_dsum, mut inv_diag) = (vec![0.0; nu], vec![0.0; nu], vec![0.0; nu]);
+    type Part<'a> = (usize, &'a mut [f64], &'a mut [f64], &'a mut [f64]);
+    let mut parts: Vec<Part<'_>> = y
+        .chunks_mut(BLOCK)
+        .zip(inv_dsum.chunks_mut(BLOCK))
+        .zip(inv_diag.chunks_mut(BLOCK))
+        .enumerate()
+        .map(|(b, ((y, w), g))| (b * BLOCK, y, w, g))
+        .collect();
+    crate::parallel::for_each_mut(&mut parts, PARALLEL_BLOCKS, |(first, y, inv_dsum, inv_diag)| {
+        for k in 0..y.len() {
+            let u = *first + k;
+            let one = [u as u32];
+            let of = members.map_or(&one[..], |m| m.of(u));
+            let (mut sum, mut dsum) = (0.0, 0.0);
+            for &v in of {
+                let v = v as usize;
+                sum += x[v] - cl.offset[v];
+                dsum += obj.d[v];
+            }
+            let diag = if let [i] = *of {
+                // a cluster of one: its diagonal alone
+                obj.p.diagonal(i as usize)
+            } else {
+                let mut diag = 0.0;
+                for &i in of {
+                    let i = i as usize;
+                    for (j, v) in obj.p.row(i) {
+                        if cl.label[j] == cl.label[i] {
+                            diag += v;
+                        }
+                    }
+                }
+                diag
+            };
+            y[k] = sum / of.len() as f64;
+            inv_dsum[k] = 1.0 / dsum.max(f64::MIN_POSITIVE);
+            inv_diag[k] = 1.0 / diag;
+        }
+    });
+    drop(parts);
+    (y, inv_dsum, inv_diag)
 }
 
 /// `xs[v] = dir[u]` for each variable `v` of unknown `u`, 0 at anchored ones.

@@ -114,12 +114,11 @@ pub(super) fn solve_clustered(obj: &Objective<'_>, cl: &Clusters, x: &mut [f64],
         None => r.iter_mut().zip(&px).for_each(|(r, p)| *r = -p),
     }
     let measure = |r: &[f64]| 0.5 * r.iter().zip(&inv_dsum).map(|(r, w)| r * r * w).sum::<f64>();
-    let mut zv: Vec<f64> = r.iter().zip(&inv_diag).map(|(r, w)| r * w).collect();
-    let mut dir = zv.clone();
+    let mut dir: Vec<f64> = r.iter().zip(&inv_diag).map(|(r, w)| r * w).collect();
     if !identity {
         scatter(&dir, &of_vertex, &mut xs);
     }
-    let mut rz: f64 = r.iter().zip(&zv).map(|(a, b)| a * b).sum();
+    let mut rz: f64 = r.iter().zip(&dir).map(|(a, b)| a * b).sum();
     let mut hd = vec![0.0; nu];
     let mut it = 0;
     let mut m = measure(&r);
@@ -138,13 +137,15 @@ pub(super) fn solve_clustered(obj: &Objective<'_>, cl: &Clusters, x: &mut [f64],
             break;
         }
         let alpha = rz / dhd;
-        // one pass: the step, the residual, its preconditioned form and both sums
-        let (rz_new, rd) = step_blocks(alpha, (&mut y, &mut r, &mut zv), (&dir, &hd), (&inv_diag, &inv_dsum));
+        // one pass: the step, the residual and both sums
+        let (rz_new, rd) = step_blocks(alpha, (&mut y, &mut r), (&dir, &hd), (&inv_diag, &inv_dsum));
         m = 0.5 * rd;
         let beta = rz_new / rz;
         rz = rz_new;
+        // the preconditioned residual r / diag made again here rather than stored by the step
+        // (the same bits; one vector less through memory)
         crate::parallel::split_mut(&mut dir, |off, piece| {
-            piece.iter_mut().zip(&zv[off..]).for_each(|(p, z)| *p = z + beta * *p);
+            piece.iter_mut().zip(r[off..].iter().zip(&inv_diag[off..])).for_each(|(p, (r, w))| *p = r * w + beta * *p);
         });
         if !identity {
             scatter(&dir, &of_vertex, &mut xs);
@@ -259,26 +260,21 @@ fn lane_sum(terms: impl Iterator<Item = f64>) -> f64 {
 /// in order.
 fn step_blocks(
     alpha: f64,
-    (y, r, z): (&mut [f64], &mut [f64], &mut [f64]),
+    (y, r): (&mut [f64], &mut [f64]),
     (p, hp): (&[f64], &[f64]),
     (inv_diag, inv_dsum): (&[f64], &[f64]),
 ) -> (f64, f64) {
-    type Part<'a> = (usize, (&'a mut [f64], &'a mut [f64], &'a mut [f64]), (f64, f64));
+    type Part<'a> = (usize, (&'a mut [f64], &'a mut [f64]), (f64, f64));
     let mut parts: Vec<Part<'_>> = y
         .chunks_mut(BLOCK)
         .zip(r.chunks_mut(BLOCK))
-        .zip(z.chunks_mut(BLOCK))
         .enumerate()
-        .map(|(b, ((y, r), z))| (b * BLOCK, (y, r, z), (0.0, 0.0)))
+        .map(|(b, (y, r))| (b * BLOCK, (y, r), (0.0, 0.0)))
         .collect();
-    crate::parallel::for_each_mut(&mut parts, PARALLEL_BLOCKS, |(first, (y, r, z), sums)| {
+    crate::parallel::for_each_mut(&mut parts, PARALLEL_BLOCKS, |(first, (y, r), sums)| {
         let range = *first..*first + y.len();
-        *sums = step(
-            alpha,
-            (y, r, z),
-            (&p[range.clone()], &hp[range.clone()]),
-            (&inv_diag[range.clone()], &inv_dsum[range]),
-        );
+        *sums =
+            step(alpha, (y, r), (&p[range.clone()], &hp[range.clone()]), (&inv_diag[range.clone()], &inv_dsum[range]));
     });
     parts.iter().fold((0.0, 0.0), |(a, b), p| (a + p.2 .0, b + p.2 .1))
 }
@@ -287,36 +283,30 @@ fn step_blocks(
 /// fixed order at the end (a single running sum made each pass wait on its additions).
 const LANES: usize = 4;
 
-/// The conjugate-gradient step: `y += α p`, `r −= α H p`, `z = r / diag`; returns `rᵀz` and
-/// `Σ r² / D` (each in [`LANES`] running sums).
+/// The conjugate-gradient step: `y += α p`, `r −= α H p`; returns `rᵀz` with `z = r / diag`
+/// (not stored) and `Σ r² / D` (each in [`LANES`] running sums).
 fn step(
     alpha: f64,
-    (y, r, z): (&mut [f64], &mut [f64], &mut [f64]),
+    (y, r): (&mut [f64], &mut [f64]),
     (p, hp): (&[f64], &[f64]),
     (inv_diag, inv_dsum): (&[f64], &[f64]),
 ) -> (f64, f64) {
     let (mut rz, mut rd) = ([0.0; LANES], [0.0; LANES]);
     let whole = y.len() / LANES * LANES;
-    let one = |k: usize,
-               l: usize,
-               y: &mut [f64],
-               r: &mut [f64],
-               z: &mut [f64],
-               rz: &mut [f64; LANES],
-               rd: &mut [f64; LANES]| {
+    let one = |k: usize, l: usize, y: &mut [f64], r: &mut [f64], rz: &mut [f64; LANES], rd: &mut [f64; LANES]| {
         y[k] += alpha * p[k];
         r[k] -= alpha * hp[k];
-        z[k] = r[k] * inv_diag[k];
-        rz[l] += r[k] * z[k];
+        let z = r[k] * inv_diag[k];
+        rz[l] += r[k] * z;
         rd[l] += r[k] * r[k] * inv_dsum[k];
     };
     for b in (0..whole).step_by(LANES) {
         for l in 0..LANES {
-            one(b + l, l, y, r, z, &mut rz, &mut rd);
+            one(b + l, l, y, r, &mut rz, &mut rd);
         }
     }
     for k in whole..y.len() {
-        one(k, k - whole, y, r, z, &mut rz, &mut rd);
+        one(k, k - whole, y, r, &mut rz, &mut rd);
     }
     ((rz[0] + rz[1]) + (rz[2] + rz[3]), (rd[0] + rd[1]) + (rd[2] + rd[3]))
 }
@@ -361,20 +351,20 @@ mod tests {
                 with_threads(t, || {
                     let mut hd = vec![0.0; nu];
                     let dhd = gather_dot(&mut hd, &dir, &px, &members);
-                    let (mut y, mut r, mut z) = (values(nu, 3), values(nu, 4), vec![0.0; nu]);
+                    let (mut y, mut r) = (values(nu, 3), values(nu, 4));
                     let inv: Vec<f64> = values(nu, 5).iter().map(|v| 1.0 + v.abs()).collect();
-                    let sums = step_blocks(0.7, (&mut y, &mut r, &mut z), (&dir, &hd), (&inv, &inv));
+                    let sums = step_blocks(0.7, (&mut y, &mut r), (&dir, &hd), (&inv, &inv));
                     let mut xs = vec![1.0; n];
                     scatter(&dir, &of_vertex, &mut xs);
                     let dot = dot_blocks(&dir, &hd);
-                    (hd, dhd, y, r, z, sums, dot, xs)
+                    (hd, dhd, y, r, sums, dot, xs)
                 })
             })
             .collect();
         for (t, run) in runs.iter().enumerate().skip(1) {
             assert!(run == &runs[0], "1 and {} threads differ", t + 1);
         }
-        let (hd, dhd, y, r, z, (rz, rd), dot, xs) = &runs[0];
+        let (hd, dhd, y, r, (rz, rd), dot, xs) = &runs[0];
         let mut plain = vec![0.0; nu];
         for (v, &u) in of_vertex.iter().enumerate() {
             if u != NONE {
@@ -393,9 +383,8 @@ mod tests {
         for u in 0..nu {
             assert_eq!(y[u], y0[u] + 0.7 * dir[u]);
             assert_eq!(r[u], r0[u] - 0.7 * hd[u]);
-            assert_eq!(z[u], r[u] * inv[u]);
         }
-        let plain_rz: f64 = r.iter().zip(z.iter()).map(|(a, b)| a * b).sum();
+        let plain_rz: f64 = r.iter().zip(&inv).map(|(a, w)| a * (a * w)).sum();
         let plain_rd: f64 = r.iter().zip(&inv).map(|(a, w)| a * a * w).sum();
         assert!(close(*rz, plain_rz) && close(*rd, plain_rd));
     }

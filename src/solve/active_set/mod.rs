@@ -66,7 +66,8 @@ const GAP_SHARE: f64 = 1e-2;
 /// (2026-12-06, docs/performance.md §3): 10⁻² cuts the conjugate-gradient iterations at 128³
 /// from 2,578 to 1,596 (77.9–80.7 → 61.1–64.0 s), but the tie-heavy 96³ volume then ends at
 /// the outer limit (a hand-over predicted past the memory, exit 3); 10⁻² for the first 15
-/// outer iterations only takes the tie-heavy 64³ from 61 to 101 outer iterations.
+/// outer iterations only takes the tie-heavy 64³ from 61 to 101 outer iterations; 10⁻³ takes
+/// it to 108 and has the tie-heavy 72³ handed over.
 const LOOSEST_TOLERANCE: f64 = 1e-4;
 
 /// What the iteration did, beside the point.

@@ -76,6 +76,11 @@ pub(super) struct Clusters {
     pub(super) forest: Forest,
 }
 
+/// The rows in the working set with their indices, in row order.
+fn in_set_rows<'a>(rows: &'a [Row], in_set: &'a [bool]) -> impl Iterator<Item = (usize, &'a Row)> + 'a {
+    rows.iter().enumerate().zip(in_set).filter(|(_, &s)| s).map(|(r, _)| r)
+}
+
 pub(super) fn find(parent: &mut [u32], mut v: u32) -> u32 {
     while parent[v as usize] != v {
         let p = parent[v as usize];
@@ -96,7 +101,7 @@ pub(super) struct Labels {
 impl Labels {
     pub(super) fn new(n: usize, rows: &[Row], in_set: &[bool]) -> Labels {
         let mut label: Vec<u32> = (0..n as u32).collect();
-        for (row, _) in rows.iter().zip(in_set).filter(|(_, &s)| s) {
+        for (_, row) in in_set_rows(rows, in_set) {
             if let Row::Pair(i, j, _) = *row {
                 let (a, b) = (find(&mut label, i as u32), find(&mut label, j as u32));
                 if a != b {
@@ -108,7 +113,7 @@ impl Labels {
             label[v as usize] = find(&mut label, v);
         }
         let mut anchor_row = vec![usize::MAX; n];
-        for (k, (row, _)) in rows.iter().zip(in_set).enumerate().filter(|(_, (_, &s))| s) {
+        for (k, row) in in_set_rows(rows, in_set) {
             if let Row::Bound(v, _, _) = *row {
                 anchor_row[label[v] as usize] = k;
             }
@@ -134,7 +139,7 @@ impl Clusters {
         // from i, j lies at −b; from j, i at +b), so that the searches below never look up
         // the rows themselves
         let mut deg = vec![0u32; n + 1];
-        for row in rows.iter().zip(in_set).filter(|(_, &s)| s).map(|(r, _)| r) {
+        for (_, row) in in_set_rows(rows, in_set) {
             if let Row::Pair(i, j, _) = *row {
                 deg[i + 1] += 1;
                 deg[j + 1] += 1;
@@ -145,7 +150,7 @@ impl Clusters {
         }
         let mut adj = vec![Across { row: 0, to: 0, step: 0.0 }; deg[n] as usize];
         let mut at = deg.clone();
-        for (k, row) in rows.iter().enumerate().zip(in_set).filter(|(_, &s)| s).map(|(r, _)| r) {
+        for (k, row) in in_set_rows(rows, in_set) {
             if let Row::Pair(i, j, b) = *row {
                 adj[at[i] as usize] = Across { row: k as u32, to: j as u32, step: -b };
                 at[i] += 1;
@@ -192,7 +197,7 @@ impl Clusters {
         let nc = count as usize;
         let mut anchor: Vec<Option<f64>> = vec![None; nc];
         let mut anchor_row = vec![usize::MAX; nc];
-        for (k, row) in rows.iter().enumerate().zip(in_set).filter(|(_, &s)| s).map(|(r, _)| r) {
+        for (k, row) in in_set_rows(rows, in_set) {
             if let Row::Bound(v, a, b) = *row {
                 anchor[label[v] as usize] = Some(a * b - offset[v]);
                 anchor_row[label[v] as usize] = k;

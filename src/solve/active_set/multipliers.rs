@@ -37,7 +37,8 @@ pub(super) fn tree_multipliers(rows: &[Row], cl: &Clusters, balanced: &[f64], z:
     let mut acc = balanced.to_vec();
     let Forest { up, order, .. } = &cl.forest;
     for &v in order.iter().rev() {
-        let Some(k) = up[v].row() else {
+        let up = up[v];
+        let Some(k) = up.row() else {
             let anchor = cl.anchor_row[cl.label[v] as usize];
             if let Some(Row::Bound(_, a, _)) = rows.get(anchor) {
                 z[anchor] = -a * acc[v];
@@ -45,9 +46,9 @@ pub(super) fn tree_multipliers(rows: &[Row], cl: &Clusters, balanced: &[f64], z:
             continue;
         };
         // stationarity at v: acc_v + a_kv z_k = 0, a = +1 at i, −1 at j of Pair(i, j, _)
-        let a_v = if up[v].is_first() { 1.0 } else { -1.0 };
+        let a_v = if up.is_first() { 1.0 } else { -1.0 };
         z[k] = -a_v * acc[v];
-        acc[up[v].parent()] += acc[v];
+        acc[up.parent()] += acc[v];
     }
 }
 

@@ -25,6 +25,7 @@ mod analyses;
 mod cost;
 mod dissection;
 pub mod double_double;
+pub mod multigrid;
 pub(crate) mod two_way;
 
 pub use analyses::{solve_spd, Analyses, SpdSolver};

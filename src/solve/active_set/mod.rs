@@ -34,7 +34,7 @@ use crate::error::NumericalError;
 use clusters::{Clusters, NONE};
 use join::{join, share_after, Joined, ADD_ABOVE};
 use multipliers::{balanced_gradient, flow_multipliers, gap_bound, tree_multipliers};
-use objective::{solve_clustered, Objective};
+use objective::{solve_clustered, Objective, MULTIGRID_AFTER, MULTIGRID_SOON};
 use operator::{RowClasses, TwoPass};
 use rows::{rows_of, Row};
 
@@ -197,7 +197,8 @@ pub(super) fn solve(
             p.classes()
         );
     }
-    let obj = Objective { p, two_pass, q: &r.q, d: &r.d, q_free: &r.q_free };
+    let budget = Some(crate::memory::Budget::of(settings.memory_limit));
+    let obj = Objective { p, two_pass, budget, q: &r.q, d: &r.d, q_free: &r.q_free };
     let mut x: Vec<f64> = match hint {
         Some(h) => h.to_vec(),
         None => r.q_free.iter().zip(&r.d).map(|(q, d)| -q / d).collect(),
@@ -218,6 +219,7 @@ pub(super) fn solve(
     let mut tabu = vec![0u8; rows.len()];
     let mut first_gap = None;
     let mut last_join: Option<Joined> = None;
+    let mut multigrid_after = MULTIGRID_AFTER;
     while outer < MAX_OUTER {
         if crate::progress::cancelled() {
             return Err("cancelled".into());
@@ -227,7 +229,9 @@ pub(super) fn solve(
         let cl = Clusters::new(n, &rows, &in_set);
         let data = obj.data_term(&x).max(f64::MIN_POSITIVE);
         let t1 = std::time::Instant::now();
-        cg_iterations += solve_clustered(&obj, &cl, &mut x, relative * data);
+        let (iterations, multigrid) = solve_clustered(&obj, &cl, &mut x, relative * data, multigrid_after);
+        cg_iterations += iterations;
+        multigrid_after = if multigrid { MULTIGRID_SOON } else { MULTIGRID_AFTER };
         let t2 = std::time::Instant::now();
         obj.gradient(&x, &mut g);
         let balanced = balanced_gradient(&cl, &g, &r.d);

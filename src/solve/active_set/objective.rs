@@ -12,6 +12,9 @@ pub(super) struct Objective<'a> {
     pub(super) p: RowClasses,
     /// P's product over the stiffness, where the energy is of order 2.
     pub(super) two_pass: Option<TwoPass>,
+    /// The memory budget the multigrid's hierarchy must fit in beside what the process holds
+    /// (`None`: no hierarchy is made).
+    pub(super) budget: Option<crate::memory::Budget>,
     pub(super) q: &'a [f64],
     pub(super) d: &'a [f64],
     pub(super) q_free: &'a [f64],
@@ -82,13 +85,23 @@ impl Members {
 /// Conjugate gradients on the cluster values: `x` in and out (its cluster means are the start),
 /// until `½ Σ_c r_c² / D_c ≤ tolerance` (r the cluster residual, D the cluster's data
 /// diagonal). Returns the iterations. Every pass but the product runs over blocks of
-/// [`BLOCK`] unknowns, shared between threads.
-pub(super) fn solve_clustered(obj: &Objective<'_>, cl: &Clusters, x: &mut [f64], tolerance: f64) -> usize {
+/// [`BLOCK`] unknowns, shared between threads. Preconditioned by the clusters' diagonal;
+/// a solve that has not converged after `multigrid_after` iterations ([`MULTIGRID_AFTER`],
+/// or [`MULTIGRID_SOON`] after a solve that needed it) goes on from where it is,
+/// preconditioned by a V-cycle of smoothed-aggregation multigrid on `CᵀPC` assembled (if
+/// its hierarchy fits in the budget); also says whether it did.
+pub(super) fn solve_clustered(
+    obj: &Objective<'_>,
+    cl: &Clusters,
+    x: &mut [f64],
+    tolerance: f64,
+    multigrid_after: usize,
+) -> (usize, bool) {
     let n = x.len();
     let nu = cl.n_unknowns;
     if nu == 0 {
         cl.expand(&[], x);
-        return 0;
+        return (0, false);
     }
     // each variable's unknown (NONE when anchored); the identity when no row is in the set
     let mut of_vertex = vec![0u32; n];
@@ -113,6 +126,12 @@ pub(super) fn solve_clustered(obj: &Objective<'_>, cl: &Clusters, x: &mut [f64],
         }),
         None => r.iter_mut().zip(&px).for_each(|(r, p)| *r = -p),
     }
+    // the V-cycle's solve, `None` (nothing changed) when its hierarchy cannot be made
+    let use_multigrid = |y: &mut [f64], r: &mut [f64], x: &mut [f64], done: usize| {
+        let it = multigrid_cg(obj, &of_vertex, members.as_ref(), (y, r), &inv_dsum, tolerance)?;
+        cl.expand(y, x);
+        Some(done + it)
+    };
     let measure = |r: &[f64]| 0.5 * r.iter().zip(&inv_dsum).map(|(r, w)| r * r * w).sum::<f64>();
     let mut dir: Vec<f64> = r.iter().zip(&inv_diag).map(|(r, w)| r * w).collect();
     if !identity {
@@ -125,6 +144,12 @@ pub(super) fn solve_clustered(obj: &Objective<'_>, cl: &Clusters, x: &mut [f64],
     while it < MAX_CG && m > tolerance {
         if it % 32 == 31 && crate::progress::cancelled() {
             break;
+        }
+        if it == multigrid_after && nu >= MULTIGRID_FROM {
+            // a slow solve: the V-cycle takes over from here
+            if let Some(it) = use_multigrid(&mut y, &mut r, x, it) {
+                return (it, true);
+            }
         }
         let dhd = if identity {
             obj.apply(&dir, &mut hd);
@@ -153,7 +178,127 @@ pub(super) fn solve_clustered(obj: &Objective<'_>, cl: &Clusters, x: &mut [f64],
         it += 1;
     }
     cl.expand(&y, x);
-    it
+    (it, false)
+}
+
+/// Iterations of a diagonal-preconditioned solve after which the V-cycle takes over (on
+/// systems of at least [`MULTIGRID_FROM`] unknowns). The 128³ bench volume's solves take at
+/// most 370; the 1000² bench grid's first ones, at a smoothing length of 12 mean edges, did
+/// not converge in 5,000, and its last ones take a handful, where building the hierarchy
+/// would cost more than the solve (docs/performance.md §3).
+pub(super) const MULTIGRID_AFTER: usize = 500;
+/// [`MULTIGRID_AFTER`] for the solve after one that needed the V-cycle: the 1000² bench
+/// grid's solves need it for dozens of rounds in a row, and its last ones converge in fewer.
+pub(super) const MULTIGRID_SOON: usize = 50;
+/// Unknowns below which the diagonal preconditioner stays.
+const MULTIGRID_FROM: usize = 10_000;
+
+/// Bytes the multigrid's solve allocates at most for `n` variables, `nu` unknowns and `e`
+/// stored entries of P (both triangles), which bound `CᵀPC`'s: `CᵀPC` (12 an entry, 8 a row)
+/// and its pieces while it is made (as much again); the prolongation (12 an entry, at most
+/// one more per row than `CᵀPC`'s), its transpose (12, and 8 a row) and its pieces; the coarser
+/// levels (no more entries than the finest: their operator complexity was 1.04–1.3 on the
+/// bench grids); per unknown five work vectors and the conjugate gradients' three (64, on
+/// levels of fewer unknowns than the finest together), and per variable the expanded
+/// vector and its product (16).
+#[must_use]
+pub(crate) fn multigrid_bytes(n: usize, nu: usize, e: usize) -> u64 {
+    let (n, nu, e) = (n as u64, nu as u64, e as u64);
+    24 * e + 16 * nu + 40 * (e + nu) + 12 * e + 2 * 64 * nu + 16 * n
+}
+
+/// The conjugate gradients from `y` (the residual `r` at it) preconditioned by a V-cycle of
+/// [`crate::linalg::multigrid::Hierarchy`] on `CᵀPC` assembled, until `½ Σ r² w ≤ tolerance`;
+/// returns the iterations, or `None` (with `y` and `r` untouched) when there is no budget,
+/// when [`multigrid_bytes`] would not fit in it beside what the process holds, or when a level
+/// is found not positive definite.
+fn multigrid_cg(
+    obj: &Objective<'_>,
+    of_vertex: &[u32],
+    members: Option<&Members>,
+    (y, r): (&mut [f64], &mut [f64]),
+    w: &[f64],
+    tolerance: f64,
+) -> Option<usize> {
+    use crate::linalg::multigrid::{Csr, Hierarchy};
+    let nu = y.len();
+    let budget = obj.budget.as_ref()?;
+    let need = multigrid_bytes(of_vertex.len(), nu, obj.p.entries());
+    if budget.in_use().saturating_add(need).saturating_add(budget.kernel_reserve()) > budget.bytes {
+        return None;
+    }
+    let t0 = std::time::Instant::now();
+    let a = Csr::from_rows(nu, nu, |u, out| {
+        let single = [u as u32];
+        let of = members.map_or(&single[..], |m| m.of(u));
+        for &v in of {
+            for (j, p) in obj.p.row(v as usize) {
+                let c = of_vertex[j];
+                if c != NONE {
+                    out.push((c, p));
+                }
+            }
+        }
+    });
+    let mut h = Hierarchy::new(a)?;
+    let t1 = std::time::Instant::now();
+    // CᵀPC's products as the diagonal's iterations make them (expand, P, gather), which read
+    // far less memory than its stored entries
+    let n = of_vertex.len();
+    let (mut xs, mut px) = (vec![0.0; if members.is_some() { n } else { 0 }], vec![0.0; n]);
+    let mut product = |v: &[f64], out: &mut [f64]| match members {
+        None => obj.apply(v, out),
+        Some(m) => {
+            scatter(v, of_vertex, &mut xs);
+            obj.apply(&xs, &mut px);
+            crate::parallel::split_mut(out, |off, piece| {
+                for (k, o) in piece.iter_mut().enumerate() {
+                    *o = m.of(off + k).iter().fold(0.0, |s, &v| s + px[v as usize]);
+                }
+            });
+        }
+    };
+    let measure = |r: &[f64]| 0.5 * r.iter().zip(w).map(|(r, w)| r * r * w).sum::<f64>();
+    let mut z = vec![0.0; nu];
+    h.apply_with(Some(&mut product), r, &mut z);
+    let mut dir = z.clone();
+    let mut rz = dot_blocks(r, &z);
+    let mut hd = vec![0.0; nu];
+    let mut it = 0;
+    while it < MAX_CG && measure(r) > tolerance {
+        if it % 32 == 31 && crate::progress::cancelled() {
+            break;
+        }
+        product(&dir, &mut hd);
+        let dhd = dot_blocks(&dir, &hd);
+        if dhd <= 0.0 || !dhd.is_finite() {
+            break;
+        }
+        let alpha = rz / dhd;
+        crate::parallel::split_mut2(y, r, |off, y, r| {
+            for k in 0..y.len() {
+                y[k] += alpha * dir[off + k];
+                r[k] -= alpha * hd[off + k];
+            }
+        });
+        h.apply_with(Some(&mut product), r, &mut z);
+        let rz_new = dot_blocks(r, &z);
+        let beta = rz_new / rz;
+        rz = rz_new;
+        crate::parallel::split_mut(&mut dir, |off, d| {
+            d.iter_mut().zip(&z[off..]).for_each(|(d, z)| *d = z + beta * *d);
+        });
+        it += 1;
+    }
+    if std::env::var_os("TOPOSMOOTH_TRACE_ACTIVE").is_some() {
+        eprintln!(
+            "multigrid: levels {:?}, hierarchy {} ms, {it} iterations in {} ms",
+            h.sizes(),
+            (t1 - t0).as_millis(),
+            t1.elapsed().as_millis()
+        );
+    }
+    Some(it)
 }
 
 /// Per unknown (on blocks of [`BLOCK`] unknowns, shared between threads): the mean of its
@@ -326,6 +471,90 @@ mod tests {
                 (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
             })
             .collect()
+    }
+
+    /// A fourth-order system on a grid (`K K + c I`, 5-point K) whose diagonal-preconditioned
+    /// solve would need thousands of iterations, with pairs of variables joined into clusters:
+    /// the V-cycle takes over after [`MULTIGRID_AFTER`] iterations, the solve reaches its
+    /// tolerance, and the same bits come out on 1, 2 and 3 threads.
+    #[test]
+    fn a_slow_solve_hands_its_preconditioning_to_the_v_cycle_and_converges() {
+        use super::super::operator::RowClasses;
+        use super::super::rows::Row;
+        let (w, h) = (150, 120);
+        let n = w * h;
+        let c = 1e-5;
+        // K's rows, then the upper triangle of K K + c I sorted by column, then row
+        let k_row = |i: usize| {
+            let (x, y) = (i % w, i / w);
+            let mut row = vec![];
+            for (dx, dy) in [(-1i64, 0i64), (1, 0), (0, -1), (0, 1)] {
+                let (nx, ny) = (x as i64 + dx, y as i64 + dy);
+                if nx >= 0 && ny >= 0 && (nx as usize) < w && (ny as usize) < h {
+                    row.push((ny as usize * w + nx as usize, -1.0));
+                }
+            }
+            let deg = row.len() as f64;
+            row.push((i, deg));
+            row
+        };
+        let mut upper = std::collections::BTreeMap::new();
+        for i in 0..n {
+            for (j, a) in k_row(i) {
+                for (l, b) in k_row(j) {
+                    if i <= l {
+                        *upper.entry((l, i)).or_insert(0.0) += a * b;
+                    }
+                }
+            }
+            *upper.entry((i, i)).or_insert(0.0) += c;
+        }
+        let triplets: Vec<(usize, usize, f64)> = upper.iter().map(|(&(col, row), &v)| (row, col, v)).collect();
+        let d = vec![c; n];
+        let q: Vec<f64> = values(n, 9);
+        let q_free = q.clone();
+        let run = |budget: Option<u64>| {
+            let obj = Objective {
+                p: RowClasses::from_upper(n, &triplets).unwrap(),
+                two_pass: None,
+                budget: budget.map(|b| crate::memory::Budget::of(Some(b))),
+                q: &q,
+                d: &d,
+                q_free: &q_free,
+            };
+            // every 7th variable joined to its right-hand neighbour one margin below
+            let rows: Vec<Row> =
+                (0..n).filter(|i| i % 7 == 0 && i % w + 1 < w).map(|i| Row::Pair(i + 1, i, -1e-3)).collect();
+            let in_set = vec![true; rows.len()];
+            let cl = Clusters::new(n, &rows, &in_set);
+            let mut x = vec![0.0; n];
+            let (it, multigrid) = solve_clustered(&obj, &cl, &mut x, 1e-12, MULTIGRID_AFTER);
+            assert_eq!(multigrid, budget == Some(u64::MAX), "{it} iterations");
+            // the gradient summed per cluster, measured as the solve measures it
+            let mut g = vec![0.0; n];
+            obj.gradient(&x, &mut g);
+            let mut sums = std::collections::BTreeMap::new();
+            for v in 0..n {
+                let e = sums.entry(cl.label[v]).or_insert((0.0, 0.0));
+                e.0 += g[v];
+                e.1 += d[v];
+            }
+            let measure: f64 = sums.values().map(|(r, w)| 0.5 * r * r / w).sum();
+            (it, measure, x)
+        };
+        let runs: Vec<_> = (1..=3).map(|t| with_threads(t, || run(Some(u64::MAX)))).collect();
+        let (it, measure, _) = &runs[0];
+        // the diagonal's iterations, then the V-cycle's: far fewer than the diagonal needs
+        // alone (with no budget for the hierarchy, or one too small for it)
+        assert!(*it > MULTIGRID_AFTER && *it < MULTIGRID_AFTER + 300, "{it} iterations");
+        for budget in [None, Some(1 << 20)] {
+            let (alone, _, _) = run(budget);
+            assert!(alone > 3 * it, "{alone} iterations without the V-cycle, {it} with it");
+        }
+        assert!(*measure <= 2e-12, "measure {measure:e}");
+        for (t, r) in runs.iter().enumerate().skip(1) {
+            assert!(r == &runs[0], "1 and {} threads differ", t + 1);
+        }
     }
 
     /// The passes over blocks give the same bits on 1, 2 and 3 threads (long enough to be

@@ -182,6 +182,11 @@ impl RowClasses {
         self.start.len() - 1
     }
 
+    /// The stored entries of both triangles (each row's entries, counted row by row).
+    pub(super) fn entries(&self) -> usize {
+        self.class.iter().map(|&c| self.start[c as usize + 1] - self.start[c as usize]).sum()
+    }
+
     /// `P_ii`.
     pub(super) fn diagonal(&self, i: usize) -> f64 {
         self.diagonal[self.class[i] as usize]

@@ -283,7 +283,7 @@ fn one_function<D: Smoothable>(
             let eps = choose_margin(eps_max, 1.0, resolution)?;
             let q = vec![0.0; domain.n_vertices()];
             let qp = MonotoneQp {
-                p: &ops.energy,
+                p: (&ops.energy).into(),
                 q: &q,
                 fixed,
                 edges: &edges,

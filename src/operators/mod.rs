@@ -16,6 +16,7 @@
 //! assert!(toposmooth::operators::quadratic_form(&q, &[1.0; 5]).abs() < 1e-12);
 //! ```
 
+mod columns;
 mod cotan;
 mod factor;
 mod gradient;
@@ -26,6 +27,7 @@ mod sparse;
 mod tet;
 mod volume;
 
+pub use columns::{BilaplacianColumns, Blocks, Column, COLUMN_BLOCK};
 pub use cotan::{
     cotan_stiffness, grid_mass, grid_stiffness, lumped_mass, negative_cotan_edges, positive_cotan_stiffness,
 };

@@ -323,7 +323,8 @@ fn smooth_stages<D: Smoothable + Sync>(
         let prepared = match (&built, settings.qp.method) {
             // a failed analysis is redone (and reported) by the solver itself
             (Ok(o), Method::Structured) if o.factor.is_none() => {
-                crate::solve::prepare(&o.p, &problem.fixed, settings.qp.memory_limit).ok().flatten()
+                o.p.stored()
+                    .and_then(|p| crate::solve::prepare(p, &problem.fixed, settings.qp.memory_limit).ok().flatten())
             }
             _ => None,
         };
@@ -431,7 +432,7 @@ fn solve_qp(
     let hint: Vec<f64> = ordered.u.iter().map(|&v| scale.unit(v)).collect();
     let unit_bounds: Vec<Bound> = ordered.bounds.iter().map(|b| Bound { value: scale.unit(b.value), ..*b }).collect();
     let qp = MonotoneQp {
-        p: &operators.p,
+        p: operators.p.quadratic(),
         q: &operators.q,
         fixed: &problem.fixed,
         edges: &ordered.edges,

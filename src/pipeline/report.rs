@@ -2,7 +2,7 @@
 //! share, terraces) and the certificate.
 
 use crate::constraints::{Activity, EdgeSet};
-use crate::operators::{Energy, Factor, Sparse};
+use crate::operators::{Energy, Factor};
 use crate::solve::{
     optimality, Bound, Formulation, MarginSummary, Method, MonotoneQp, QpSettings, RepairSummary, SolveStatus,
 };
@@ -222,7 +222,7 @@ impl FitReport {
 
 /// The QP in the field's units, for [`fit_report`].
 pub(super) struct FitInputs<'a> {
-    pub(super) p: &'a Sparse,
+    pub(super) p: crate::solve::Quadratic<'a>,
     pub(super) data_diag: &'a [f64],
     pub(super) h: &'a [f64],
     pub(super) fixed: &'a [bool],

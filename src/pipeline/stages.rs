@@ -12,12 +12,10 @@ use crate::constraints::{activity, choose_margin, constraint_edges, margin_cap, 
 use crate::domain::{sos_sort, Domain};
 use crate::error::{Error, Result};
 use crate::linalg::Analyses;
-use crate::operators::{
-    plus_diagonal, polyharmonic_factor, polyharmonic_products, quadratic_form_without_diagonal, Factor, Sparse,
-};
+use crate::operators::{plus_diagonal, polyharmonic_factor, polyharmonic_products, BilaplacianColumns, Factor, Sparse};
 use crate::solve::{
-    condition_estimate, meet_margin, repair, Bound, Formulation, MarginSummary, Method, QpSolution, RepairSummary,
-    SolveStatus, FACTORED_ABOVE,
+    condition_estimate, meet_margin, repair, Bound, Formulation, MarginSummary, Method, QpSolution, Quadratic,
+    RepairSummary, SolveStatus, FACTORED_ABOVE,
 };
 use crate::topology::morse_smale::MorseSmale;
 use crate::topology::{KeptSet, Role};
@@ -199,12 +197,38 @@ fn free_end_bounds<D: Domain>(domain: &D, u: &[f64], roles: &[Role], (lo, hi): (
         .collect()
 }
 
+/// The QP's matrix P: stored, or — for the active set on an energy of one term of order 2,
+/// which makes its own forms of P once — made column by column as it is read (the same bits;
+/// at 128³ the stored one was 850 MB held through the solve, 42 % of its heap).
+pub(super) enum EnergyMatrix<'a> {
+    Stored(Sparse),
+    Columns(BilaplacianColumns<'a>),
+}
+
+impl EnergyMatrix<'_> {
+    /// P as the solvers read it.
+    pub(super) fn quadratic(&self) -> Quadratic<'_> {
+        match self {
+            EnergyMatrix::Stored(p) => Quadratic::Stored(p),
+            EnergyMatrix::Columns(c) => Quadratic::Columns(c),
+        }
+    }
+
+    /// The stored matrix, if it is one.
+    pub(super) fn stored(&self) -> Option<&Sparse> {
+        match self {
+            EnergyMatrix::Stored(p) => Some(p),
+            EnergyMatrix::Columns(_) => None,
+        }
+    }
+}
+
 /// The energy's matrices, built beside the representative.
-pub(super) struct Operators {
+pub(super) struct Operators<'a> {
     weights: Vec<f64>,
     pub(super) data_diag: Vec<f64>,
     pub(super) factor: Option<Factor>,
-    pub(super) p: Sparse,
+    pub(super) p: EnergyMatrix<'a>,
     pub(super) q: Vec<f64>,
     pub(super) condition: Option<f64>,
     /// `s` with the energy `K diag(s) K` where it is of order 2 and the active set runs
@@ -214,15 +238,16 @@ pub(super) struct Operators {
 
 /// The QP's objective for smoothing length `ell`: `P` = the energy plus the data diagonal
 /// (in the energy's storage: one matrix of the size of a bilaplacian less, 300 MiB at a
-/// million vertices), `q`, and the factor `P = FᵀF + diag(d)` where the assembled form would
-/// lose the digits the gap needs.
-pub(super) fn build_operators<D: Smoothable>(
+/// million vertices; for the active set on one order-2 term not stored at all, its columns
+/// made from `k` and `m` as they are read), `q`, and the factor `P = FᵀF + diag(d)` where the
+/// assembled form would lose the digits the gap needs.
+pub(super) fn build_operators<'a, D: Smoothable>(
     domain: &D,
-    (k, m): (&Sparse, &[f64]),
+    (k, m): (&'a Sparse, &'a [f64]),
     settings: &SmoothSettings,
     ell: f64,
     problem: &Problem,
-) -> Result<Operators> {
+) -> Result<Operators<'a>> {
     let n = m.len();
     let weights: Vec<f64> = settings
         .energy
@@ -230,18 +255,25 @@ pub(super) fn build_operators<D: Smoothable>(
         .iter()
         .map(|&(order, _)| settings.smooth_weight.unwrap_or(ell.powi(2 * order as i32)))
         .collect();
-    // the interior-point routes analyse P's pattern as the normal matrix's, which must hold
-    // every constrained pair (every edge); the active set needs only P's non-zero products
-    let q_energy = if settings.qp.method == Method::ActiveSet {
-        polyharmonic_products(k, m, &settings.energy, &weights)
-    } else {
-        energy_on_edges(domain, k, m, &settings.energy, &weights)
-    };
     let gd = settings.data_weight;
     let data_diag: Vec<f64> = m.iter().map(|mi| gd * mi).collect();
-    let p = plus_diagonal(q_energy, &data_diag);
+    // the interior-point routes analyse P's pattern as the normal matrix's, which must hold
+    // every constrained pair (every edge); the active set needs only P's non-zero products,
+    // and of an energy of one order-2 term not even those stored
+    let active_set = settings.qp.method == Method::ActiveSet;
+    let p = match active_set.then(|| BilaplacianColumns::new(k, m, &settings.energy, &weights, &data_diag)).flatten() {
+        Some(columns) => EnergyMatrix::Columns(columns),
+        None => {
+            let q_energy = if active_set {
+                polyharmonic_products(k, m, &settings.energy, &weights)
+            } else {
+                energy_on_edges(domain, k, m, &settings.energy, &weights)
+            };
+            EnergyMatrix::Stored(plus_diagonal(q_energy, &data_diag))
+        }
+    };
     let q: Vec<f64> = (0..n).map(|i| -gd * m[i] * problem.z[i]).collect();
-    let condition = condition_estimate(&p, &data_diag, &problem.fixed);
+    let condition = condition_estimate(p.quadratic(), &data_diag, &problem.fixed);
     let factored = match (settings.qp.method, settings.qp.formulation) {
         (Method::ClarabelAuxiliary, _) | (_, Formulation::Factored) => true,
         (_, Formulation::Assembled) => false,
@@ -298,7 +330,7 @@ pub(super) fn output_of(x: &[f64], p: &Problem, o: &Ordered) -> (Vec<f64>, Margi
 pub(super) struct Run<'a> {
     pub(super) problem: &'a Problem<'a>,
     pub(super) ordered: &'a Ordered,
-    pub(super) operators: &'a Operators,
+    pub(super) operators: &'a Operators<'a>,
     pub(super) mass: &'a [f64],
     pub(super) settings: &'a SmoothSettings,
     pub(super) sol: &'a QpSolution,
@@ -327,7 +359,7 @@ impl Run<'_> {
         let is_fixed: Vec<bool> = kept.roles.iter().map(|r| r.is_fixed()).collect();
         let fit = fit_report(
             &FitInputs {
-                p: &ops.p,
+                p: ops.p.quadratic(),
                 data_diag: &ops.data_diag,
                 h,
                 fixed: &is_fixed,
@@ -362,7 +394,7 @@ impl Run<'_> {
                 self.sol.status, self.sol.iterations, settings.qp.gap_tolerance
             ));
         }
-        let smoothness = quadratic_form_without_diagonal(&ops.p, &ops.data_diag, f);
+        let smoothness = ops.p.quadratic().quadratic_form_without_diagonal(&ops.data_diag, f);
         let data: f64 = gd * (0..n).map(|i| m[i] * (f[i] - h[i]).powi(2)).sum::<f64>();
         let sq: f64 = (0..n).map(|i| (f[i] - h[i]).powi(2)).sum();
         let max_deviation = (0..n).map(|i| (f[i] - h[i]).abs()).fold(0.0, f64::max);

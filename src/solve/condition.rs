@@ -22,7 +22,10 @@ pub(super) fn estimate(r: &ReducedQp) -> Option<f64> {
 
 /// `estimate` on the free block of a full `P` (upper and lower triangle stored) with data
 /// diagonal `d`, before the problem is reduced: `None` unless `d > 0` at every free entry.
-pub fn condition_estimate(p: &crate::operators::Sparse, d: &[f64], fixed: &[Option<f64>]) -> Option<f64> {
+///
+/// Made columns ([`super::Quadratic::Columns`]) are multiplied in two passes over their
+/// stiffness (the same matrix up to rounding, which an estimate does not see).
+pub fn condition_estimate(p: super::Quadratic<'_>, d: &[f64], fixed: &[Option<f64>]) -> Option<f64> {
     let free: Vec<usize> = (0..d.len()).filter(|&i| fixed[i].is_none()).collect();
     if free.is_empty() || free.iter().any(|&i| d[i].partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater)) {
         return None;
@@ -32,6 +35,24 @@ pub fn condition_estimate(p: &crate::operators::Sparse, d: &[f64], fixed: &[Opti
         slot[i] = k;
     }
     let df: Vec<f64> = free.iter().map(|&i| d[i]).collect();
+    let p = match p {
+        super::Quadratic::Stored(p) => p,
+        super::Quadratic::Columns(c) => {
+            let (mut x, mut y) = (vec![0.0; d.len()], vec![0.0; d.len()]);
+            let (x, y) = (std::cell::RefCell::new(&mut x), std::cell::RefCell::new(&mut y));
+            return Some(power(&df, |v, w| {
+                let (mut x, mut y) = (x.borrow_mut(), y.borrow_mut());
+                for (&i, &vi) in free.iter().zip(v) {
+                    x[i] = vi;
+                }
+                y.iter_mut().for_each(|a| *a = 0.0);
+                c.add_product(&x, &mut y);
+                for (wk, &i) in w.iter_mut().zip(&free) {
+                    *wk += y[i];
+                }
+            }));
+        }
+    };
     let (cp, ri, val) = (p.symbolic().col_ptr(), p.symbolic().row_idx(), p.val());
     // P is stored whole and symmetric, so column j is row j: each entry of `w` gathers its
     // own row, on contiguous pieces one a thread (the same sums for any thread count)
@@ -104,13 +125,13 @@ mod tests {
         for order in 1..=3u8 {
             let gamma = 10f64.powi(2 * order as i32); // ℓ = 10 samples
             let p = plus_diagonal(polyharmonic(&k, &m, &Energy::order(order), &[gamma]), &m);
-            let est = condition_estimate(&p, &m, &fixed).unwrap();
+            let est = condition_estimate((&p).into(), &m, &fixed).unwrap();
             let expected = 1.0 + gamma * 4f64.powi(order as i32);
             assert!(est <= expected * 1.05 && est >= expected * 0.7, "order {order}: {est:e} against {expected:e}");
         }
         // no data weight at a free vertex: no estimate
         let mut d = m.clone();
         d[3] = 0.0;
-        assert!(condition_estimate(&series_stiffness(&s), &d, &fixed).is_none());
+        assert!(condition_estimate((&series_stiffness(&s)).into(), &d, &fixed).is_none());
     }
 }

@@ -25,7 +25,7 @@ pub use bounded::solve_bounded_partition;
 pub use condition::condition_estimate;
 pub use newton::Prepared;
 pub use optimality::{optimality, optimality_with, Optimality};
-pub use problem::{constraint_rows, Bound, MonotoneQp, Row, SecondOrder};
+pub use problem::{constraint_rows, Bound, MonotoneQp, Quadratic, Row, SecondOrder};
 pub use qp::{prepare, solve_monotone_qp, solve_monotone_qp_with};
 pub use repair::{meet_margin, repair, MarginSummary, RepairSummary};
 pub use settings::{Formulation, Method, QpSettings, ACTIVE_SET_FROM, DOUBLE_DOUBLE_ABOVE, FACTORED_ABOVE};

@@ -155,15 +155,14 @@ fn gradient(qp: &MonotoneQp<'_>, f: &[f64], y: Option<&[f64]>) -> (Vec<Dd>, f64)
         }
         _ => {
             // P f + q
-            let (cp, ri, v) = (qp.p.symbolic().col_ptr(), qp.p.symbolic().row_idx(), qp.p.val());
             for (j, r) in rho.iter_mut().enumerate() {
                 *r = dd(qp.q[j]);
             }
-            for j in 0..n {
-                for p in cp[j]..cp[j + 1] {
-                    rho[ri[p]] += product(v[p], f[j]);
+            qp.p.for_each_column(|j, ri, v| {
+                for (&i, &v) in ri.iter().zip(v) {
+                    rho[i] += product(v, f[j]);
                 }
-            }
+            });
         }
     }
     (rho, auxiliary_residual)
@@ -199,14 +198,13 @@ fn rows_into(qp: &MonotoneQp<'_>, rows: &[Row], f: &[f64], z: &[f64], rho: &mut 
 }
 
 /// `½ fᵀ P f` in double-double (P holds both triangles).
-fn half_energy(p: &crate::operators::Sparse, f: &[f64]) -> f64 {
-    let (cp, ri, v) = (p.symbolic().col_ptr(), p.symbolic().row_idx(), p.val());
+fn half_energy(p: super::problem::Quadratic<'_>, f: &[f64]) -> f64 {
     let mut e = dd(0.0);
-    for j in 0..f.len() {
-        for p in cp[j]..cp[j + 1] {
-            e += product(v[p], f[ri[p]]) * dd(f[j]);
+    p.for_each_column(|j, ri, v| {
+        for (&i, &v) in ri.iter().zip(v) {
+            e += product(v, f[i]) * dd(f[j]);
         }
-    }
+    });
     0.5 * round(e)
 }
 
@@ -227,16 +225,15 @@ fn solve_with_p(
             nf += 1;
         }
     }
-    let (cp, ri, v) = (qp.p.symbolic().col_ptr(), qp.p.symbolic().row_idx(), qp.p.val());
     let mut t = Vec::new();
-    for j in 0..n {
-        for p in cp[j]..cp[j + 1] {
-            let (si, sj) = (slot[ri[p]], slot[j]);
+    qp.p.for_each_column(|j, ri, v| {
+        for (&i, &v) in ri.iter().zip(v) {
+            let (si, sj) = (slot[i], slot[j]);
             if si != usize::MAX && sj != usize::MAX && si <= sj {
-                t.push(faer::sparse::Triplet::new(si, sj, v[p]));
+                t.push(faer::sparse::Triplet::new(si, sj, v));
             }
         }
-    }
+    });
     let upper = crate::operators::Sparse::try_new_from_triplets(nf, nf, &t).ok()?;
     let r: Vec<f64> = (0..n).filter(|&i| free[i]).map(|i| round(rho[i])).collect();
     let mut y = r.clone();

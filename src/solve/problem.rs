@@ -3,7 +3,7 @@
 //! constraint).
 
 use crate::linalg::double_double::Dd;
-use crate::operators::{Factor, Sparse};
+use crate::operators::{BilaplacianColumns, Column, Factor, Sparse};
 
 /// A one-sided bound on one entry: `f_v ≤ value` (`upper`) or `f_v ≥ value`.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -20,7 +20,7 @@ pub struct Bound {
 /// `f_j − f_i ≥ margin` for every `(i, j)` in `edges`, and the `bounds`.
 pub struct MonotoneQp<'a> {
     /// `#V × #V` symmetric positive semi-definite (positive definite on the free block).
-    pub p: &'a Sparse,
+    pub p: Quadratic<'a>,
     /// Linear term, `#V`. With `data`, `q = −diag(data)·c` for the data's target `c`.
     pub q: &'a [f64],
     /// Fixed values, `#V` (`None` = free).
@@ -47,6 +47,126 @@ pub struct MonotoneQp<'a> {
     /// P's energy as `K diag(s) K` (order 2), for products in two passes over `K`'s stencil
     /// (the active-set iteration), if known.
     pub second_order: Option<SecondOrder<'a>>,
+}
+
+/// P as the solvers read it: a stored matrix (both triangles), or the matrix of an order-2
+/// energy made column by column as it is read ([`BilaplacianColumns`]: the same entries, the
+/// same bits, nothing stored; for the active set, which makes its own forms of P once).
+#[derive(Clone, Copy, Debug)]
+pub enum Quadratic<'a> {
+    /// Compressed columns, both triangles.
+    Stored(&'a Sparse),
+    /// Made column by column.
+    Columns(&'a BilaplacianColumns<'a>),
+}
+
+impl<'a> From<&'a Sparse> for Quadratic<'a> {
+    fn from(p: &'a Sparse) -> Self {
+        Quadratic::Stored(p)
+    }
+}
+
+impl Quadratic<'_> {
+    /// The order of the matrix.
+    #[must_use]
+    pub fn n(&self) -> usize {
+        match self {
+            Quadratic::Stored(p) => p.ncols(),
+            Quadratic::Columns(c) => c.n(),
+        }
+    }
+
+    /// The stored matrix, if it is one.
+    #[must_use]
+    pub fn stored(&self) -> Option<&Sparse> {
+        match self {
+            Quadratic::Stored(p) => Some(p),
+            Quadratic::Columns(_) => None,
+        }
+    }
+
+    /// A workspace for [`Self::column`] (empty for a stored matrix).
+    #[must_use]
+    pub fn workspace(&self) -> Column {
+        match self {
+            Quadratic::Stored(_) => Column::default(),
+            Quadratic::Columns(c) => c.workspace(),
+        }
+    }
+
+    /// Column `j`'s rows (increasing) and values, from storage or made in `work`.
+    pub fn column<'s>(&'s self, j: usize, work: &'s mut Column) -> (&'s [usize], &'s [f64]) {
+        match self {
+            Quadratic::Stored(p) => {
+                let (cp, ri) = (p.symbolic().col_ptr(), p.symbolic().row_idx());
+                (&ri[cp[j]..cp[j + 1]], &p.val()[cp[j]..cp[j + 1]])
+            }
+            Quadratic::Columns(c) => {
+                c.column(j, work);
+                (&work.rows, &work.vals)
+            }
+        }
+    }
+
+    /// `visit(j, rows, values)` for every column `j` in order (made columns made in blocks on
+    /// up to the cap's threads: [`BilaplacianColumns::for_each_column`]).
+    pub fn for_each_column(&self, mut visit: impl FnMut(usize, &[usize], &[f64])) {
+        match self {
+            Quadratic::Stored(p) => {
+                let (cp, ri, v) = (p.symbolic().col_ptr(), p.symbolic().row_idx(), p.val());
+                for j in 0..p.ncols() {
+                    visit(j, &ri[cp[j]..cp[j + 1]], &v[cp[j]..cp[j + 1]]);
+                }
+            }
+            Quadratic::Columns(c) => c.for_each_column(visit),
+        }
+    }
+
+    /// The entry at row `i` of column `j` (`None` outside the pattern).
+    #[must_use]
+    pub fn entry(&self, i: usize, j: usize) -> Option<f64> {
+        match self {
+            Quadratic::Stored(p) => {
+                let (cp, ri) = (p.symbolic().col_ptr(), p.symbolic().row_idx());
+                ri[cp[j]..cp[j + 1]].binary_search(&i).ok().map(|at| p.val()[cp[j] + at])
+            }
+            Quadratic::Columns(c) => c.entry(i, j),
+        }
+    }
+
+    /// An upper bound on the entries of the columns of `free` in the rows of `free` that lie
+    /// on or above the diagonal (the stored count, or for made columns half the pushes their
+    /// sums take, plus the diagonal): what a reduction's upper triangle may hold.
+    #[must_use]
+    pub fn upper_entries_at_most(&self, free: &[usize]) -> usize {
+        match self {
+            Quadratic::Stored(p) => {
+                let (cp, ri) = (p.symbolic().col_ptr(), p.symbolic().row_idx());
+                let mut is_free = vec![false; p.ncols()];
+                free.iter().for_each(|&v| is_free[v] = true);
+                free.iter().map(|&j| ri[cp[j]..cp[j + 1]].iter().filter(|&&i| i <= j && is_free[i]).count()).sum()
+            }
+            Quadratic::Columns(c) => {
+                let pushes = c.pushes_at_most();
+                pushes / 2 + c.n()
+            }
+        }
+    }
+
+    /// `fᵀ (P − diag(d)) f` for a P that holds `diag(d)` in its diagonal entries: `d` is taken
+    /// off each diagonal entry before it is used, so a large `d` does not swamp the rest by
+    /// cancellation.
+    #[must_use]
+    pub fn quadratic_form_without_diagonal(&self, d: &[f64], f: &[f64]) -> f64 {
+        let mut s = 0.0;
+        self.for_each_column(|j, rows, vals| {
+            for (&i, &v) in rows.iter().zip(vals) {
+                let aij = if i == j { v - d[j] } else { v };
+                s += f[i] * aij * f[j];
+            }
+        });
+        s
+    }
 }
 
 /// An energy of order 2 as its stiffness and the scales between: `Q = K diag(row_scale) K`
@@ -352,26 +472,33 @@ pub(super) fn reduce_with(qp: &MonotoneQp<'_>, free: &[usize], triplets: bool) -
     }
     let xfix = |i: usize| qp.fixed[i].unwrap_or(0.0);
     let mut q: Vec<f64> = free.iter().map(|&i| qp.q[i]).collect();
-    let (cp, ri, val) = (qp.p.symbolic().col_ptr(), qp.p.symbolic().row_idx(), qp.p.val());
     let nf = free.len();
+    let mut work = qp.p.workspace();
     // a band when every free entry lies near the diagonal (a series), else triplets
     let width = if triplets {
-        (0..n)
-            .filter(|&j| slot[j] != usize::MAX)
-            .flat_map(|j| ri[cp[j]..cp[j + 1]].iter().filter(|&&i| slot[i] != usize::MAX).map(move |&i| (i, j)))
-            .map(|(i, j)| slot[i].abs_diff(slot[j]))
-            .try_fold(0usize, |a, d| (d <= crate::linalg::BANDED_MAX).then_some(a.max(d)))
+        let mut width = Some(0usize);
+        for j in (0..n).filter(|&j| slot[j] != usize::MAX) {
+            let (rows, _) = qp.p.column(j, &mut work);
+            for &i in rows.iter().filter(|&&i| slot[i] != usize::MAX) {
+                let d = slot[i].abs_diff(slot[j]);
+                width = width.and_then(|a| (d <= crate::linalg::BANDED_MAX).then_some(a.max(d)));
+            }
+            if width.is_none() {
+                break;
+            }
+        }
+        width
     } else {
         None
     };
     // the upper triangle of a symmetric pattern: half the off-diagonal entries and the diagonal
-    let mut p = Vec::with_capacity(if triplets && width.is_none() { cp[n] / 2 + n } else { 0 });
+    let capacity = qp.p.stored().map_or(0, |p| p.val().len() / 2 + n);
+    let mut p = Vec::with_capacity(if triplets && width.is_none() { capacity } else { 0 });
     let mut band = width.map(|w| vec![0.0; nf * (w + 1)]);
     let (mut upper, mut diag) = (0usize, Vec::with_capacity(if triplets { 0 } else { nf }));
     let mut constant = 0.0;
-    for j in 0..n {
-        for k in cp[j]..cp[j + 1] {
-            let i = ri[k];
+    let mut visit = |j: usize, ri: &[usize], val: &[f64]| {
+        for (k, &i) in ri.iter().enumerate() {
             match (slot[i], slot[j]) {
                 (usize::MAX, usize::MAX) => constant += 0.5 * xfix(i) * val[k] * xfix(j),
                 (usize::MAX, _) => {}
@@ -388,6 +515,22 @@ pub(super) fn reduce_with(qp: &MonotoneQp<'_>, free: &[usize], triplets: bool) -
                 _ => {}
             }
         }
+    };
+    // without triplets a free column gives its diagonal only (all that is read of it): made
+    // columns are then made for the fixed vertices alone
+    let made = matches!(qp.p, Quadratic::Columns(_));
+    for (j, &sj) in slot.iter().enumerate() {
+        if made && !triplets && sj != usize::MAX {
+            let diagonal = qp.p.entry(j, j).unwrap_or(0.0);
+            visit(j, &[j], &[diagonal]);
+        } else {
+            let (rows, vals) = qp.p.column(j, &mut work);
+            visit(j, rows, vals);
+        }
+    }
+    drop(work);
+    if made && !triplets {
+        upper = qp.p.upper_entries_at_most(free);
     }
     let mut p = match (band, width) {
         (Some(values), Some(width)) => UpperP::Band { width, values },

@@ -3,7 +3,7 @@
 
 use super::newton::Prepared;
 use super::problem::{
-    constraint_rows, reduce, reduce_factor, reduce_with, rescale, MonotoneQp, ReducedQp, MAX_VARIABLES,
+    constraint_rows, reduce, reduce_factor, reduce_with, rescale, MonotoneQp, Quadratic, ReducedQp, MAX_VARIABLES,
 };
 use super::settings::{Formulation, Method, QpSettings, DOUBLE_DOUBLE_ABOVE, FACTORED_ABOVE};
 use super::status::{QpSolution, SolveStatus};
@@ -35,7 +35,7 @@ pub fn solve_monotone_qp_with(
 ) -> Result<QpSolution> {
     let n = qp.q.len();
     assert_eq!(qp.fixed.len(), n);
-    assert_eq!(qp.p.nrows(), n);
+    assert_eq!(qp.p.n(), n);
     let free: Vec<usize> = (0..n).filter(|&i| qp.fixed[i].is_none()).collect();
     if free.len() > MAX_VARIABLES {
         return Err(crate::error::Error::input(format!(
@@ -132,8 +132,14 @@ pub fn solve_monotone_qp_with(
             };
             // its operands first, then the iteration beside them, each checked before it is made
             let two_pass = qp.second_order.map(|e| (e.k.ncols(), e.k.val().len()));
-            let before = fits(super::active_set::operand_bytes(reduced.n, reduced.m(), upper_entries, two_pass))?;
-            let outcome = match super::active_set::Operands::new(qp, &free, &reduced) {
+            let made = matches!(qp.p, Quadratic::Columns(_)).then(crate::parallel::threads);
+            let before = fits(super::active_set::operand_bytes(reduced.n, reduced.m(), upper_entries, two_pass, made))?;
+            let t = std::time::Instant::now();
+            let operands = super::active_set::Operands::new(qp, &free, &reduced);
+            if std::env::var_os("TOPOSMOOTH_TRACE_ACTIVE").is_some() {
+                eprintln!("active set: operands made in {} ms", t.elapsed().as_millis());
+            }
+            let outcome = match operands {
                 Ok(operands) => {
                     let beside = fits(super::active_set::iteration_bytes(reduced.n, reduced.m()))?;
                     predicted_peak = Some(before.max(beside));
@@ -328,7 +334,7 @@ mod tests {
     fn with_data<'a>(wave: &'a Wave, data: &'a [f64]) -> MonotoneQp<'a> {
         let (p, edges, q, fixed) = wave;
         MonotoneQp {
-            p,
+            p: p.into(),
             q,
             fixed,
             edges,
@@ -400,7 +406,7 @@ mod tests {
         // every edge increasing to the right and upwards: a monotone ramp, feasible
         let hint: Vec<f64> = (0..n).map(|i| -1.0 + 3.0 * ((i % nx) + (i / nx)) as f64 / (nx + ny - 2) as f64).collect();
         let qp = MonotoneQp {
-            p: &p,
+            p: (&p).into(),
             q: &q,
             fixed: &fixed,
             edges: &edges,
@@ -475,7 +481,7 @@ mod tests {
         hint: Option<&'a [f64]>,
     ) -> MonotoneQp<'a> {
         MonotoneQp {
-            p,
+            p: p.into(),
             q,
             fixed,
             edges,
@@ -566,7 +572,7 @@ mod tests {
         fixed[n - 1] = Some(1.2);
         let hint: Vec<f64> = (0..n).map(|i| -0.2 + 1.4 * ramp(i)).collect();
         let qp = MonotoneQp {
-            p: &p,
+            p: (&p).into(),
             q: &q,
             fixed: &fixed,
             edges: &edges,

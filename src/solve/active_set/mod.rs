@@ -85,12 +85,22 @@ pub(super) struct ActiveSetOutcome {
 /// passes over a stiffness of `(vertices, entries)` ([`TwoPass`]), per vertex its intermediate
 /// value and inner class (12), per variable its outer class and the three test vectors of its
 /// check (28), and both passes' tables (12 bytes an entry each when no row
-/// repeats).
+/// repeats). P's made columns ([`super::Quadratic::Columns`], `made` with the threads that
+/// make them) add each thread's workspace (12 bytes a vertex) and its block of rows (at most
+/// 16 bytes an entry of a block's share of both triangles).
 #[must_use]
-pub(crate) fn operand_bytes(n: usize, m: usize, p_entries: usize, two_pass: Option<(usize, usize)>) -> u64 {
+pub(crate) fn operand_bytes(
+    n: usize,
+    m: usize,
+    p_entries: usize,
+    two_pass: Option<(usize, usize)>,
+    made: Option<usize>,
+) -> u64 {
     let (n, m, p) = (n as u64, m as u64, p_entries as u64);
     let two_pass = two_pass.map_or(0, |(v, k)| 12 * v as u64 + 28 * n + 24 * k as u64);
-    56 * m + 12 * (2 * p) + 20 * (n + 1) + two_pass
+    let made = made
+        .map_or(0, |threads| threads as u64 * (12 * n + 16 * (2 * p).min(40 * crate::operators::COLUMN_BLOCK as u64)));
+    56 * m + 12 * (2 * p) + 20 * (n + 1) + two_pass + made
 }
 
 /// Bytes the iteration allocates beside its operands, at most, for `n` variables and `m` rows,

@@ -10,7 +10,8 @@
 //! the order compressed rows would hold them, so the products are those of the compressed
 //! rows bit for bit; on a mesh, where rows rarely repeat, each row is its own class.
 
-use crate::operators::Sparse;
+use crate::operators::{BilaplacianColumns, Sparse};
+use crate::solve::Quadratic;
 use std::collections::HashMap;
 
 /// Rows of one class a product sums side by side.
@@ -88,12 +89,19 @@ impl RowClasses {
     /// as the triplets take them, so the same bits. Row `u`'s entries below the diagonal are
     /// column `u`'s, those above are in the columns its own entries below the diagonal name
     /// (the pattern is symmetric), each found at that column's cursor as rows advance.
+    /// Made columns ([`Quadratic::Columns`]) give row `u` from column `u`'s own entries below
+    /// the diagonal and, above it, from the entry of each later column at row `u`, made alone:
+    /// the same values.
     pub(super) fn from_columns(
-        p: &Sparse,
+        p: Quadratic<'_>,
         free: &[usize],
         slot: &[usize],
         scale: f64,
     ) -> Result<RowClasses, &'static str> {
+        let p = match p {
+            Quadratic::Stored(p) => p,
+            Quadratic::Columns(c) => return Self::from_made_columns(c, free, slot, scale),
+        };
         let (cp, ri, val) = (p.symbolic().col_ptr(), p.symbolic().row_idx(), p.val());
         let mut cursor: Vec<usize> = cp[..p.ncols()].to_vec();
         Self::from_rows(free.len(), |u, entry| {
@@ -121,6 +129,44 @@ impl RowClasses {
                 }
                 entry(s, val[*at] / scale);
                 *at += 1;
+            }
+            Ok(())
+        })
+    }
+
+    /// [`Self::from_columns`] for made columns: each row's entries (as slots, divided by
+    /// `scale`) made in blocks on up to the cap's threads, an entry outside the pattern as NaN.
+    fn from_made_columns(
+        p: &BilaplacianColumns<'_>,
+        free: &[usize],
+        slot: &[usize],
+        scale: f64,
+    ) -> Result<RowClasses, &'static str> {
+        let mut blocks = p.blocks(free.len(), |u, work, cols, vals| {
+            let j = free[u];
+            p.column(j, work);
+            for (&i, &v) in work.rows.iter().zip(&work.vals) {
+                let s = slot[i];
+                if s != usize::MAX && s <= u {
+                    cols.push(s);
+                    vals.push(v / scale);
+                }
+            }
+            for &c in &work.rows {
+                let s = slot[c];
+                if s != usize::MAX && s > u {
+                    cols.push(s);
+                    vals.push(p.entry(j, c).map_or(f64::NAN, |v| v / scale));
+                }
+            }
+        });
+        Self::from_rows(free.len(), |u, entry| {
+            let (cols, vals) = blocks.item(u);
+            for (&c, &v) in cols.iter().zip(vals) {
+                if v.is_nan() {
+                    return Err("P's pattern is not symmetric");
+                }
+                entry(c, v);
             }
             Ok(())
         })
@@ -423,7 +469,7 @@ mod tests {
         }
         let (a, b) = (
             RowClasses::from_upper(free.len(), &upper).unwrap(),
-            RowClasses::from_columns(&p, &free, &slot, scale).unwrap(),
+            RowClasses::from_columns((&p).into(), &free, &slot, scale).unwrap(),
         );
         assert_eq!(a.classes(), b.classes());
         let x: Vec<f64> = (0..free.len()).map(|i| (i as f64 * 0.9).cos()).collect();
@@ -437,7 +483,43 @@ mod tests {
         // an entry below the diagonal whose mirror is missing
         t.push(faer::sparse::Triplet::new(5, 0, 1.0));
         let lopsided = Sparse::try_new_from_triplets(n, n, &t).unwrap();
-        assert!(RowClasses::from_columns(&lopsided, &free, &slot, scale).is_err());
+        assert!(RowClasses::from_columns((&lopsided).into(), &free, &slot, scale).is_err());
+    }
+
+    /// Made columns ([`BilaplacianColumns`]) of a volume's bilaplacian with three fixed vertices
+    /// give the same classes, rows and products, bit for bit, as the assembled matrix stored:
+    /// made in more than one block (each block's rows on its own thread) and on one.
+    #[test]
+    fn made_columns_give_the_stored_matrix_s_rows() {
+        use crate::operators::{plus_diagonal, polyharmonic_products, volume_mass, volume_stiffness, Energy};
+        let g = crate::domain::Grid3d::with_geometry([70, 60, 40], [1.0, 0.8, 1.3], [0.0; 3]).unwrap();
+        let (k, m) = (volume_stiffness(&g), volume_mass(&g));
+        let n = m.len();
+        let data: Vec<f64> = m.iter().map(|v| 0.3 * v).collect();
+        let energy = Energy::order(2);
+        let stored = plus_diagonal(polyharmonic_products(&k, &m, &energy, &[6.0]), &data);
+        let made = BilaplacianColumns::new(&k, &m, &energy, &[6.0], &data).unwrap();
+        let free: Vec<usize> = (0..n).filter(|&v| ![0, 777, 90_001].contains(&v)).collect();
+        let mut slot = vec![usize::MAX; n];
+        free.iter().enumerate().for_each(|(k, &v)| slot[v] = k);
+        let scale = 2.3;
+        let a = RowClasses::from_columns((&stored).into(), &free, &slot, scale).unwrap();
+        let x: Vec<f64> = (0..free.len()).map(|i| (i as f64 * 0.37).sin()).collect();
+        let mut ya = vec![0.0; free.len()];
+        a.apply(&x, &mut ya);
+        for threads in [1, 2] {
+            let b = crate::parallel::with_threads(threads, || {
+                RowClasses::from_columns(Quadratic::Columns(&made), &free, &slot, scale).unwrap()
+            });
+            assert_eq!(a.classes(), b.classes(), "{threads} threads");
+            let mut yb = vec![0.0; free.len()];
+            b.apply(&x, &mut yb);
+            assert!(ya.iter().zip(&yb).all(|(a, b)| a.to_bits() == b.to_bits()), "{threads} threads");
+            for i in (0..free.len()).step_by(997) {
+                assert_eq!(a.row(i).collect::<Vec<_>>(), b.row(i).collect::<Vec<_>>(), "row {i}");
+                assert_eq!(a.diagonal(i).to_bits(), b.diagonal(i).to_bits());
+            }
+        }
     }
 
     /// The product in two passes over a 7-point stiffness on a 12 × 6 × 5 box, with two fixed

@@ -1,7 +1,7 @@
 //! The clusters a working set makes: a label and an offset per variable, an anchor or an
 //! unknown per cluster, and the spanning trees the multipliers walk.
 
-use super::rows::Row;
+use super::rows::{Row, RowKind};
 
 pub(super) const NONE: u32 = u32::MAX;
 
@@ -102,7 +102,7 @@ impl Labels {
     pub(super) fn new(n: usize, rows: &[Row], in_set: &[bool]) -> Labels {
         let mut label: Vec<u32> = (0..n as u32).collect();
         for (_, row) in in_set_rows(rows, in_set) {
-            if let Row::Pair(i, j, _) = *row {
+            if let RowKind::Pair(i, j, _) = row.kind() {
                 let (a, b) = (find(&mut label, i as u32), find(&mut label, j as u32));
                 if a != b {
                     label[a as usize] = b;
@@ -114,7 +114,7 @@ impl Labels {
         }
         let mut anchor_row = vec![usize::MAX; n];
         for (k, row) in in_set_rows(rows, in_set) {
-            if let Row::Bound(v, _, _) = *row {
+            if let RowKind::Bound(v, _, _) = row.kind() {
                 anchor_row[label[v] as usize] = k;
             }
         }
@@ -140,7 +140,7 @@ impl Clusters {
         // the rows themselves
         let mut deg = vec![0u32; n + 1];
         for (_, row) in in_set_rows(rows, in_set) {
-            if let Row::Pair(i, j, _) = *row {
+            if let RowKind::Pair(i, j, _) = row.kind() {
                 deg[i + 1] += 1;
                 deg[j + 1] += 1;
             }
@@ -151,7 +151,7 @@ impl Clusters {
         let mut adj = vec![Across { row: 0, to: 0, step: 0.0 }; deg[n] as usize];
         let mut at = deg.clone();
         for (k, row) in in_set_rows(rows, in_set) {
-            if let Row::Pair(i, j, b) = *row {
+            if let RowKind::Pair(i, j, b) = row.kind() {
                 adj[at[i] as usize] = Across { row: k as u32, to: j as u32, step: -b };
                 at[i] += 1;
                 adj[at[j] as usize] = Across { row: k as u32 | Up::FIRST, to: i as u32, step: b };
@@ -198,7 +198,7 @@ impl Clusters {
         let mut anchor: Vec<Option<f64>> = vec![None; nc];
         let mut anchor_row = vec![usize::MAX; nc];
         for (k, row) in in_set_rows(rows, in_set) {
-            if let Row::Bound(v, a, b) = *row {
+            if let RowKind::Bound(v, a, b) = row.kind() {
                 anchor[label[v] as usize] = Some(a * b - offset[v]);
                 anchor_row[label[v] as usize] = k;
             }
@@ -207,7 +207,7 @@ impl Clusters {
         // from there, over the cluster's own stretch of `order`
         let mut seen = Vec::new();
         for (c, &k) in anchor_row.iter().enumerate() {
-            let Some(Row::Bound(root, _, _)) = rows.get(k).copied() else { continue };
+            let Some(RowKind::Bound(root, _, _)) = rows.get(k).map(|r| r.kind()) else { continue };
             if order[first[c]] == root {
                 continue;
             }

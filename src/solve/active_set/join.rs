@@ -5,7 +5,7 @@
 //! or a bound where two anchored clusters are pulled together.
 
 use super::clusters::{find, Forest, Labels};
-use super::rows::Row;
+use super::rows::{Row, RowKind};
 
 /// A row joins the working set when violated by more than this (unit values; the margin
 /// repair closes smaller violations).
@@ -117,8 +117,8 @@ pub(super) fn join(
             break;
         }
         let before = changed;
-        match rows[k] {
-            Row::Pair(i, j, _) if cl.label[i] == cl.label[j] => {
+        match rows[k].kind() {
+            RowKind::Pair(i, j, _) if cl.label[i] == cl.label[j] => {
                 // a cycle in one cluster: the row replaces a tree row on its path
                 // several per cluster when their paths share no row a swap took out:
                 // each such path is then the new tree's path too (at 48³ of a quantised
@@ -150,7 +150,7 @@ pub(super) fn join(
                     stuck[1] += 1;
                 }
             }
-            Row::Pair(i, j, _) => {
+            RowKind::Pair(i, j, _) => {
                 let (ci, cj) = (cl.label[i], cl.label[j]);
                 let (a, b) = (find(&mut parent, ci), find(&mut parent, cj));
                 if a != b && !(anchored[a as usize] && anchored[b as usize]) {
@@ -187,7 +187,7 @@ pub(super) fn join(
                     stuck[if a == b { 2 } else { 3 }] += 1;
                 }
             }
-            Row::Bound(v, _, _) => {
+            RowKind::Bound(v, _, _) => {
                 let c = cl.label[v] as usize;
                 let a = find(&mut parent, cl.label[v]);
                 if !anchored[a as usize] {

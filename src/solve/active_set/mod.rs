@@ -36,7 +36,7 @@ use join::{join, share_after, Joined, ADD_ABOVE};
 use multipliers::{balanced_gradient, flow_multipliers, gap_bound, tree_multipliers};
 use objective::{solve_clustered, Objective, MULTIGRID_AFTER, MULTIGRID_SOON};
 use operator::{RowClasses, TwoPass};
-use rows::{rows_of, Row};
+use rows::{rows_of, Row, RowKind};
 
 /// Outer iterations at most. The tie-heavy 96³ volume (`bench --single 96x96x96q`) needs 407:
 /// at 200 it still had 86,747 rows violated, and the interior-point route it would hand over
@@ -78,7 +78,7 @@ pub(super) struct ActiveSetOutcome {
 }
 
 /// Bytes the iteration's operands take, at most, before they are made, for `n` variables, `m`
-/// rows and `p_entries` stored entries of P's upper triangle: the rows (32 bytes each, with the
+/// rows and `p_entries` stored entries of P's upper triangle: the rows (16 bytes each, with the
 /// 24 of the problem's own row list they are made from), the row classes' tables (12 bytes an
 /// entry of both triangles when no row repeats, as on a mesh; a grid's few hundred classes
 /// take next to nothing) and per variable its class, slot and cursor; with the product in two
@@ -100,7 +100,7 @@ pub(crate) fn operand_bytes(
     let two_pass = two_pass.map_or(0, |(v, k)| 12 * v as u64 + 28 * n + 24 * k as u64);
     let made = made
         .map_or(0, |threads| threads as u64 * (12 * n + 16 * (2 * p).min(40 * crate::operators::COLUMN_BLOCK as u64)));
-    56 * m + 12 * (2 * p) + 20 * (n + 1) + two_pass + made
+    40 * m + 12 * (2 * p) + 20 * (n + 1) + two_pass + made
 }
 
 /// Bytes the iteration allocates beside its operands, at most, for `n` variables and `m` rows,
@@ -222,7 +222,7 @@ pub(super) fn solve(
     let mut status = SolveStatus::MaxIterations;
     let mut outer = 0;
     let mut history: Vec<(usize, usize, usize)> = Vec::new();
-    let margin = rows.iter().map(|r| if let Row::Pair(_, _, b) = *r { -b } else { 0.0 }).fold(0.0, f64::max);
+    let margin = rows.iter().map(|r| if let RowKind::Pair(_, _, b) = r.kind() { -b } else { 0.0 }).fold(0.0, f64::max);
     let stuck_above = (STUCK_SHARE * margin).max(ADD_ABOVE);
     // how often a row joined two anchored clusters (an anchor left for it): twice at most,
     // once per anchor, as the next cut tends to undo it
@@ -258,11 +258,11 @@ pub(super) fn solve(
         let mut unanchored = vec![false; cl.anchor.len()];
         for (k, row) in rows.iter().enumerate() {
             if in_set[k] && z[k] < 0.0 {
-                match *row {
-                    Row::Pair(i, j, _) if z[k] * z[k] / r.d[i].min(r.d[j]) > significant => {
+                match row.kind() {
+                    RowKind::Pair(i, j, _) if z[k] * z[k] / r.d[i].min(r.d[j]) > significant => {
                         marked[cl.label[i] as usize] = true;
                     }
-                    Row::Bound(v, _, _) if z[k] * z[k] / r.d[v] > significant => {
+                    RowKind::Bound(v, _, _) if z[k] * z[k] / r.d[v] > significant => {
                         unanchored[cl.label[v] as usize] = true;
                         in_set[k] = false;
                         z[k] = 0.0;

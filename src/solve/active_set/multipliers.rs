@@ -4,7 +4,7 @@
 
 use super::super::flow::Network;
 use super::clusters::{Clusters, Forest, NONE};
-use super::rows::Row;
+use super::rows::{Row, RowKind};
 
 /// The gradient with each unanchored cluster's sum spread back over it in proportion to the
 /// data diagonal (the conjugate gradients leave a residual of their tolerance): what the
@@ -40,7 +40,7 @@ pub(super) fn tree_multipliers(rows: &[Row], cl: &Clusters, balanced: &[f64], z:
         let up = up[v];
         let Some(k) = up.row() else {
             let anchor = cl.anchor_row[cl.label[v] as usize];
-            if let Some(Row::Bound(_, a, _)) = rows.get(anchor) {
+            if let Some(RowKind::Bound(_, a, _)) = rows.get(anchor).map(|r| r.kind()) {
                 z[anchor] = -a * acc[v];
             }
             continue;
@@ -207,14 +207,14 @@ impl Flows<'_> {
         }
         let mut arcs: Vec<(usize, usize)> = Vec::new();
         for (k, row) in rows.iter().enumerate() {
-            match *row {
-                Row::Pair(i, j, _) => {
+            match row.kind() {
+                RowKind::Pair(i, j, _) => {
                     if node[i] == NONE || cl.label[i] != cl.label[j] || !(in_set[k] || row.slack(x) <= TIGHT) {
                         continue;
                     }
                     arcs.push((k, net.add_arc(node[i] as usize, node[j] as usize, f64::INFINITY)));
                 }
-                Row::Bound(v, a, _) if in_set[k] && node[v] != NONE => {
+                RowKind::Bound(v, a, _) if in_set[k] && node[v] != NONE => {
                     let c = local[cl.label[v] as usize] as usize;
                     let (source, sink) = (terminals[c].0 as usize, terminals[c].1 as usize);
                     let hub = net.add_node();
@@ -227,7 +227,7 @@ impl Flows<'_> {
                         supply_or_demand(&mut net, &mut supply, source, hub, (-sum[c]).max(0.0), Some(c as u32));
                     }
                 }
-                Row::Bound(..) => {}
+                RowKind::Bound(..) => {}
             }
         }
         let mut side = vec![false; net.nodes()];
@@ -242,7 +242,7 @@ impl Flows<'_> {
         let cut = |c: usize| deficit[c] * deficit[c] / dmin[c] > significant;
         let mut out = GroupFlow { z: Vec::with_capacity(arcs.len()), dropped: Vec::new() };
         for &(k, a) in &arcs {
-            if let Row::Pair(i, j, _) = rows[k] {
+            if let RowKind::Pair(i, j, _) = rows[k].kind() {
                 if in_set[k]
                     && cut(local[cl.label[i] as usize] as usize)
                     && side[node[i] as usize] != side[node[j] as usize]
@@ -283,12 +283,12 @@ pub(super) fn gap_bound(rows: &[Row], x: &[f64], z: &[f64], g: &[f64], d: &[f64]
             continue;
         }
         complementarity += row.slack(x).max(0.0) * zk;
-        match *row {
-            Row::Pair(i, j, _) => {
+        match row.kind() {
+            RowKind::Pair(i, j, _) => {
                 rho[i] += zk;
                 rho[j] -= zk;
             }
-            Row::Bound(v, a, _) => rho[v] += a * zk,
+            RowKind::Bound(v, a, _) => rho[v] += a * zk,
         }
     }
     complementarity + 0.5 * rho.iter().zip(d).map(|(r, d)| r * r / d).sum::<f64>()

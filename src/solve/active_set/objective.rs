@@ -524,7 +524,7 @@ mod tests {
             };
             // every 7th variable joined to its right-hand neighbour one margin below
             let rows: Vec<Row> =
-                (0..n).filter(|i| i % 7 == 0 && i % w + 1 < w).map(|i| Row::Pair(i + 1, i, -1e-3)).collect();
+                (0..n).filter(|i| i % 7 == 0 && i % w + 1 < w).map(|i| Row::pair(i + 1, i, -1e-3)).collect();
             let in_set = vec![true; rows.len()];
             let cl = Clusters::new(n, &rows, &in_set);
             let mut x = vec![0.0; n];

@@ -78,10 +78,10 @@ pub(super) struct ActiveSetOutcome {
 }
 
 /// Bytes the iteration's operands take, at most, before they are made, for `n` variables, `m`
-/// rows and `p_entries` stored entries of P's upper triangle: the rows (16 bytes each, with the
-/// 24 of the problem's own row list they are made from), the row classes' tables (12 bytes an
-/// entry of both triangles when no row repeats, as on a mesh; a grid's few hundred classes
-/// take next to nothing) and per variable its class, slot and cursor; with the product in two
+/// rows and `p_entries` stored entries of P's upper triangle: the rows (16 bytes each, made one
+/// at a time from the problem's rows), the row classes' tables (12 bytes an entry of both
+/// triangles when no row repeats, as on a mesh; a grid's few hundred classes take next to
+/// nothing) and per variable its class, slot and cursor; with the product in two
 /// passes over a stiffness of `(vertices, entries)` ([`TwoPass`]), per vertex its intermediate
 /// value and inner class (12), per variable its outer class and the three test vectors of its
 /// check (28), and both passes' tables (12 bytes an entry each when no row
@@ -100,7 +100,7 @@ pub(crate) fn operand_bytes(
     let two_pass = two_pass.map_or(0, |(v, k)| 12 * v as u64 + 28 * n + 24 * k as u64);
     let made = made
         .map_or(0, |threads| threads as u64 * (12 * n + 16 * (2 * p).min(40 * crate::operators::COLUMN_BLOCK as u64)));
-    40 * m + 12 * (2 * p) + 20 * (n + 1) + two_pass + made
+    16 * m + 12 * (2 * p) + 20 * (n + 1) + two_pass + made
 }
 
 /// Bytes the iteration allocates beside its operands, at most, for `n` variables and `m` rows,

@@ -1,6 +1,6 @@
 //! The reduced QP's constraint rows as the active-set iteration reads them.
 
-use super::super::problem::{constraint_rows, MonotoneQp, Row as QpRow};
+use super::super::problem::{constraint_rows_iter, MonotoneQp, Row as QpRow};
 
 /// One constraint row of the reduced QP, in 16 bytes (at 256³ the 31.9 million rows took 1.0
 /// GB as an enum of two indices of a word and a value): `x_a − x_b ≤ rhs`, or for a bound
@@ -67,8 +67,7 @@ impl Row {
 /// order of [`constraint_rows`]), `slot[v]` being `v`'s index among the free variables.
 pub(super) fn rows_of(qp: &MonotoneQp<'_>, slot: &[usize]) -> Vec<Row> {
     let eps = qp.margin;
-    constraint_rows(qp)
-        .into_iter()
+    constraint_rows_iter(qp)
         .map(|row| match row {
             // f_j − f_i ≥ ε  ⇔  f_i − f_j ≤ −ε
             QpRow::Pair(i, j) => match (qp.fixed[i], qp.fixed[j]) {

@@ -37,7 +37,9 @@ pub struct Column {
     /// The entries at `rows`.
     pub vals: Vec<f64>,
     work: Vec<f64>,
+    /// The call that last saw each row (so that no mark needs clearing between columns).
     mark: Vec<u32>,
+    calls: u32,
 }
 
 impl<'a> BilaplacianColumns<'a> {
@@ -79,17 +81,24 @@ impl<'a> BilaplacianColumns<'a> {
         &self.data
     }
 
-    /// A workspace for [`Self::column`] (12 bytes a vertex).
+    /// A workspace for [`Self::column`] (12 bytes a vertex; any column may be made in it any
+    /// number of times, in any order).
     #[must_use]
     pub fn workspace(&self) -> Column {
-        Column { rows: Vec::new(), vals: Vec::new(), work: vec![0.0; self.n()], mark: vec![0; self.n()] }
+        Column { rows: Vec::new(), vals: Vec::new(), work: vec![0.0; self.n()], mark: vec![0; self.n()], calls: 0 }
     }
 
     /// Column `j` into `out.rows` and `out.vals`.
     pub fn column(&self, j: usize, out: &mut Column) {
         let (cp, ri, v) = (self.k.symbolic().col_ptr(), self.k.symbolic().row_idx(), self.k.val());
         let (d, m) = (&self.d, self.m);
-        let stamp = j as u32 + 1;
+        // a column made twice in one workspace must not find its own marks
+        out.calls = out.calls.wrapping_add(1);
+        if out.calls == 0 {
+            out.mark.iter_mut().for_each(|m| *m = 0);
+            out.calls = 1;
+        }
+        let stamp = out.calls;
         out.rows.clear();
         out.vals.clear();
         for p in cp[j]..cp[j + 1] {
@@ -324,6 +333,12 @@ mod tests {
                 for (&i, &value) in col.rows.iter().zip(&col.vals) {
                     assert_eq!(gen.entry(i, j).map(f64::to_bits), Some(value.to_bits()));
                 }
+            }
+            // made again, out of order, in the same workspace: the same column
+            for j in [n / 2, 0, n / 2] {
+                gen.column(j, &mut col);
+                assert_eq!(col.rows, &ri[cp[j]..cp[j + 1]], "column {j} made again");
+                assert_eq!(col.vals, &v[cp[j]..cp[j + 1]]);
             }
             assert_eq!(gen.entry(0, n - 1), None);
             let x: Vec<f64> = (0..n).map(|i| ((i * 7919) % 101) as f64 / 101.0 - 0.4).collect();

@@ -653,3 +653,62 @@ pub(super) fn reduce_factor(qp: &MonotoneQp<'_>, f: &Factor, free: &[usize], sca
         double_iteration: false,
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::operators::{plus_diagonal, polyharmonic_products, volume_mass, volume_stiffness, Energy};
+
+    /// The reductions from made columns are those from the stored matrix, bit for bit: with
+    /// P's triplets (what a route taking over from the active set rebuilds) and without them
+    /// (the active set's own: the fixed vertices' coupling, the scale, the constant), with the
+    /// same rows and right-hand sides.
+    #[test]
+    fn made_columns_reduce_as_the_stored_matrix() {
+        let g = crate::domain::Grid3d::with_geometry([11, 9, 8], [1.0, 0.7, 1.2], [0.0; 3]).unwrap();
+        let (k, m) = (volume_stiffness(&g), volume_mass(&g));
+        let n = m.len();
+        let data: Vec<f64> = m.iter().map(|v| 0.4 * v).collect();
+        let energy = Energy::order(2);
+        let stored = plus_diagonal(polyharmonic_products(&k, &m, &energy, &[5.0]), &data);
+        let made = BilaplacianColumns::new(&k, &m, &energy, &[5.0], &data).unwrap();
+        let q: Vec<f64> = (0..n).map(|i| -data[i] * ((i * 13 % 17) as f64 * 0.05)).collect();
+        let mut fixed = vec![None; n];
+        for (v, value) in [(3, 0.2), (250, 0.9), (700, 0.1)] {
+            fixed[v] = Some(value);
+        }
+        let edges: Vec<(usize, usize)> = (0..n - 1).filter(|i| i % 11 != 10).map(|i| (i, i + 1)).collect();
+        let bounds = [Bound { vertex: 5, value: 1.0, upper: true }];
+        let free: Vec<usize> = (0..n).filter(|&v| fixed[v].is_none()).collect();
+        let problem = |p: Quadratic<'_>| {
+            let qp = MonotoneQp {
+                p,
+                q: &q,
+                fixed: &fixed,
+                edges: &edges,
+                margin: 1e-5,
+                bounds: &bounds,
+                data: Some(&data),
+                hint: None,
+                factor: None,
+                condition: None,
+                second_order: None,
+            };
+            [true, false].map(|triplets| reduce_with(&qp, &free, triplets))
+        };
+        let (a, b) = (problem(Quadratic::Stored(&stored)), problem(Quadratic::Columns(&made)));
+        let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        for ((ra, ua), (rb, ub)) in a.iter().zip(&b) {
+            assert_eq!(bits(&ra.q), bits(&rb.q));
+            assert_eq!(bits(&ra.b), bits(&rb.b));
+            assert_eq!(bits(&ra.d), bits(&rb.d));
+            assert_eq!(ra.scale.to_bits(), rb.scale.to_bits());
+            assert_eq!(ra.constant.to_bits(), rb.constant.to_bits());
+            assert_eq!(ra.rows.ends(), rb.rows.ends());
+            let entries = |r: &ReducedQp| r.p.entries().map(|(i, j, v)| (i, j, v.to_bits())).collect::<Vec<_>>();
+            assert_eq!(entries(ra), entries(rb));
+            assert!(ub >= ua, "the made columns' count {ub} bounds the stored {ua}");
+        }
+        assert!(a[0].1 > 0 && a[0].0.p.len() == a[0].1);
+    }
+}

@@ -221,20 +221,20 @@ impl<'a> BilaplacianColumns<'a> {
     /// `w += P v` in two passes over K, `c·K (d∘d∘m∘(K v)) + data∘v` (on up to the cap's
     /// threads): the matrix's product up to rounding, for estimates (the condition), not for
     /// the certificate.
-    pub fn add_product(&self, v: &[f64], w: &mut [f64]) {
+    /// `t` is the passes' intermediate vector (resized to the order).
+    pub fn add_product(&self, v: &[f64], w: &mut [f64], t: &mut Vec<f64>) {
         let (cp, ri, kv) = (self.k.symbolic().col_ptr(), self.k.symbolic().row_idx(), self.k.val());
-        let n = self.n();
         // K is symmetric: column i is row i
         let row = |i: usize, x: &[f64]| -> f64 { (cp[i]..cp[i + 1]).map(|p| kv[p] * x[ri[p]]).sum() };
-        let mut t = vec![0.0; n];
-        crate::parallel::split_mut(&mut t, |offset, t| {
+        t.resize(self.n(), 0.0);
+        crate::parallel::split_mut(t, |offset, t| {
             for (ti, i) in t.iter_mut().zip(offset..) {
                 *ti = row(i, v) * (self.d[i] * self.d[i] * self.m[i] * self.c);
             }
         });
         crate::parallel::split_mut(w, |offset, w| {
             for (wi, i) in w.iter_mut().zip(offset..) {
-                *wi += row(i, &t) + self.data[i] * v[i];
+                *wi += row(i, t) + self.data[i] * v[i];
             }
         });
     }
@@ -343,7 +343,7 @@ mod tests {
             assert_eq!(gen.entry(0, n - 1), None);
             let x: Vec<f64> = (0..n).map(|i| ((i * 7919) % 101) as f64 / 101.0 - 0.4).collect();
             let mut fast = vec![0.0; n];
-            gen.add_product(&x, &mut fast);
+            gen.add_product(&x, &mut fast, &mut Vec::new());
             let exact = crate::operators::sparse::mul_vec(&stored, &x);
             let size = exact.iter().fold(0.0f64, |a, v| a.max(v.abs()));
             for (a, b) in fast.iter().zip(&exact) {

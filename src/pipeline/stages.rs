@@ -259,9 +259,12 @@ pub(super) fn build_operators<'a, D: Smoothable>(
     let data_diag: Vec<f64> = m.iter().map(|mi| gd * mi).collect();
     // the interior-point routes analyse P's pattern as the normal matrix's, which must hold
     // every constrained pair (every edge); the active set needs only P's non-zero products,
-    // and of an energy of one order-2 term not even those stored
+    // and of an energy of one order-2 term not even those stored; nor does a series, whose
+    // solver reads P once into its band (its bilaplacian's pattern holds every edge)
     let active_set = settings.qp.method == Method::ActiveSet;
-    let p = match active_set.then(|| BilaplacianColumns::new(k, m, &settings.energy, &weights, &data_diag)).flatten() {
+    let series = domain.pairing_rule() == crate::domain::PairingRule::Path;
+    let made = (active_set || series).then(|| BilaplacianColumns::new(k, m, &settings.energy, &weights, &data_diag));
+    let p = match made.flatten() {
         Some(columns) => EnergyMatrix::Columns(columns),
         None => {
             let q_energy = if active_set {

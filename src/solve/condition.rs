@@ -38,15 +38,14 @@ pub fn condition_estimate(p: super::Quadratic<'_>, d: &[f64], fixed: &[Option<f6
     let p = match p {
         super::Quadratic::Stored(p) => p,
         super::Quadratic::Columns(c) => {
-            let (mut x, mut y) = (vec![0.0; d.len()], vec![0.0; d.len()]);
-            let (x, y) = (std::cell::RefCell::new(&mut x), std::cell::RefCell::new(&mut y));
+            let scratch = std::cell::RefCell::new((vec![0.0; d.len()], vec![0.0; d.len()], Vec::new()));
             return Some(power(&df, |v, w| {
-                let (mut x, mut y) = (x.borrow_mut(), y.borrow_mut());
+                let (x, y, t) = &mut *scratch.borrow_mut();
                 for (&i, &vi) in free.iter().zip(v) {
                     x[i] = vi;
                 }
                 y.iter_mut().for_each(|a| *a = 0.0);
-                c.add_product(&x, &mut y);
+                c.add_product(x, y, t);
                 for (wk, &i) in w.iter_mut().zip(&free) {
                     *wk += y[i];
                 }

@@ -477,16 +477,29 @@ pub(super) fn reduce_with(qp: &MonotoneQp<'_>, free: &[usize], triplets: bool) -
     let nf = free.len();
     let mut work = qp.p.workspace();
     // a band when every free entry lies near the diagonal (a series), else triplets
+    let made = matches!(qp.p, Quadratic::Columns(_));
     let width = if triplets {
         let mut width = Some(0usize);
-        for j in (0..n).filter(|&j| slot[j] != usize::MAX) {
-            let (rows, _) = qp.p.column(j, &mut work);
-            for &i in rows.iter().filter(|&&i| slot[i] != usize::MAX) {
-                let d = slot[i].abs_diff(slot[j]);
-                width = width.and_then(|a| (d <= crate::linalg::BANDED_MAX).then_some(a.max(d)));
+        // whether the entries so far lie in a band
+        let mut widen = |j: usize, rows: &[usize]| {
+            if slot[j] != usize::MAX {
+                for &i in rows.iter().filter(|&&i| slot[i] != usize::MAX) {
+                    let d = slot[i].abs_diff(slot[j]);
+                    width = width.and_then(|a| (d <= crate::linalg::BANDED_MAX).then_some(a.max(d)));
+                }
             }
-            if width.is_none() {
-                break;
+            width.is_some()
+        };
+        if made {
+            // made columns in blocks on every core (a stored matrix stops at the first wide entry)
+            qp.p.for_each_column(|j, rows, _| {
+                widen(j, rows);
+            });
+        } else {
+            for j in 0..n {
+                if !widen(j, qp.p.column(j, &mut work).0) {
+                    break;
+                }
             }
         }
         width
@@ -519,15 +532,18 @@ pub(super) fn reduce_with(qp: &MonotoneQp<'_>, free: &[usize], triplets: bool) -
         }
     };
     // without triplets a free column gives its diagonal only (all that is read of it): made
-    // columns are then made for the fixed vertices alone
-    let made = matches!(qp.p, Quadratic::Columns(_));
-    for (j, &sj) in slot.iter().enumerate() {
-        if made && !triplets && sj != usize::MAX {
-            let diagonal = qp.p.entry(j, j).unwrap_or(0.0);
-            visit(j, &[j], &[diagonal]);
-        } else {
-            let (rows, vals) = qp.p.column(j, &mut work);
-            visit(j, rows, vals);
+    // columns are then made for the fixed vertices alone; with them, in blocks on every core
+    if made && triplets {
+        qp.p.for_each_column(&mut visit);
+    } else {
+        for (j, &sj) in slot.iter().enumerate() {
+            if made && sj != usize::MAX {
+                let diagonal = qp.p.entry(j, j).unwrap_or(0.0);
+                visit(j, &[j], &[diagonal]);
+            } else {
+                let (rows, vals) = qp.p.column(j, &mut work);
+                visit(j, rows, vals);
+            }
         }
     }
     drop(work);

@@ -51,7 +51,8 @@ pub struct MonotoneQp<'a> {
 
 /// P as the solvers read it: a stored matrix (both triangles), or the matrix of an order-2
 /// energy made column by column as it is read ([`BilaplacianColumns`]: the same entries, the
-/// same bits, nothing stored; for the active set, which makes its own forms of P once).
+/// same bits, nothing stored: for the active set, which makes its own forms of P once, and a
+/// series, whose solver reads it once into its band).
 #[derive(Clone, Copy, Debug)]
 pub enum Quadratic<'a> {
     /// Compressed columns, both triangles.

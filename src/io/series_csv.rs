@@ -5,7 +5,7 @@
 
 use super::csv_dialect::{sniff, Dialect};
 pub use super::series_output::{
-    read_series_output, stage_series_output, write_series_output, SeriesColumns, SeriesOutput, XText,
+    read_series_output, stage_series_output, write_series_output, SeriesColumns, SeriesOutput, Texts, XText,
 };
 pub use super::timestamps::parse_date_days;
 use super::timestamps::parse_stamp;
@@ -328,7 +328,7 @@ impl Cells<'_> {
     /// instant) or numbers, strictly increasing, with their text.
     fn x(&self, name: &str, c: usize, dates: bool) -> Result<(Vec<f64>, XText, XSource)> {
         let mut x = Vec::with_capacity(self.data.len());
-        let mut text = Vec::with_capacity(self.data.len());
+        let mut text = Texts::with_capacity(self.data.len());
         let mut first_aware: Option<(bool, u64, String)> = None;
         for (line, r) in self.data.iter() {
             let cell = r[c].trim();
@@ -359,12 +359,20 @@ impl Cells<'_> {
                 self.error(line, format!("`{cell}` in x column `{name}` is not a {what}"))
             })?;
             x.push(v);
-            text.push(if dates || !self.dialect.decimal_comma { cell.to_string() } else { cell.replace(',', ".") });
+            if dates || !self.dialect.decimal_comma {
+                text.push(cell);
+            } else {
+                text.push(&cell.replace(',', "."));
+            }
         }
         if let Some(i) = (1..x.len()).find(|&i| x[i] <= x[i - 1]) {
             return Err(self.error(
                 self.data.line(i),
-                format!("x column `{name}` must strictly increase, but `{}` follows `{}`", text[i], text[i - 1]),
+                format!(
+                    "x column `{name}` must strictly increase, but `{}` follows `{}`",
+                    text.get(i),
+                    text.get(i - 1)
+                ),
             ));
         }
         let source = if dates {
@@ -457,7 +465,7 @@ mod tests {
         let s = read_series(&p, &SeriesCsvOptions { x_column: Some("depth".into()), ..Default::default() }).unwrap();
         assert_eq!(
             (s.x.clone(), s.x_text.clone(), s.x_name.as_str()),
-            (vec![0.5, 1.5, 3.0], XText::Text(vec!["0.5".to_string(), "1.5".into(), "3".into()]), "depth")
+            (vec![0.5, 1.5, 3.0], XText::Text(["0.5", "1.5", "3"].into_iter().collect()), "depth")
         );
         let p = tmp("tab.tsv", "time\tv\n1\t3\n2\t1\n4\t2\n");
         let s = read_series(&p, &opts).unwrap();

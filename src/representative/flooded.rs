@@ -6,7 +6,8 @@ use crate::topology::{KeptSet, Role};
 /// The data's own simplification as a representative (NOTES.md 9, after Tierny & Pascucci
 /// 2012): a priority flood from the kept minima visits the vertices upwards and gives every
 /// vertex at least the next double above the vertex visited before it, so cancelled basins are
-/// raised to their spill level and ties are broken in visiting order; a flood from the kept
+/// raised to their spill level and ties are broken in the order the flood reached them (a
+/// plateau rises with the distance from where the flood entered it); a flood from the kept
 /// maxima does the same downwards. Every vertex but a seed is reached from a visited neighbour
 /// with a strictly smaller (larger) value, so after the two floods only kept extrema remain
 /// (repeated a few times if the second flood undid the first). Kept values are unchanged; the
@@ -43,11 +44,16 @@ fn flood<D: crate::domain::Domain>(domain: &D, g: &mut [f64], kept: &KeptSet, ro
     let n = g.len();
     // a vertex's value changes only when it is popped, so its key is the same whoever pushes
     // it: each vertex is pushed once (the order is that of pushing it from every neighbour)
+    // equal keys leave in the order they were reached, so a plateau rises (falls) with the
+    // distance from where the flood entered it, as a flat drains to its outlet in a
+    // hydrological flat resolution, not in the order of the vertices' indices
     let mut queued = vec![false; n];
     let mut heap = BinaryHeap::with_capacity(n);
+    let mut reached = 0usize;
     for (v, &gv) in g.iter().enumerate() {
         if kept.roles[v] == role {
-            heap.push(Reverse((key(gv), 0u8, v)));
+            heap.push(Reverse((key(gv), reached, v)));
+            reached += 1;
             queued[v] = true;
         }
     }
@@ -62,8 +68,58 @@ fn flood<D: crate::domain::Domain>(domain: &D, g: &mut [f64], kept: &KeptSet, ro
         for w in domain.neighbors(v) {
             if !queued[w] {
                 queued[w] = true;
-                heap.push(Reverse((key(g[w]), 1u8, w)));
+                heap.push(Reverse((key(g[w]), reached, w)));
+                reached += 1;
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::domain::{Domain, Grid2d};
+    use crate::topology::{select, Selection};
+
+    /// A plateau entered from one corner rises with the graph distance from that corner (the
+    /// order a flood reaches it), not with the vertices' indices.
+    #[test]
+    fn a_plateau_rises_with_the_distance_from_where_the_flood_entered() {
+        let (nx, ny) = (6, 5);
+        let g = Grid2d::new(nx, ny).unwrap();
+        let n = nx * ny;
+        // one minimum at the last vertex, one maximum at the first, a plateau between
+        let mut h = vec![1.0; n];
+        (h[n - 1], h[0]) = (0.0, 2.0);
+        let kept = select(&g, &h, &Selection::Explicit { minima: vec![n - 1], maxima: vec![0] }).unwrap();
+        let u = flooded_representative(&g, &h, &kept).unwrap();
+        // graph distances from the minimum
+        let mut dist = vec![usize::MAX; n];
+        dist[n - 1] = 0;
+        let mut queue = std::collections::VecDeque::from([n - 1]);
+        while let Some(v) = queue.pop_front() {
+            for w in g.neighbors(v) {
+                if dist[w] == usize::MAX {
+                    dist[w] = dist[v] + 1;
+                    queue.push_back(w);
+                }
+            }
+        }
+        let plateau: Vec<usize> = (1..n - 1).collect();
+        for &a in &plateau {
+            for &b in &plateau {
+                if dist[a] < dist[b] {
+                    assert!(
+                        u[a] < u[b],
+                        "u[{a}] = {} (distance {}) not below u[{b}] = {} (distance {})",
+                        u[a],
+                        dist[a],
+                        u[b],
+                        dist[b]
+                    );
+                }
+            }
+        }
+        assert!(crate::verify::certify(&g, &u, &kept.roles, None).passed);
     }
 }

@@ -38,10 +38,10 @@ use objective::{solve_clustered, Objective, MULTIGRID_AFTER, MULTIGRID_SOON};
 use operator::{RowClasses, TwoPass};
 use rows::{rows_of, Row, RowKind};
 
-/// Outer iterations at most. The tie-heavy 96³ volume (`bench --single 96x96x96q`) needs 407:
-/// at 200 it still had 86,747 rows violated, and the interior-point route it would hand over
-/// to does not fit (32.8 GiB predicted), so it ended in exit 3; with room to 700 it ends
-/// certified at Ĝ 2·10⁻⁸ of the data term in 690 CPU s and 1,433 MiB (2026-12-05).
+/// Outer iterations at most. The tie-heavy 96³ volume (`bench --single 96x96x96q`) needed 407
+/// (2026-12-05: at 200 it still had 86,747 rows violated, and the interior-point route it
+/// would hand over to does not fit, 32.8 GiB predicted) and 445 later, until its plateaus
+/// were made strict in the flood's order (2026-12-07): 106.
 const MAX_OUTER: u32 = 500;
 /// The iteration ends as stalled when the same working-set size, violated count and number
 /// of changes come back this many times within [`CYCLE_WINDOW`] outer iterations.

@@ -13,7 +13,7 @@ use crate::operators::{
 use crate::representative::{flooded_representative, separatrix_representative, series_representative, Repairs};
 use crate::topology::morse_smale::MorseSmale;
 use crate::topology::{KeptSet, Role};
-use crate::verify::certify;
+use crate::verify::{certify, Certificate};
 
 /// Which representative function to build on surfaces (series always use the linear one).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -95,6 +95,9 @@ pub struct Representative {
     pub fallbacks: Vec<String>,
     /// The simplified Morse–Smale complex (surfaces).
     pub complex: Option<MorseSmale>,
+    /// The certificate of `u` its construction made to accept it (`None` where it made none:
+    /// the caller certifies then; at 128³ a certificate takes about 0.25 s).
+    pub certificate: Option<Certificate>,
 }
 
 /// A domain the pipeline can smooth on: it supplies its operators and its representative.
@@ -197,6 +200,7 @@ impl Smoothable for Series {
             name: "linear".into(),
             fallbacks: Vec::new(),
             complex: None,
+            certificate: None,
         })
     }
 }
@@ -319,7 +323,7 @@ fn surface_representative<D: Domain>(
     // beside free vertices the fill holds below it). u is built from the values with their
     // ties broken as the complex broke them (SoS): a saddle and an extremum of equal input
     // value no longer give a flat separatrix.
-    let separatrix = |why: &mut Vec<String>| -> Option<Vec<f64>> {
+    let separatrix = |why: &mut Vec<String>| -> Option<(Vec<f64>, Certificate)> {
         let matched = complex_for(why)?;
         let merged = matched.with_one_sided();
         let untied = crate::domain::sos_untied(h);
@@ -341,7 +345,7 @@ fn surface_representative<D: Domain>(
                             one_sided_saddles.set(ms.saddles.len() - matched.saddles.len());
                             *merged_used.borrow_mut() = Some(ms.clone());
                         }
-                        return Some(u);
+                        return Some((u, c));
                     }
                     last_failure = Some(format!("separatrix representative: {}", c.summary()));
                 }
@@ -351,13 +355,13 @@ fn surface_representative<D: Domain>(
         why.extend(last_failure);
         None
     };
-    let harmonic = |why: &mut Vec<String>| -> Option<Vec<f64>> {
+    let harmonic = |why: &mut Vec<String>| -> Option<(Vec<f64>, Certificate)> {
         crate::progress::update("representative", || "harmonic fill".into());
         match harmonic_representative(h, kept, k) {
             Ok(u) => {
                 let c = certify(domain, &u, &kept.roles, None);
                 if c.passed {
-                    return Some(u);
+                    return Some((u, c));
                 }
                 why.push(format!("harmonic representative: {}", c.summary()));
             }
@@ -365,7 +369,7 @@ fn surface_representative<D: Domain>(
         }
         None
     };
-    let flooded = |why: &mut Vec<String>| -> Option<Vec<f64>> {
+    let flooded = |why: &mut Vec<String>| -> Option<(Vec<f64>, Certificate)> {
         crate::progress::update("representative", || "flooded".into());
         let u = flooded_representative(domain, h, kept);
         if u.is_none() {
@@ -400,17 +404,24 @@ fn surface_representative<D: Domain>(
         if skip(kind) {
             continue;
         }
-        if let Some(u) = build(kind, &mut why) {
-            found = Some((kind, u));
+        if let Some(made) = build(kind, &mut why) {
+            found = Some((kind, made));
             break;
         }
     }
     // the constructions' borrows of the complex end here: it moves into the result
-    if let Some((kind, u)) = found {
+    if let Some((kind, (u, certificate))) = found {
         // --complex writes the separatrices u was built from
         let complex = built.into_inner().flatten();
         let complex = if kind == Separatrix { merged_used.take().or(complex) } else { complex };
-        return Ok(Representative { u, kind, name: named(kind), fallbacks: why, complex });
+        return Ok(Representative {
+            u,
+            kind,
+            name: named(kind),
+            fallbacks: why,
+            complex,
+            certificate: Some(certificate),
+        });
     }
     let message = match choice {
         Some(_) => format!("{} (requested explicitly: not replaced by another construction)", why.join("; ")),

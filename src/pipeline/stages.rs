@@ -112,7 +112,10 @@ pub(super) fn order_representative<D: Smoothable>(
             seconds.complex = ms.seconds[0];
             seconds.simplify = ms.seconds[1];
         }
-        let certificate = certify(domain, &rep.u, &kept.roles, None);
+        let certificate = match rep.certificate {
+            Some(c) => c,
+            None => certify(domain, &rep.u, &kept.roles, None),
+        };
         if !certificate.passed {
             return Err(Error::Representative { path: None, message: certificate.summary() });
         }

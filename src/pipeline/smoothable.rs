@@ -98,6 +98,9 @@ pub struct Representative {
     /// The certificate of `u` its construction made to accept it (`None` where it made none:
     /// the caller certifies then; at 128³ a certificate takes about 0.25 s).
     pub certificate: Option<Certificate>,
+    /// The vertices in u's order ([`crate::domain::sos_sort`]) where the construction made
+    /// them in that order (the flooded one), else `None`.
+    pub order: Option<Vec<usize>>,
 }
 
 /// A domain the pipeline can smooth on: it supplies its operators and its representative.
@@ -201,6 +204,7 @@ impl Smoothable for Series {
             fallbacks: Vec::new(),
             complex: None,
             certificate: None,
+            order: None,
         })
     }
 }
@@ -323,7 +327,7 @@ fn surface_representative<D: Domain>(
     // beside free vertices the fill holds below it). u is built from the values with their
     // ties broken as the complex broke them (SoS): a saddle and an extremum of equal input
     // value no longer give a flat separatrix.
-    let separatrix = |why: &mut Vec<String>| -> Option<(Vec<f64>, Certificate)> {
+    let separatrix = |why: &mut Vec<String>| -> Option<(Vec<f64>, Certificate, Option<Vec<usize>>)> {
         let matched = complex_for(why)?;
         let merged = matched.with_one_sided();
         let untied = crate::domain::sos_untied(h);
@@ -345,7 +349,7 @@ fn surface_representative<D: Domain>(
                             one_sided_saddles.set(ms.saddles.len() - matched.saddles.len());
                             *merged_used.borrow_mut() = Some(ms.clone());
                         }
-                        return Some((u, c));
+                        return Some((u, c, None));
                     }
                     last_failure = Some(format!("separatrix representative: {}", c.summary()));
                 }
@@ -355,13 +359,13 @@ fn surface_representative<D: Domain>(
         why.extend(last_failure);
         None
     };
-    let harmonic = |why: &mut Vec<String>| -> Option<(Vec<f64>, Certificate)> {
+    let harmonic = |why: &mut Vec<String>| -> Option<(Vec<f64>, Certificate, Option<Vec<usize>>)> {
         crate::progress::update("representative", || "harmonic fill".into());
         match harmonic_representative(h, kept, k) {
             Ok(u) => {
                 let c = certify(domain, &u, &kept.roles, None);
                 if c.passed {
-                    return Some((u, c));
+                    return Some((u, c, None));
                 }
                 why.push(format!("harmonic representative: {}", c.summary()));
             }
@@ -369,7 +373,7 @@ fn surface_representative<D: Domain>(
         }
         None
     };
-    let flooded = |why: &mut Vec<String>| -> Option<(Vec<f64>, Certificate)> {
+    let flooded = |why: &mut Vec<String>| -> Option<(Vec<f64>, Certificate, Option<Vec<usize>>)> {
         crate::progress::update("representative", || "flooded".into());
         let u = flooded_representative(domain, h, kept);
         if u.is_none() {
@@ -410,7 +414,7 @@ fn surface_representative<D: Domain>(
         }
     }
     // the constructions' borrows of the complex end here: it moves into the result
-    if let Some((kind, (u, certificate))) = found {
+    if let Some((kind, (u, certificate, order))) = found {
         // --complex writes the separatrices u was built from
         let complex = built.into_inner().flatten();
         let complex = if kind == Separatrix { merged_used.take().or(complex) } else { complex };
@@ -421,6 +425,7 @@ fn surface_representative<D: Domain>(
             fallbacks: why,
             complex,
             certificate: Some(certificate),
+            order,
         });
     }
     let message = match choice {

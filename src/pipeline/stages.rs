@@ -8,7 +8,7 @@ use super::report::{
 };
 use super::settings::SmoothSettings;
 use super::smoothable::{energy_on_edges, RepresentativeKind, Smoothable};
-use crate::constraints::{activity, choose_margin, constraint_edges, margin_cap, max_margin_or_conflict};
+use crate::constraints::{activity, choose_margin, constraint_edges, margin_cap, max_margin_along};
 use crate::domain::{sos_sort, Domain};
 use crate::error::{Error, Result};
 use crate::linalg::Analyses;
@@ -89,6 +89,9 @@ pub(super) struct Ordered {
     /// The largest margin the order allows, and the one used (units of the range).
     eps_max: f64,
     pub(super) eps: f64,
+    /// The vertices in u's order where the representative handed them over (else the
+    /// output's repair sorts u again).
+    order: Option<Vec<usize>>,
 }
 
 /// Builds the representative and its constraints. A representative whose order makes the
@@ -123,7 +126,7 @@ pub(super) fn order_representative<D: Smoothable>(
         let t = Instant::now();
         let edges = constraint_edges(domain, &rep.u, &p.fixed, settings.edges);
         let bounds = free_end_bounds(domain, &rep.u, &kept.roles, (p.scale.lo, p.scale.hi));
-        let margins = margins(p, &rep.u, &edges, &bounds);
+        let margins = margins(p, &rep.u, rep.order.as_deref(), &edges, &bounds);
         seconds.constraints += t.elapsed().as_secs_f64();
         match margins {
             Ok((eps_max, eps)) => {
@@ -137,6 +140,7 @@ pub(super) fn order_representative<D: Smoothable>(
                     bounds,
                     eps_max,
                     eps,
+                    order: rep.order,
                 })
             }
             Err(e @ Error::Infeasible { .. })
@@ -163,7 +167,13 @@ pub(super) fn order_representative<D: Smoothable>(
 
 /// The largest margin the order of `u` allows on `edges` and the one used, or the path that
 /// makes the order infeasible.
-fn margins(p: &Problem, u: &[f64], edges: &[(usize, usize)], bounds: &[Bound]) -> Result<(f64, f64)> {
+fn margins(
+    p: &Problem,
+    u: &[f64],
+    order: Option<&[usize]>,
+    edges: &[(usize, usize)],
+    bounds: &[Bound],
+) -> Result<(f64, f64)> {
     let unit_bounds: Vec<(usize, f64, bool)> =
         bounds.iter().map(|b| (b.vertex, p.scale.unit(b.value), b.upper)).collect();
     let describe = |v: usize| {
@@ -175,7 +185,15 @@ fn margins(p: &Problem, u: &[f64], edges: &[(usize, usize)], bounds: &[Bound]) -
         };
         format!("{what} {v} (value {})", p.h[v])
     };
-    let eps_max = max_margin_or_conflict(u, edges, &p.fixed, &unit_bounds, Some(margin_cap(1.0, p.resolution)))
+    let sorted;
+    let order = match order {
+        Some(order) => order,
+        None => {
+            sorted = sos_sort(u);
+            &sorted
+        }
+    };
+    let eps_max = max_margin_along(order, edges, &p.fixed, &unit_bounds, Some(margin_cap(1.0, p.resolution)))
         .map_err(|(a, w)| {
             Error::infeasible(format!(
                 "its order runs a path upward from the {} to the {}, which is not higher: no strict function with the kept values follows it",
@@ -325,10 +343,17 @@ pub(super) fn output_of(x: &[f64], p: &Problem, o: &Ordered) -> (Vec<f64>, Margi
             *fi = p.h[i];
         }
     }
-    let order = sos_sort(&o.u);
+    let sorted;
+    let order = match &o.order {
+        Some(order) => order,
+        None => {
+            sorted = sos_sort(&o.u);
+            &sorted
+        }
+    };
     let range = p.scale.range;
-    let margin = meet_margin(&mut f, &is_fixed, &o.edges, &order, o.eps * range, &o.bounds);
-    let strictness = repair(&mut f, &is_fixed, &o.edges, &order, 0.25 * o.eps * range);
+    let margin = meet_margin(&mut f, &is_fixed, &o.edges, order, o.eps * range, &o.bounds);
+    let strictness = repair(&mut f, &is_fixed, &o.edges, order, 0.25 * o.eps * range);
     (f, margin, strictness)
 }
 

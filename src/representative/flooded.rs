@@ -14,31 +14,38 @@ use crate::verify::Certificate;
 /// (repeated a few times if the second flood undid the first). Kept values are unchanged; the
 /// plateaus get increments of one unit in the last place, keeping the flood order.
 ///
-/// Returns the representative with the certificate that ended the floods, or `None` if they
-/// do not settle (the caller's check reports it) or past 2³² vertices (a flood's entries hold
-/// a vertex and a count in 32 bits each; such a field's values alone take 32 GiB).
+/// Returns the representative with the certificate that ended the floods and its vertices in
+/// increasing order (the last flood's in reverse: its values fall in the order it visits them,
+/// but kept extrema of equal values may leave out of index order: `None` then), or `None` if the floods do not settle (the caller's
+/// check reports it) or past 2³² vertices (a flood's entries hold a vertex and a count in 32
+/// bits each; such a field's values alone take 32 GiB).
 pub fn flooded_representative<D: crate::domain::Domain>(
     domain: &D,
     h: &[f64],
     kept: &KeptSet,
-) -> Option<(Vec<f64>, Certificate)> {
+) -> Option<(Vec<f64>, Certificate, Option<Vec<usize>>)> {
     if u32::try_from(h.len()).is_err() {
         return None;
     }
     let mut g = h.to_vec();
+    let mut order = Vec::with_capacity(h.len());
     for _ in 0..8 {
-        flood(domain, &mut g, kept, Role::Min);
-        flood(domain, &mut g, kept, Role::Max);
+        flood(domain, &mut g, kept, Role::Min, &mut order);
+        flood(domain, &mut g, kept, Role::Max, &mut order);
         let certificate = crate::verify::certify(domain, &g, &kept.roles, None);
         if certificate.passed {
-            return Some((g, certificate));
+            order.reverse();
+            let increasing =
+                order.len() == g.len() && order.windows(2).all(|w| crate::domain::sos_less(&g, w[0], w[1]));
+            return Some((g, certificate, increasing.then_some(order)));
         }
     }
     None
 }
 
-/// Priority flood from the kept extrema of one type (see [`flooded_representative`]).
-fn flood<D: crate::domain::Domain>(domain: &D, g: &mut [f64], kept: &KeptSet, role: Role) {
+/// Priority flood from the kept extrema of one type (see [`flooded_representative`]); the
+/// vertices in the order it visits them in `visited`.
+fn flood<D: crate::domain::Domain>(domain: &D, g: &mut [f64], kept: &KeptSet, role: Role, visited: &mut Vec<usize>) {
     let up = role == Role::Min;
     // a total order on finite doubles: their bits made monotone (descending for maxima)
     let key = |x: f64| {
@@ -73,8 +80,10 @@ fn flood<D: crate::domain::Domain>(domain: &D, g: &mut [f64], kept: &KeptSet, ro
         }
     }
     let mut last: Option<f64> = None;
+    visited.clear();
     while let Some(e) = frontier.pop() {
         let v = e as u32 as usize;
+        visited.push(v);
         if kept.roles[v] != role {
             if let Some(l) = last {
                 g[v] = if up { g[v].max(l.next_up()) } else { g[v].min(l.next_down()) };
@@ -124,7 +133,7 @@ mod tests {
         let mut h = vec![1.0; n];
         (h[n - 1], h[0]) = (0.0, 2.0);
         let kept = select(&g, &h, &Selection::Explicit { minima: vec![n - 1], maxima: vec![0] }).unwrap();
-        let (u, _) = flooded_representative(&g, &h, &kept).unwrap();
+        let (u, _, order) = flooded_representative(&g, &h, &kept).unwrap();
         // graph distances from the minimum
         let mut dist = vec![usize::MAX; n];
         dist[n - 1] = 0;
@@ -153,5 +162,40 @@ mod tests {
             }
         }
         assert!(crate::verify::certify(&g, &u, &kept.roles, None).passed);
+        assert_eq!(order, Some(crate::domain::sos_sort(&u)));
+    }
+
+    /// The order handed over is u's own ([`crate::domain::sos_sort`]) on noisy fields, with
+    /// ties (then it may not be handed over) and without, whose floods raise basins and
+    /// plateaus.
+    #[test]
+    fn the_order_handed_over_is_the_representatives() {
+        let (nx, ny) = (23, 17);
+        let g = Grid2d::new(nx, ny).unwrap();
+        let mut state = 88172645463325252u64;
+        let mut handed = 0;
+        for (levels, step) in [(7u64, 8.0), (50, 8.0), (1 << 20, 0.0), (1 << 30, 0.0)] {
+            let h: Vec<f64> = (0..nx * ny)
+                .map(|v| {
+                    state ^= state << 13;
+                    state ^= state >> 7;
+                    state ^= state << 17;
+                    let (x, y) = ((v % nx) as f64 / nx as f64, (v / nx) as f64 / ny as f64);
+                    (6.0 * x).sin() * (5.0 * y).cos() + (state % levels) as f64 / levels as f64
+                })
+                .map(|x| if step > 0.0 { (x * step).round() / step } else { x })
+                .collect();
+            let kept = select(&g, &h, &Selection::Relative(0.2)).unwrap();
+            let (u, c, order) = flooded_representative(&g, &h, &kept).unwrap();
+            assert!(c.passed);
+            if let Some(order) = order {
+                assert_eq!(order, crate::domain::sos_sort(&u));
+                handed += 1;
+            } else {
+                // a kept maximum of a tie class lowered around it leaves after its neighbours
+                assert!(step > 0.0, "no order handed over without ties ({levels} levels)");
+            }
+        }
+        assert!(handed >= 2);
     }
 }

@@ -146,18 +146,42 @@ pub fn max_margin_bounded(
     })
 }
 
-/// The margin tests' pass: the edges out of each vertex, the vertices in u's order, the
-/// fixed values and bounds.
+/// The margin tests' pass: the vertices in u's order, the edges out of each vertex (those of
+/// `v` are `succ[start[v]..start[v + 1]]`), the fixed values and bounds.
 struct Sweep<'a> {
     order: &'a [usize],
-    start: &'a [usize],
-    succ: &'a [usize],
+    start: Vec<usize>,
+    succ: Vec<usize>,
     fixed: &'a [Option<f64>],
     lower: &'a [f64],
     upper: &'a [f64],
 }
 
-impl Sweep<'_> {
+impl<'a> Sweep<'a> {
+    fn new(
+        order: &'a [usize],
+        edges: &[(usize, usize)],
+        fixed: &'a [Option<f64>],
+        lower: &'a [f64],
+        upper: &'a [f64],
+    ) -> Sweep<'a> {
+        let n = order.len();
+        let mut start = vec![0usize; n + 1];
+        for &(a, _) in edges {
+            start[a + 1] += 1;
+        }
+        for i in 0..n {
+            start[i + 1] += start[i];
+        }
+        let mut fill = start.clone();
+        let mut succ = vec![0usize; edges.len()];
+        for &(a, b) in edges {
+            succ[fill[a]] = b;
+            fill[a] += 1;
+        }
+        Sweep { order, start, succ, fixed, lower, upper }
+    }
+
     /// For each margin ε of `eps`, in one pass over the vertices in u's order: `Some((a, w))`,
     /// the first fixed (or upper-bounded) vertex `w` whose value the lowest values rising by ε
     /// along the edges from a fixed (or lower-bounded) vertex `a` exceed, or `None` when ε is
@@ -247,21 +271,7 @@ pub fn max_margin_along(
             }
         }
     }
-    // out-edges in compressed form
-    let mut start = vec![0usize; n + 1];
-    for &(a, _) in edges {
-        start[a + 1] += 1;
-    }
-    for i in 0..n {
-        start[i + 1] += start[i];
-    }
-    let mut fill = start.clone();
-    let mut succ = vec![0usize; edges.len()];
-    for &(a, b) in edges {
-        succ[fill[a]] = b;
-        fill[a] += 1;
-    }
-    let sweep = Sweep { order, start: &start, succ: &succ, fixed, lower: &lower, upper: &upper };
+    let sweep = Sweep::new(order, edges, fixed, &lower, &upper);
     let (fmin, fmax) = crate::domain::value_range(fixed.iter().flatten().chain(bounds.iter().map(|b| &b.1)));
     let span = if fmax > fmin { fmax - fmin } else { 1.0 };
     // the usual case: the cap of `choose_margin` is feasible twice over; one pass decides it
@@ -435,21 +445,7 @@ mod tests {
             let (lower, mut upper) = (vec![f64::NEG_INFINITY; n], vec![f64::INFINITY; n]);
             upper[(next() % n as u64) as usize] = 500.0;
             let order = sos_sort(&u);
-            let mut start = vec![0usize; n + 1];
-            for &(a, _) in &edges {
-                start[a + 1] += 1;
-            }
-            for i in 0..n {
-                start[i + 1] += start[i];
-            }
-            let mut fill = start.clone();
-            let mut succ = vec![0usize; edges.len()];
-            for &(a, b) in &edges {
-                succ[fill[a]] = b;
-                fill[a] += 1;
-            }
-            let sweep =
-                Sweep { order: &order, start: &start, succ: &succ, fixed: &fixed, lower: &lower, upper: &upper };
+            let sweep = Sweep::new(&order, &edges, &fixed, &lower, &upper);
             for pair in [[0.0, 0.5], [0.5, 3.0], [3.0, 40.0], [40.0, 0.0]] {
                 let together = sweep.run(pair);
                 let alone = [sweep.run([pair[0]])[0], sweep.run([pair[1]])[0]];

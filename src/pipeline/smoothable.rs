@@ -377,7 +377,11 @@ fn surface_representative<D: Domain>(
         crate::progress::update("representative", || "flooded".into());
         let u = flooded_representative(domain, h, kept);
         if u.is_none() {
-            why.push("flooded representative: the floods did not settle".into());
+            why.push(if u32::try_from(h.len()).is_err() {
+                "flooded representative: more than 2³² vertices".into()
+            } else {
+                "flooded representative: the floods did not settle".into()
+            });
         }
         u
     };

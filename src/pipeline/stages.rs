@@ -165,6 +165,11 @@ pub(super) fn order_representative<D: Smoothable>(
     }
 }
 
+/// The vertices in u's order: `given` where the representative handed it over, else sorted.
+fn sos_order<'a>(u: &[f64], given: Option<&'a [usize]>) -> std::borrow::Cow<'a, [usize]> {
+    given.map_or_else(|| std::borrow::Cow::Owned(sos_sort(u)), std::borrow::Cow::Borrowed)
+}
+
 /// The largest margin the order of `u` allows on `edges` and the one used, or the path that
 /// makes the order infeasible.
 fn margins(
@@ -185,15 +190,7 @@ fn margins(
         };
         format!("{what} {v} (value {})", p.h[v])
     };
-    let sorted;
-    let order = match order {
-        Some(order) => order,
-        None => {
-            sorted = sos_sort(u);
-            &sorted
-        }
-    };
-    let eps_max = max_margin_along(order, edges, &p.fixed, &unit_bounds, Some(margin_cap(1.0, p.resolution)))
+    let eps_max = max_margin_along(&sos_order(u, order), edges, &p.fixed, &unit_bounds, Some(margin_cap(1.0, p.resolution)))
         .map_err(|(a, w)| {
             Error::infeasible(format!(
                 "its order runs a path upward from the {} to the {}, which is not higher: no strict function with the kept values follows it",
@@ -343,17 +340,10 @@ pub(super) fn output_of(x: &[f64], p: &Problem, o: &Ordered) -> (Vec<f64>, Margi
             *fi = p.h[i];
         }
     }
-    let sorted;
-    let order = match &o.order {
-        Some(order) => order,
-        None => {
-            sorted = sos_sort(&o.u);
-            &sorted
-        }
-    };
+    let order = sos_order(&o.u, o.order.as_deref());
     let range = p.scale.range;
-    let margin = meet_margin(&mut f, &is_fixed, &o.edges, order, o.eps * range, &o.bounds);
-    let strictness = repair(&mut f, &is_fixed, &o.edges, order, 0.25 * o.eps * range);
+    let margin = meet_margin(&mut f, &is_fixed, &o.edges, &order, o.eps * range, &o.bounds);
+    let strictness = repair(&mut f, &is_fixed, &o.edges, &order, 0.25 * o.eps * range);
     (f, margin, strictness)
 }
 

@@ -15,10 +15,11 @@ use crate::verify::Certificate;
 /// plateaus get increments of one unit in the last place, keeping the flood order.
 ///
 /// Returns the representative with the certificate that ended the floods and its vertices in
-/// increasing order (the last flood's in reverse: its values fall in the order it visits them,
-/// but kept extrema of equal values may leave out of index order: `None` then), or `None` if the floods do not settle (the caller's
-/// check reports it) or past 2³² vertices (a flood's entries hold a vertex and a count in 32
-/// bits each; such a field's values alone take 32 GiB).
+/// increasing order (the last flood's visits reversed; `None` where they are not u's order:
+/// with ties a kept maximum may leave after neighbours the flood lowered below it), or `None`
+/// if the floods do not settle (the caller's check reports it) or past 2³² vertices (a flood's
+/// entries hold a vertex and a count in 32 bits each; such a field's values alone take
+/// 32 GiB).
 pub fn flooded_representative<D: crate::domain::Domain>(
     domain: &D,
     h: &[f64],
@@ -30,8 +31,8 @@ pub fn flooded_representative<D: crate::domain::Domain>(
     let mut g = h.to_vec();
     let mut order = Vec::with_capacity(h.len());
     for _ in 0..8 {
-        flood(domain, &mut g, kept, Role::Min, &mut order);
-        flood(domain, &mut g, kept, Role::Max, &mut order);
+        flood(domain, &mut g, kept, Role::Min, None);
+        flood(domain, &mut g, kept, Role::Max, Some(&mut order));
         let certificate = crate::verify::certify(domain, &g, &kept.roles, None);
         if certificate.passed {
             order.reverse();
@@ -44,8 +45,14 @@ pub fn flooded_representative<D: crate::domain::Domain>(
 }
 
 /// Priority flood from the kept extrema of one type (see [`flooded_representative`]); the
-/// vertices in the order it visits them in `visited`.
-fn flood<D: crate::domain::Domain>(domain: &D, g: &mut [f64], kept: &KeptSet, role: Role, visited: &mut Vec<usize>) {
+/// vertices in the order it visits them in `visited`, when given.
+fn flood<D: crate::domain::Domain>(
+    domain: &D,
+    g: &mut [f64],
+    kept: &KeptSet,
+    role: Role,
+    mut visited: Option<&mut Vec<usize>>,
+) {
     let up = role == Role::Min;
     // a total order on finite doubles: their bits made monotone (descending for maxima)
     let key = |x: f64| {
@@ -80,10 +87,14 @@ fn flood<D: crate::domain::Domain>(domain: &D, g: &mut [f64], kept: &KeptSet, ro
         }
     }
     let mut last: Option<f64> = None;
-    visited.clear();
+    if let Some(visited) = visited.as_deref_mut() {
+        visited.clear();
+    }
     while let Some(e) = frontier.pop() {
         let v = e as u32 as usize;
-        visited.push(v);
+        if let Some(visited) = visited.as_deref_mut() {
+            visited.push(v);
+        }
         if kept.roles[v] != role {
             if let Some(l) = last {
                 g[v] = if up { g[v].max(l.next_up()) } else { g[v].min(l.next_down()) };
@@ -102,7 +113,8 @@ fn flood<D: crate::domain::Domain>(domain: &D, g: &mut [f64], kept: &KeptSet, ro
 /// The flood's queue: its entries leave smallest first. A heap of four children a node (with
 /// 16-byte entries a node's children share a cache line, and it has half the levels of a
 /// binary heap). At 128³ the two floods took 1.76–2.0 s with a binary heap of (key, count,
-/// vertex) tuples and 1.20–1.52 s with this one, the same order (docs/performance.md §3).
+/// vertex) tuples and 1.20–1.52 s with this one, the same order (docs/performance.md,
+/// "Topology against TTK").
 #[derive(Default)]
 struct Frontier(dary_heap::QuaternaryHeap<std::cmp::Reverse<u128>>);
 

@@ -127,6 +127,25 @@ impl<'a> BilaplacianColumns<'a> {
         }
     }
 
+    /// `visit(i)` for every row `i` of column `j`'s pattern (the rows [`Self::column`] makes,
+    /// some more than once), its values not made.
+    pub fn pattern_rows(&self, j: usize, mut visit: impl FnMut(usize)) {
+        let (cp, ri, v) = (self.k.symbolic().col_ptr(), self.k.symbolic().row_idx(), self.k.val());
+        for p in cp[j]..cp[j + 1] {
+            let kk = ri[p];
+            if v[p] == 0.0 && kk != j {
+                continue;
+            }
+            for q in cp[kk]..cp[kk + 1] {
+                let i = ri[q];
+                if v[q] == 0.0 && i != kk {
+                    continue;
+                }
+                visit(i);
+            }
+        }
+    }
+
     /// The entry at row `i` of column `j` (`None` outside the pattern): the same sum as
     /// [`Self::column`]'s, term by term.
     #[must_use]
@@ -328,6 +347,11 @@ mod tests {
             for j in 0..n {
                 gen.column(j, &mut col);
                 assert_eq!(col.rows, &ri[cp[j]..cp[j + 1]], "column {j}'s rows");
+                let mut pattern = Vec::new();
+                gen.pattern_rows(j, |i| pattern.push(i));
+                pattern.sort_unstable();
+                pattern.dedup();
+                assert_eq!(pattern, col.rows, "column {j}'s pattern");
                 let bits = |x: &[f64]| x.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
                 assert_eq!(bits(&col.vals), bits(&v[cp[j]..cp[j + 1]]), "column {j}'s values");
                 for (&i, &value) in col.rows.iter().zip(&col.vals) {

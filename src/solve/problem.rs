@@ -123,6 +123,38 @@ impl Quadratic<'_> {
         }
     }
 
+    /// The largest `|slot[i] − slot[j]|` over the entries `(i, j)` of the pattern with both
+    /// slots in use (not `usize::MAX`), if it is at most `limit` (`None` past it: the search
+    /// stops at the first such entry). Made columns are not made: their patterns come from K.
+    #[must_use]
+    pub fn slot_width_at_most(&self, slot: &[usize], limit: usize) -> Option<usize> {
+        let mut width = 0usize;
+        for (j, &sj) in slot.iter().enumerate() {
+            if sj == usize::MAX {
+                continue;
+            }
+            let mut wide = false;
+            let mut widen = |i: usize| {
+                if slot[i] != usize::MAX {
+                    let d = slot[i].abs_diff(sj);
+                    wide |= d > limit;
+                    width = width.max(d);
+                }
+            };
+            match self {
+                Quadratic::Stored(p) => {
+                    let (cp, ri) = (p.symbolic().col_ptr(), p.symbolic().row_idx());
+                    ri[cp[j]..cp[j + 1]].iter().for_each(|&i| widen(i));
+                }
+                Quadratic::Columns(c) => c.pattern_rows(j, widen),
+            }
+            if wide {
+                return None;
+            }
+        }
+        Some(width)
+    }
+
     /// The entry at row `i` of column `j` (`None` outside the pattern).
     #[must_use]
     pub fn entry(&self, i: usize, j: usize) -> Option<f64> {
@@ -479,34 +511,7 @@ pub(super) fn reduce_with(qp: &MonotoneQp<'_>, free: &[usize], triplets: bool) -
     let mut work = qp.p.workspace();
     // a band when every free entry lies near the diagonal (a series), else triplets
     let made = matches!(qp.p, Quadratic::Columns(_));
-    let width = if triplets {
-        let mut width = Some(0usize);
-        // whether the entries so far lie in a band
-        let mut widen = |j: usize, rows: &[usize]| {
-            if slot[j] != usize::MAX {
-                for &i in rows.iter().filter(|&&i| slot[i] != usize::MAX) {
-                    let d = slot[i].abs_diff(slot[j]);
-                    width = width.and_then(|a| (d <= crate::linalg::BANDED_MAX).then_some(a.max(d)));
-                }
-            }
-            width.is_some()
-        };
-        if made {
-            // made columns in blocks on every core (a stored matrix stops at the first wide entry)
-            qp.p.for_each_column(|j, rows, _| {
-                widen(j, rows);
-            });
-        } else {
-            for j in 0..n {
-                if !widen(j, qp.p.column(j, &mut work).0) {
-                    break;
-                }
-            }
-        }
-        width
-    } else {
-        None
-    };
+    let width = if triplets { qp.p.slot_width_at_most(&slot, crate::linalg::BANDED_MAX) } else { None };
     // the upper triangle of a symmetric pattern: half the off-diagonal entries and the diagonal
     let capacity = qp.p.stored().map_or(0, |p| p.val().len() / 2 + n);
     let mut p = Vec::with_capacity(if triplets && width.is_none() { capacity } else { 0 });

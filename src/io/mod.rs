@@ -80,7 +80,24 @@ pub fn stage_json<T: serde::Serialize>(path: &Path, value: &T) -> Result<Staged>
 
 /// Shortest text that reads back to the same double (Rust's `Debug` for f64).
 pub fn format_f64(v: f64) -> String {
-    format!("{v:?}")
+    let mut text = String::new();
+    push_f64(&mut text, v);
+    text
+}
+
+/// Appends [`format_f64`]'s text of `v` to `text`. Between 10⁻⁴ and 10¹⁶ in size (and at 0),
+/// where its layout is `Debug`'s (digits, a point, at least one decimal), by `zmij`, about
+/// three times faster (the 3·10⁷ values of a 10⁷-sample series' output took 5 CPU s); the
+/// digits are the shortest that read back to the same bits either way, and where two such
+/// texts are equally close (a value with few bits below its point, such as 2⁴⁶ + 0.625)
+/// the two may end in a different last digit. Elsewhere `Debug` itself (`1e-5`, `1e16`).
+pub fn push_f64(text: &mut String, v: f64) {
+    if v == 0.0 || (1e-4..1e16).contains(&v.abs()) {
+        text.push_str(zmij::Buffer::new().format_finite(v));
+    } else {
+        use std::fmt::Write as _;
+        let _ = write!(text, "{v:?}");
+    }
 }
 
 #[cfg(test)]
@@ -93,5 +110,36 @@ mod tests {
             let s = format_f64(v);
             assert_eq!(s.parse::<f64>().unwrap().to_bits(), v.to_bits(), "{s}");
         }
+    }
+
+    /// `Debug`'s text on either side of the range handed to `zmij` and inside it, and the
+    /// same bits read back from random doubles of every size; where the digits differ from
+    /// `Debug`'s it is only in the last one, between two equally close texts.
+    #[test]
+    fn the_fast_text_is_debug_s_and_reads_back() {
+        let fixed = [0.0, -0.0, 1.0, -2.5, 0.1, 1e-4, 9.99e-5, 1.5e-5, 1e15, 9.999e15, 1e16, 1e300, 5e-324];
+        for v in fixed.into_iter().chain([f64::NAN, f64::INFINITY, f64::NEG_INFINITY]) {
+            assert_eq!(format_f64(v), format!("{v:?}"), "{v:?}");
+        }
+        let mut x = 0x9E37_79B9_7F4A_7C15u64;
+        let mut ties = 0;
+        for _ in 0..200_000 {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            for v in [f64::from_bits(x), ((x >> 11) as f64 / (1u64 << 53) as f64 - 0.5) * 1e3] {
+                if !v.is_finite() {
+                    continue;
+                }
+                let (fast, debug) = (format_f64(v), format!("{v:?}"));
+                assert_eq!(fast.parse::<f64>().unwrap().to_bits(), v.to_bits(), "{fast}");
+                if fast != debug {
+                    ties += 1;
+                    assert_eq!(fast.len(), debug.len(), "{fast} {debug}");
+                    assert_eq!(fast[..fast.len() - 1], debug[..debug.len() - 1], "{fast} {debug}");
+                }
+            }
+        }
+        assert!(ties < 100, "{ties} texts differ from Debug's");
     }
 }

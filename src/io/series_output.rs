@@ -231,7 +231,12 @@ fn format_rows(out: &SeriesColumns<'_>, filled: Option<&[bool]>, range: std::ops
                 let _ = write!(text, "{i}");
             }
         }
-        let _ = write!(text, ",{:?},{:?},{:?},{}", out.input[i], out.output[i], out.u[i], out.roles[i].label());
+        for v in [out.input[i], out.output[i], out.u[i]] {
+            text.push(',');
+            super::push_f64(text, v);
+        }
+        text.push(',');
+        text.push_str(out.roles[i].label());
         if let Some(f) = filled {
             text.push_str(if f[i] { ",1" } else { ",0" });
         }

@@ -7,7 +7,8 @@ use crate::topology::Role;
 use std::path::Path;
 
 /// The x column's text per sample, written back out: the sample index when the series has no
-/// x column (made when asked: at 10⁷ samples a string each held 0.5 GB), else the file's text.
+/// x column or one of the indices themselves (made when asked: at 10⁷ samples a string each
+/// held 0.5 GB), else the file's text.
 #[derive(Clone, Debug, PartialEq)]
 pub enum XText {
     /// `0, 1, …, n − 1`.

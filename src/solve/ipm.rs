@@ -224,7 +224,7 @@ const POLISH_SWEEPS: usize = 2;
 pub(super) fn solve(
     r: &ReducedQp,
     assembly: Option<Assembly>,
-    hint: Option<&[f64]>,
+    hint: Option<Vec<f64>>,
     settings: &QpSettings,
     analyses: &mut ordering::Analyses,
     prepared: Option<Prepared>,
@@ -532,7 +532,7 @@ fn run<T: Real, O: Objective<T>>(
     r: &ReducedQp,
     rows: &Rows,
     objective: &mut O,
-    hint: Option<&[f64]>,
+    hint: Option<Vec<f64>>,
     settings: &QpSettings,
 ) -> std::result::Result<Outcome, crate::error::NumericalError> {
     let (n, m) = (r.n, r.m());
@@ -540,7 +540,7 @@ fn run<T: Real, O: Objective<T>>(
     let of = T::of;
     let b = T::lift(&r.b);
     let x: Vec<T> = match hint {
-        Some(h) => h.iter().map(|&v| of(v)).collect(),
+        Some(h) => T::lift_vec(h),
         None => vec![zero; n],
     };
     let finish = |x: &[T], z: &[T], status: SolveStatus, iterations: u32, objective: &O| Outcome {

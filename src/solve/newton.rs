@@ -168,12 +168,17 @@ pub(super) trait Real:
     fn div_by(self, den: Self, inv: Self) -> Self;
     /// `v` in this arithmetic: borrowed in double (a copy of a vector of 10⁷ rows is 80 MB).
     fn lift(v: &[f64]) -> std::borrow::Cow<'_, [Self]>;
+    /// `v` in this arithmetic, owned: `v` itself in double.
+    fn lift_vec(v: Vec<f64>) -> Vec<Self>;
 }
 
 impl Real for f64 {
     const RECIPROCALS: bool = false;
     fn lift(v: &[f64]) -> std::borrow::Cow<'_, [Self]> {
         std::borrow::Cow::Borrowed(v)
+    }
+    fn lift_vec(v: Vec<f64>) -> Vec<Self> {
+        v
     }
     fn of(x: f64) -> Self {
         x
@@ -190,6 +195,9 @@ impl Real for Dd {
     const RECIPROCALS: bool = true;
     fn lift(v: &[f64]) -> std::borrow::Cow<'_, [Self]> {
         std::borrow::Cow::Owned(v.iter().map(|&x| Dd::from(x)).collect())
+    }
+    fn lift_vec(v: Vec<f64>) -> Vec<Self> {
+        v.into_iter().map(Dd::from).collect()
     }
     #[inline(always)]
     fn of(x: f64) -> Self {

@@ -43,10 +43,10 @@ pub fn solve_monotone_qp_with(
             free.len()
         )));
     }
-    let mut x: Vec<f64> = qp.fixed.iter().map(|f| f.unwrap_or(0.0)).collect();
+    let fixed_values = || -> Vec<f64> { qp.fixed.iter().map(|f| f.unwrap_or(0.0)).collect() };
     if free.is_empty() {
         return Ok(QpSolution {
-            x,
+            x: fixed_values(),
             z: vec![0.0; constraint_rows(qp).len()],
             y: None,
             status: SolveStatus::Trivial,
@@ -97,7 +97,9 @@ pub fn solve_monotone_qp_with(
     };
     // the storage made in advance is for the assembled normal matrix only
     let mut prepared = prepared.filter(|_| formulation == Formulation::Assembled);
-    let hint: Option<Vec<f64>> = qp.hint.map(|h| free.iter().map(|&i| h[i]).collect());
+    // the start on the free entries, made for each route that takes it (the interior point
+    // keeps it as its iterate: at 10⁷ samples a copy held through the solve was 80 MB)
+    let hint = || -> Option<Vec<f64>> { qp.hint.map(|h| free.iter().map(|&i| h[i]).collect()) };
     let mut fallback = None;
     // Clarabel on the reduced QP; on the paper's auxiliary form it can certify infeasibility
     // of rows that are feasible by construction (the margin was checked on u's order): a
@@ -143,7 +145,7 @@ pub fn solve_monotone_qp_with(
                 Ok(operands) => {
                     let beside = fits(super::active_set::iteration_bytes(reduced.n, reduced.m()))?;
                     predicted_peak = Some(before.max(beside));
-                    super::active_set::solve(&reduced, operands, hint.as_deref(), settings)
+                    super::active_set::solve(&reduced, operands, hint().as_deref(), settings)
                 }
                 Err(why) => Err(why),
             };
@@ -200,7 +202,7 @@ pub fn solve_monotone_qp_with(
             if let Some(why) = &fallback {
                 super::policy::announce_hand_over(why, Method::Structured);
             }
-            match super::ipm::solve(&reduced, assembly, hint.as_deref(), settings, analyses, prepared.take()) {
+            match super::ipm::solve(&reduced, assembly, hint(), settings, analyses, prepared.take()) {
                 Ok(out) => (out, Method::Structured),
                 // the assembled normal matrix lost its definiteness (an energy without a data
                 // term, ill-conditioned on its own): the factored form in double-double next
@@ -212,7 +214,7 @@ pub fn solve_monotone_qp_with(
                 {
                     to_factored(&mut reduced, qp.factor.expect("checked"));
                     formulation = Formulation::Factored;
-                    match super::ipm::solve(&reduced, None, hint.as_deref(), settings, analyses, None) {
+                    match super::ipm::solve(&reduced, None, hint(), settings, analyses, None) {
                         Ok(out) => (out, Method::Structured),
                         Err(why) => {
                             crate::progress::checkpoint()?;
@@ -234,6 +236,8 @@ pub fn solve_monotone_qp_with(
             (clarabel(&mut reduced, &mut formulation)?, settings.method)
         }
     };
+    // made after the solve: the solver's storage is gone by then
+    let mut x = fixed_values();
     for (k, &i) in free.iter().enumerate() {
         x[i] = out.x[k];
     }

@@ -50,21 +50,13 @@ fn out_of_memory(size: usize) -> ! {
     const HEAD: &[u8] = b"error: not enough memory: an allocation of ";
     const TAIL: &[u8] = b" bytes failed (the memory budget's prediction did not foresee it: give a larger \
 --memory-limit or ulimit -v, or a smaller input); no output was written\n";
-    let mut digits = [0u8; 20];
-    let (mut k, mut v) = (digits.len(), size);
-    loop {
-        k -= 1;
-        digits[k] = b'0' + (v % 10) as u8;
-        v /= 10;
-        if v == 0 {
-            break;
-        }
-    }
+    let mut buf = [0u8; 20];
+    let digits = crate::io::decimal(size, &mut buf);
     #[cfg(unix)]
     // SAFETY: writes of static and stack buffers to standard error, then the process ends
     unsafe {
         libc::write(2, HEAD.as_ptr().cast(), HEAD.len());
-        libc::write(2, digits[k..].as_ptr().cast(), digits.len() - k);
+        libc::write(2, digits.as_ptr().cast(), digits.len());
         libc::write(2, TAIL.as_ptr().cast(), TAIL.len());
         crate::io::staging::remove_temporaries_unallocated();
         libc::_exit(crate::error::ErrorKind::Memory.exit_code());

@@ -78,6 +78,21 @@ pub fn stage_json<T: serde::Serialize>(path: &Path, value: &T) -> Result<Staged>
     })
 }
 
+/// The decimal digits of `v`, written into `buf` (nothing allocated: the allocator's failure
+/// path uses it).
+pub fn decimal(v: usize, buf: &mut [u8; 20]) -> &[u8] {
+    let (mut k, mut v) = (buf.len(), v);
+    loop {
+        k -= 1;
+        buf[k] = b'0' + (v % 10) as u8;
+        v /= 10;
+        if v == 0 {
+            break;
+        }
+    }
+    &buf[k..]
+}
+
 /// Shortest text that reads back to the same double (Rust's `Debug` for f64).
 pub fn format_f64(v: f64) -> String {
     let mut text = String::new();
@@ -103,6 +118,13 @@ pub fn push_f64(text: &mut String, v: f64) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn decimal_digits() {
+        for v in [0usize, 7, 10, 1234, usize::MAX] {
+            assert_eq!(decimal(v, &mut [0u8; 20]), v.to_string().as_bytes());
+        }
+    }
 
     #[test]
     fn shortest_round_trip() {

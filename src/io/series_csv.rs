@@ -403,17 +403,7 @@ impl Cells<'_> {
 
 /// Whether `cell` is the decimal text of `i` (no sign, no leading zero, no point).
 fn is_index(cell: &str, i: usize) -> bool {
-    let mut digits = [0u8; 20];
-    let (mut k, mut v) = (digits.len(), i);
-    loop {
-        k -= 1;
-        digits[k] = b'0' + (v % 10) as u8;
-        v /= 10;
-        if v == 0 {
-            break;
-        }
-    }
-    cell.as_bytes() == &digits[k..]
+    cell.as_bytes() == super::decimal(i, &mut [0u8; 20])
 }
 
 #[cfg(test)]

@@ -427,6 +427,11 @@ mod tests {
         );
         assert_eq!(sa.to_bits(), sb.to_bits());
         assert_eq!(sa.to_bits(), crate::operators::quadratic_form_without_diagonal(&stored, &data, &f).to_bits());
+        // the gap's pass makes the same form
+        assert_eq!(
+            (a.smoothness.map(f64::to_bits), b.smoothness.map(f64::to_bits)),
+            (Some(sa.to_bits()), Some(sa.to_bits()))
+        );
         let (ca, cb) = (
             condition_estimate(Quadratic::Stored(&stored), &data, &fixed).unwrap(),
             condition_estimate(Quadratic::Columns(&made), &data, &fixed).unwrap(),

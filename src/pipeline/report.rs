@@ -232,14 +232,14 @@ pub(super) struct FitInputs<'a> {
 
 /// The gap bound of the certified output `f` in the field's units: the solver's multipliers
 /// (and auxiliary variables) mapped from values scaled to [0, 1] (by `range`, margin `eps`
-/// scaled, data weight `gd`, mass `m`).
+/// scaled, data weight `gd`, mass `m`); with `fᵀ(P − diag(data))f` where its pass made it.
 pub(super) fn fit_report(
     qp: &FitInputs<'_>,
     f: &[f64],
     sol: &crate::solve::QpSolution,
     factor: Option<&Factor>,
     (range, eps, gd, m): (f64, f64, f64, &[f64]),
-) -> FitReport {
+) -> (FitReport, Option<f64>) {
     let n = f.len();
     let q: Vec<f64> = (0..n).map(|i| -qp.data_diag[i] * qp.h[i]).collect();
     let fixed: Vec<Option<f64>> = (0..n).map(|i| qp.fixed[i].then_some(qp.h[i])).collect();
@@ -278,7 +278,7 @@ pub(super) fn fit_report(
     } else {
         None
     };
-    FitReport {
+    let report = FitReport {
         gap: bounded.then_some(2.0 * o.gap),
         gap_over_data: (bounded && o.data > 0.0).then(|| o.gap / o.data),
         gap_over_energy: (bounded && o.by_solve && o.energy > 0.0).then(|| o.gap / o.energy),
@@ -291,5 +291,6 @@ pub(super) fn fit_report(
         condition: sol.condition,
         formulation: sol.formulation,
         why_no_bound,
-    }
+    };
+    (report, o.smoothness)
 }

@@ -378,7 +378,7 @@ impl Run<'_> {
         let range = p.scale.range;
         let gd = settings.data_weight;
         let is_fixed: Vec<bool> = kept.roles.iter().map(|r| r.is_fixed()).collect();
-        let fit = fit_report(
+        let (fit, smoothness) = fit_report(
             &FitInputs {
                 p: ops.p.quadratic(),
                 data_diag: &ops.data_diag,
@@ -415,7 +415,9 @@ impl Run<'_> {
                 self.sol.status, self.sol.iterations, settings.qp.gap_tolerance
             ));
         }
-        let smoothness = ops.p.quadratic().quadratic_form_without_diagonal(&ops.data_diag, f);
+        // from the gap's pass over P's columns where it read them
+        let smoothness =
+            smoothness.unwrap_or_else(|| ops.p.quadratic().quadratic_form_without_diagonal(&ops.data_diag, f));
         let data: f64 = gd * (0..n).map(|i| m[i] * (f[i] - h[i]).powi(2)).sum::<f64>();
         let sq: f64 = (0..n).map(|i| (f[i] - h[i]).powi(2)).sum();
         let max_deviation = (0..n).map(|i| (f[i] - h[i]).abs()).fold(0.0, f64::max);

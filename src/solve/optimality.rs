@@ -39,6 +39,10 @@ pub struct Optimality {
     /// `‖f − f*‖_D ≤ √(2 Ĝ)` (`‖f − f*‖_P` when `by_solve`), when f is feasible (`None` when
     /// some slack is negative).
     pub distance: Option<f64>,
+    /// `fᵀ(P − diag(data))f` as [`super::Quadratic::quadratic_form_without_diagonal`] sums it
+    /// (the same bits), made in the gradient's pass over P's columns where the gradient reads
+    /// them (not in the factored form), with a data term.
+    pub smoothness: Option<f64>,
 }
 
 fn dd(x: f64) -> Dd {
@@ -82,7 +86,7 @@ pub fn optimality_with(
     let m = constraint_rows_iter(qp).count();
     assert_eq!(z.len(), m);
     let free: Vec<bool> = qp.fixed.iter().map(Option::is_none).collect();
-    let (mut rho, auxiliary_residual, half) = gradient(qp, f, y);
+    let (mut rho, auxiliary_residual, forms) = gradient(qp, f, y);
     let (complementarity, min_slack) = rows_into(qp, constraint_rows_iter(qp), f, z, &mut rho);
     let mut stationarity = dd(0.0);
     let mut data = dd(0.0);
@@ -110,7 +114,7 @@ pub fn optimality_with(
         stationarity = solve_with_p(qp, &free, &rho, analyses).unwrap_or(f64::INFINITY);
     }
     let gap = complementarity + 0.5 * stationarity + 0.5 * auxiliary_residual * auxiliary_residual;
-    let energy = half.unwrap_or_else(|| half_energy(qp.p, f));
+    let energy = forms.map_or_else(|| half_energy(qp.p, f), |(half, _)| half);
     let min_slack = if m == 0 { 0.0 } else { min_slack };
     Optimality {
         gap,
@@ -122,14 +126,17 @@ pub fn optimality_with(
         dual_residual: stationarity.sqrt(),
         auxiliary_residual,
         distance: (gap.is_finite() && min_slack >= 0.0).then(|| (2.0 * gap.max(0.0)).sqrt()),
+        smoothness: forms.and_then(|(_, smoothness)| smoothness),
     }
 }
 
 /// The objective's gradient at `f` in double-double, `ρ = P f + q` (or, factored, `D f + q +
 /// Fᵀ y` with the auxiliary residual `|F f − y|`), over all entries (only the free ones count);
-/// with `P f`, in the same pass over P's columns, [`half_energy`] (each column's sum as it
-/// makes it: a pass of P's made columns at 10⁷ samples is a second).
-fn gradient(qp: &MonotoneQp<'_>, f: &[f64], y: Option<&[f64]>) -> (Vec<Dd>, f64, Option<f64>) {
+/// with `P f`, in the same pass over P's columns, [`half_energy`] and (with a data term)
+/// [`Optimality::smoothness`], each summed as its own pass would (a pass of P's made columns
+/// at 10⁷ samples is a second).
+#[allow(clippy::type_complexity)]
+fn gradient(qp: &MonotoneQp<'_>, f: &[f64], y: Option<&[f64]>) -> (Vec<Dd>, f64, Option<(f64, Option<f64>)>) {
     let n = qp.q.len();
     let mut rho = vec![dd(0.0); n];
     let mut auxiliary_residual = 0.0;
@@ -161,14 +168,19 @@ fn gradient(qp: &MonotoneQp<'_>, f: &[f64], y: Option<&[f64]>) -> (Vec<Dd>, f64,
             for (j, r) in rho.iter_mut().enumerate() {
                 *r = dd(qp.q[j]);
             }
-            let mut e = dd(0.0);
+            let (mut e, mut smoothness) = (dd(0.0), 0.0);
+            let d = qp.data;
             qp.p.for_each_column(|j, ri, v| {
                 for (&i, &v) in ri.iter().zip(v) {
                     rho[i] += product(v, f[j]);
                     e += product(v, f[i]) * dd(f[j]);
+                    if let Some(d) = d {
+                        let aij = if i == j { v - d[j] } else { v };
+                        smoothness += f[i] * aij * f[j];
+                    }
                 }
             });
-            return (rho, auxiliary_residual, Some(0.5 * round(e)));
+            return (rho, auxiliary_residual, Some((0.5 * round(e), d.map(|_| smoothness))));
         }
     }
     (rho, auxiliary_residual, None)

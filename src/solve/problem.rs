@@ -508,7 +508,6 @@ pub(super) fn reduce_with(qp: &MonotoneQp<'_>, free: &[usize], triplets: bool) -
     let xfix = |i: usize| qp.fixed[i].unwrap_or(0.0);
     let mut q: Vec<f64> = free.iter().map(|&i| qp.q[i]).collect();
     let nf = free.len();
-    let mut work = qp.p.workspace();
     // a band when every free entry lies near the diagonal (a series), else triplets
     let made = matches!(qp.p, Quadratic::Columns(_));
     let width = if triplets { qp.p.slot_width_at_most(&slot, crate::linalg::BANDED_MAX) } else { None };
@@ -542,6 +541,8 @@ pub(super) fn reduce_with(qp: &MonotoneQp<'_>, free: &[usize], triplets: bool) -
     if made && triplets {
         qp.p.for_each_column(&mut visit);
     } else {
+        // made columns' workspace only where a column is made one at a time (12 bytes a vertex)
+        let mut work = qp.p.workspace();
         for (j, &sj) in slot.iter().enumerate() {
             if made && sj != usize::MAX {
                 let diagonal = qp.p.entry(j, j).unwrap_or(0.0);
@@ -552,7 +553,6 @@ pub(super) fn reduce_with(qp: &MonotoneQp<'_>, free: &[usize], triplets: bool) -
             }
         }
     }
-    drop(work);
     if made && !triplets {
         upper = qp.p.upper_entries_at_most(free);
     }
